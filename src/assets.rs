@@ -1,0 +1,14 @@
+//! Data built into the binary so it runs from any directory, with no files beside it.
+
+use std::path::Path;
+
+use crate::geometry::{parse_bpt, BezierPatch};
+
+/// Newell's Utah teapot (1975): 32 bicubic patches, z up, in the `.bpt` text format.
+/// The same figures as `assets/teapot.bpt`.
+pub const TEAPOT_BPT: &str = include_str!("../assets/teapot.bpt");
+
+/// The Utah teapot's 32 patches.
+pub fn teapot() -> Vec<BezierPatch> {
+    parse_bpt(TEAPOT_BPT, Path::new("assets/teapot.bpt")).expect("the built-in teapot parses")
+}

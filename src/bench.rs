@@ -1,0 +1,86 @@
+//! Measurement harnesses behind `caustic bench`: deterministic inputs, figures printed, never
+//! asserted (tests assert correctness; benches report speed).
+
+use std::time::Instant;
+
+use glam::DVec3;
+
+use crate::assets::teapot;
+use crate::geometry::{GeometryBuilder, PatchMethod, Ray, SceneGeometry};
+
+/// Primary rays of a `width × height` pinhole view that frames the whole Utah teapot (z up),
+/// one ray through each pixel centre, row by row from the top.
+pub fn teapot_view(width: usize, height: usize) -> Vec<Ray> {
+    let target = DVec3::new(0.2, 0.0, 1.4);
+    let eye = target + 10.0 * DVec3::new(0.35, -1.0, 0.55).normalize();
+    let forward = (target - eye).normalize();
+    let right = forward.cross(DVec3::Z).normalize();
+    let up = right.cross(forward);
+    let half = (40.0f64.to_radians() * 0.5).tan();
+    let aspect = width as f64 / height as f64;
+    let mut rays = Vec::with_capacity(width * height);
+    for y in 0..height {
+        for x in 0..width {
+            let sx = ((x as f64 + 0.5) / width as f64 * 2.0 - 1.0) * half * aspect;
+            let sy = (1.0 - (y as f64 + 0.5) / height as f64 * 2.0) * half;
+            rays.push(Ray::new(eye, forward + sx * right + sy * up));
+        }
+    }
+    rays
+}
+
+/// The teapot's patches in a geometry using `method`.
+pub fn teapot_geometry(method: PatchMethod) -> SceneGeometry {
+    let mut builder = GeometryBuilder::with_patch_method(method);
+    for patch in teapot() {
+        builder.add_patch(patch, 0);
+    }
+    builder.build()
+}
+
+/// Timing of one intersector over one view.
+#[derive(Clone, Debug)]
+pub struct IntersectTiming {
+    /// Intersector name.
+    pub method: String,
+    /// Rays that hit the teapot.
+    pub hit_rays: usize,
+    /// Rays that miss it.
+    pub miss_rays: usize,
+    /// Mean nanoseconds per hitting ray.
+    pub ns_per_hit: f64,
+    /// Mean nanoseconds per missing ray.
+    pub ns_per_miss: f64,
+}
+
+/// Times `geometry.intersect` over `rays`, split into the rays that hit and those that miss,
+/// repeating each set `repeat` times on the calling thread.
+pub fn time_intersect(name: &str, geometry: &SceneGeometry, rays: &[Ray], repeat: usize) -> IntersectTiming {
+    let (hits, misses): (Vec<Ray>, Vec<Ray>) = rays
+        .iter()
+        .partition(|r| geometry.intersect(r, f64::INFINITY).is_some());
+    let time = |set: &[Ray]| {
+        if set.is_empty() {
+            return 0.0;
+        }
+        let start = Instant::now();
+        let mut checksum = 0.0;
+        for _ in 0..repeat {
+            for ray in set {
+                if let Some(h) = geometry.intersect(ray, f64::INFINITY) {
+                    checksum += h.t;
+                }
+            }
+        }
+        let elapsed = start.elapsed().as_secs_f64();
+        std::hint::black_box(checksum);
+        elapsed * 1e9 / (set.len() * repeat) as f64
+    };
+    IntersectTiming {
+        method: name.to_owned(),
+        hit_rays: hits.len(),
+        miss_rays: misses.len(),
+        ns_per_hit: time(&hits),
+        ns_per_miss: time(&misses),
+    }
+}

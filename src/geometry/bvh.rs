@@ -1,0 +1,298 @@
+//! A bounding volume hierarchy over primitive bounds: binned SAH construction (Wald 2007,
+//! "On fast construction of SAH-based bounding volume hierarchies"; pbrt-v4 `BVHAggregate`)
+//! flattened into a depth-first array, traversed front-to-back with an explicit stack.
+
+use glam::DVec3;
+
+use super::aabb::{safe_inverse, Aabb};
+use super::ray::Ray;
+
+/// A flattened node: an interior node's first child follows it, the second is at `offset`; a
+/// leaf holds `count > 0` primitives starting at `offset` in [`Bvh::order`].
+#[derive(Clone, Copy, Debug)]
+pub struct BvhNode {
+    /// Bounds of everything below.
+    pub bounds: Aabb,
+    /// Second child (interior) or first primitive (leaf).
+    pub offset: u32,
+    /// Number of primitives; 0 for an interior node.
+    pub count: u16,
+    /// Split axis of an interior node.
+    pub axis: u8,
+}
+
+/// The hierarchy: nodes plus the primitive order its leaves index into.
+#[derive(Clone, Debug, Default)]
+pub struct Bvh {
+    /// Depth-first nodes; `nodes[0]` is the root.
+    pub nodes: Vec<BvhNode>,
+    /// Primitive indices, grouped by leaf.
+    pub order: Vec<u32>,
+}
+
+const BINS: usize = 16;
+const MAX_LEAF: usize = 4;
+/// Cost of a node traversal relative to one primitive test, for the SAH.
+const TRAVERSAL_COST: f64 = 0.5;
+
+struct BuildItem {
+    bounds: Aabb,
+    centroid: DVec3,
+    index: u32,
+}
+
+impl Bvh {
+    /// Builds a hierarchy over primitives with the given bounds (index `i` is primitive `i`).
+    pub fn build(bounds: &[Aabb]) -> Self {
+        let mut items: Vec<BuildItem> = bounds
+            .iter()
+            .enumerate()
+            .map(|(i, b)| BuildItem {
+                bounds: *b,
+                centroid: b.centroid(),
+                index: i as u32,
+            })
+            .collect();
+        let mut bvh = Bvh {
+            nodes: Vec::with_capacity(2 * bounds.len()),
+            order: Vec::with_capacity(bounds.len()),
+        };
+        if !items.is_empty() {
+            bvh.build_node(&mut items);
+        }
+        bvh
+    }
+
+    /// Bounds of everything, or the empty box.
+    pub fn bounds(&self) -> Aabb {
+        self.nodes.first().map_or(Aabb::EMPTY, |n| n.bounds)
+    }
+
+    fn push_leaf(&mut self, bounds: Aabb, items: &[BuildItem]) -> usize {
+        let node = self.nodes.len();
+        self.nodes.push(BvhNode {
+            bounds,
+            offset: self.order.len() as u32,
+            count: items.len() as u16,
+            axis: 0,
+        });
+        self.order.extend(items.iter().map(|it| it.index));
+        node
+    }
+
+    fn build_node(&mut self, items: &mut [BuildItem]) -> usize {
+        let bounds = items.iter().fold(Aabb::EMPTY, |b, it| b.union(it.bounds));
+        if items.len() <= 1 {
+            return self.push_leaf(bounds, items);
+        }
+        let centroids = items.iter().fold(Aabb::EMPTY, |b, it| b.grow(it.centroid));
+        let axis = centroids.longest_axis();
+        let (lo, hi) = (centroids.min[axis], centroids.max[axis]);
+        if hi <= lo {
+            // All centroids coincide: no split can separate them.
+            if items.len() <= u16::MAX as usize {
+                return self.push_leaf(bounds, items);
+            }
+            let mid = items.len() / 2;
+            return self.push_interior(bounds, axis, items, mid);
+        }
+
+        // Bin centroids and sweep for the cheapest SAH split.
+        let bin_of = |c: DVec3| (((c[axis] - lo) / (hi - lo) * BINS as f64) as usize).min(BINS - 1);
+        let mut bin_bounds = [Aabb::EMPTY; BINS];
+        let mut bin_count = [0usize; BINS];
+        for it in items.iter() {
+            let b = bin_of(it.centroid);
+            bin_bounds[b] = bin_bounds[b].union(it.bounds);
+            bin_count[b] += 1;
+        }
+        let mut below_area = [0.0; BINS - 1];
+        let mut below_count = [0usize; BINS - 1];
+        let (mut acc, mut n) = (Aabb::EMPTY, 0);
+        for k in 0..BINS - 1 {
+            acc = acc.union(bin_bounds[k]);
+            n += bin_count[k];
+            below_area[k] = acc.surface_area();
+            below_count[k] = n;
+        }
+        let (mut best_cost, mut best_split) = (f64::INFINITY, 0);
+        let (mut acc, mut n) = (Aabb::EMPTY, 0);
+        for k in (0..BINS - 1).rev() {
+            acc = acc.union(bin_bounds[k + 1]);
+            n += bin_count[k + 1];
+            let cost = below_count[k] as f64 * below_area[k] + n as f64 * acc.surface_area();
+            if cost < best_cost {
+                best_cost = cost;
+                best_split = k;
+            }
+        }
+        let leaf_cost = items.len() as f64;
+        let split_cost = TRAVERSAL_COST + best_cost / bounds.surface_area().max(f64::MIN_POSITIVE);
+        if items.len() <= MAX_LEAF && leaf_cost <= split_cost {
+            return self.push_leaf(bounds, items);
+        }
+        let mut mid = partition(items, |it| bin_of(it.centroid) <= best_split);
+        if mid == 0 || mid == items.len() {
+            mid = items.len() / 2;
+            items.select_nth_unstable_by(mid, |a, b| a.centroid[axis].total_cmp(&b.centroid[axis]));
+        }
+        self.push_interior(bounds, axis, items, mid)
+    }
+
+    fn push_interior(&mut self, bounds: Aabb, axis: usize, items: &mut [BuildItem], mid: usize) -> usize {
+        let node = self.nodes.len();
+        self.nodes.push(BvhNode {
+            bounds,
+            offset: 0,
+            count: 0,
+            axis: axis as u8,
+        });
+        let (left, right) = items.split_at_mut(mid);
+        self.build_node(left);
+        let second = self.build_node(right);
+        self.nodes[node].offset = second as u32;
+        node
+    }
+
+    /// Visits, front to back, every primitive whose leaf the ray reaches before `t_max`.
+    /// `visit(primitive, t_max)` returns the distance of a nearer hit, which then bounds the
+    /// rest of the traversal. Returns the final `t_max`.
+    #[inline]
+    pub fn traverse(&self, ray: &Ray, mut t_max: f64, mut visit: impl FnMut(u32, f64) -> Option<f64>) -> f64 {
+        let Some(root) = self.nodes.first() else {
+            return t_max;
+        };
+        let inv_dir = safe_inverse(ray.dir);
+        if root.bounds.hit_interval(ray.origin, inv_dir, t_max).is_none() {
+            return t_max;
+        }
+        // Entries are nodes whose box the ray enters at the stored distance.
+        let mut stack = [(0u32, 0.0f64); 64];
+        let mut top = 0usize;
+        let mut node = 0usize;
+        loop {
+            let n = &self.nodes[node];
+            if n.count > 0 {
+                let first = n.offset as usize;
+                for &prim in &self.order[first..first + n.count as usize] {
+                    if let Some(t) = visit(prim, t_max) {
+                        t_max = t_max.min(t);
+                    }
+                }
+            } else {
+                // Test both children here; go to the nearer, keep the farther for later.
+                let (a, b) = (node + 1, n.offset as usize);
+                let ha = self.nodes[a].bounds.hit_interval(ray.origin, inv_dir, t_max);
+                let hb = self.nodes[b].bounds.hit_interval(ray.origin, inv_dir, t_max);
+                match (ha, hb) {
+                    (Some((ta, _)), Some((tb, _))) => {
+                        let (near, far, t_far) = if ta <= tb { (a, b, tb) } else { (b, a, ta) };
+                        stack[top] = (far as u32, t_far);
+                        top += 1;
+                        node = near;
+                        continue;
+                    }
+                    (Some(_), None) => {
+                        node = a;
+                        continue;
+                    }
+                    (None, Some(_)) => {
+                        node = b;
+                        continue;
+                    }
+                    (None, None) => {}
+                }
+            }
+            // Pop the next node the ray still reaches before the nearest hit so far.
+            loop {
+                if top == 0 {
+                    return t_max;
+                }
+                top -= 1;
+                let (next, t_enter) = stack[top];
+                if t_enter <= t_max {
+                    node = next as usize;
+                    break;
+                }
+            }
+        }
+    }
+
+    /// Whether any primitive reports a hit before `t_max`: `test(primitive)` for each candidate
+    /// until one returns `true` (shadow rays).
+    pub fn any(&self, ray: &Ray, t_max: f64, mut test: impl FnMut(u32) -> bool) -> bool {
+        let mut found = false;
+        self.traverse(ray, t_max, |prim, _| {
+            if !found && test(prim) {
+                found = true;
+                // A negative distance ends the traversal: no box starts before it.
+                return Some(-1.0);
+            }
+            None
+        });
+        found
+    }
+
+    /// Depth of the deepest leaf (for statistics and the stack-size guarantee).
+    pub fn depth(&self) -> usize {
+        fn walk(bvh: &Bvh, node: usize) -> usize {
+            let n = &bvh.nodes[node];
+            if n.count > 0 {
+                1
+            } else {
+                1 + walk(bvh, node + 1).max(walk(bvh, n.offset as usize))
+            }
+        }
+        if self.nodes.is_empty() {
+            0
+        } else {
+            walk(self, 0)
+        }
+    }
+}
+
+/// Moves the items satisfying `pred` to the front; returns how many there are.
+fn partition<T>(items: &mut [T], pred: impl Fn(&T) -> bool) -> usize {
+    let mut first = 0;
+    for k in 0..items.len() {
+        if pred(&items[k]) {
+            items.swap(first, k);
+            first += 1;
+        }
+    }
+    first
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn finds_the_same_nearest_box_as_brute_force() {
+        // A deterministic cloud of small boxes.
+        let mut boxes = Vec::new();
+        let mut x = 0x2545F4914F6CDD1Du64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..2000 {
+            let c = DVec3::new(next(), next(), next()) * 10.0;
+            boxes.push(Aabb::new(c, c + 0.2));
+        }
+        let bvh = Bvh::build(&boxes);
+        assert!(bvh.depth() < 64);
+        for _ in 0..500 {
+            let o = DVec3::new(next(), next(), next()) * 14.0 - 2.0;
+            let d = DVec3::new(next() - 0.5, next() - 0.5, next() - 0.5);
+            let ray = Ray::new(o, d);
+            let inv = safe_inverse(ray.dir);
+            let entry = |b: &Aabb| b.hit_interval(ray.origin, inv, f64::INFINITY).map(|(t0, _)| t0);
+            let brute = boxes.iter().filter_map(entry).fold(f64::INFINITY, f64::min);
+            let found = bvh.traverse(&ray, f64::INFINITY, |p, _| entry(&boxes[p as usize]));
+            assert_eq!(brute, found);
+        }
+    }
+}

@@ -1,0 +1,27 @@
+//! Geometry in `f64`: rays, bounds, Bézier patch maths and exact ray/patch intersection,
+//! spheres, quads and planes, triangle meshes, the BVH, and the container that holds a scene's
+//! shapes. DESIGN.md §2.
+
+pub mod aabb;
+pub mod bezier;
+pub mod bpt;
+pub mod bvh;
+pub mod mesh;
+pub mod patch;
+pub mod quad;
+pub mod ray;
+pub mod scene_geometry;
+pub mod sphere;
+
+pub use aabb::Aabb;
+pub use bezier::BezierPatch;
+pub use bpt::{load_bpt, parse_bpt, BptError};
+pub use bvh::Bvh;
+pub use mesh::{MeshError, TriangleMesh};
+pub use patch::{PatchHit, PatchLeaf, SubdivisionParams, Window};
+pub use quad::{Plane, Quad};
+pub use ray::{spawn_ray, Ray};
+pub use scene_geometry::{
+    GeometryBuilder, GeometryStats, Hit, PatchMethod, Primitive, SceneGeometry, ShapeRef,
+};
+pub use sphere::Sphere;

@@ -1,0 +1,427 @@
+//! All of a scene's shapes behind one SAH BVH: spheres, quads, triangle meshes and Bézier
+//! patches (as prepared leaves, or whole for the per-ray reference intersector), plus
+//! unbounded planes tested beside the BVH.
+//!
+//! ```
+//! use caustic::geometry::{GeometryBuilder, Ray, Sphere};
+//! use glam::DVec3;
+//!
+//! let mut builder = GeometryBuilder::default();
+//! builder.add_sphere(Sphere { center: DVec3::ZERO, radius: 1.0 }, 7);
+//! let geometry = builder.build();
+//! let hit = geometry.intersect(&Ray::new(DVec3::new(0.0, 0.0, -3.0), DVec3::Z), f64::INFINITY);
+//! assert_eq!(hit.map(|h| (h.t, h.object)), Some((2.0, 7)));
+//! ```
+
+use glam::{DVec2, DVec3};
+
+use super::aabb::Aabb;
+use super::bezier::BezierPatch;
+use super::bvh::Bvh;
+use super::mesh::TriangleMesh;
+use super::patch::{intersect_leaf, intersect_per_ray, subdivide, PatchLeaf, RayFrame, SubdivisionParams};
+use super::quad::{Plane, Quad};
+use super::ray::{spawn_ray, Ray};
+use super::sphere::Sphere;
+
+/// Which ray/patch intersector the geometry uses.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PatchMethod {
+    /// Leaves prepared once per scene, in the BVH; Newton per leaf (the default).
+    Prepared(SubdivisionParams),
+    /// The seed's per-ray queue subdivision to `depth` levels, then Newton (reference).
+    PerRay {
+        /// Subdivision levels before Newton.
+        depth: u32,
+    },
+}
+
+impl Default for PatchMethod {
+    fn default() -> Self {
+        PatchMethod::Prepared(SubdivisionParams::default())
+    }
+}
+
+/// One thing the BVH holds; the closed set of shapes (pbrt-style `match`, no trait objects).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Primitive {
+    /// `spheres[i]`.
+    Sphere(u32),
+    /// `quads[i]`.
+    Quad(u32),
+    /// Triangle `triangle` of `meshes[mesh]`.
+    Triangle {
+        /// Mesh index.
+        mesh: u32,
+        /// Triangle index within the mesh.
+        triangle: u32,
+    },
+    /// `leaves[i]` (prepared patch method).
+    PatchLeaf(u32),
+    /// `patches[i]` whole (per-ray patch method).
+    Patch(u32),
+    /// `planes[i]`: unbounded, so tested beside the BVH rather than in it.
+    Plane(u32),
+}
+
+/// Which shape a hit landed on: kind and index within its kind (stable across BVH builds).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ShapeRef {
+    /// A sphere.
+    Sphere(u32),
+    /// A quad.
+    Quad(u32),
+    /// A plane.
+    Plane(u32),
+    /// A mesh.
+    Mesh(u32),
+    /// A Bézier patch.
+    Patch(u32),
+}
+
+/// A ray's nearest intersection.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    /// Distance along the ray.
+    pub t: f64,
+    /// The hit point.
+    pub point: DVec3,
+    /// Geometric unit normal as the shape defines it (not flipped towards the ray).
+    pub normal: DVec3,
+    /// Unit shading normal (interpolated for meshes with normals), same side as `normal`.
+    pub shading_normal: DVec3,
+    /// Surface parameters: the original patch's `(u,v)`, sphere `(φ/2π, θ/π)`, quad `(a,b)`,
+    /// plane coordinates in scene units, mesh texture coordinates (or barycentrics).
+    pub uv: DVec2,
+    /// The caller's object id given when the shape was added.
+    pub object: u32,
+    /// The shape hit.
+    pub shape: ShapeRef,
+}
+
+impl Hit {
+    /// A ray leaving this hit in direction `dir`, offset so it cannot re-hit this point.
+    pub fn spawn(&self, dir: DVec3) -> Ray {
+        spawn_ray(self.point, self.normal, dir)
+    }
+}
+
+/// Collects shapes, then [`GeometryBuilder::build`]s the [`SceneGeometry`].
+#[derive(Clone, Debug, Default)]
+pub struct GeometryBuilder {
+    spheres: Vec<(Sphere, u32)>,
+    quads: Vec<(Quad, u32)>,
+    planes: Vec<(Plane, u32)>,
+    meshes: Vec<(TriangleMesh, u32)>,
+    patches: Vec<(BezierPatch, u32)>,
+    /// The patch intersector.
+    pub patch_method: PatchMethod,
+}
+
+impl GeometryBuilder {
+    /// An empty builder whose patches will use `patch_method`.
+    pub fn with_patch_method(patch_method: PatchMethod) -> Self {
+        Self {
+            patch_method,
+            ..Default::default()
+        }
+    }
+
+    /// Adds a sphere tagged with `object`.
+    pub fn add_sphere(&mut self, sphere: Sphere, object: u32) -> ShapeRef {
+        self.spheres.push((sphere, object));
+        ShapeRef::Sphere(self.spheres.len() as u32 - 1)
+    }
+    /// Adds a quad tagged with `object`.
+    pub fn add_quad(&mut self, quad: Quad, object: u32) -> ShapeRef {
+        self.quads.push((quad, object));
+        ShapeRef::Quad(self.quads.len() as u32 - 1)
+    }
+    /// Adds an infinite plane tagged with `object`.
+    pub fn add_plane(&mut self, plane: Plane, object: u32) -> ShapeRef {
+        self.planes.push((plane, object));
+        ShapeRef::Plane(self.planes.len() as u32 - 1)
+    }
+    /// Adds a triangle mesh tagged with `object`.
+    pub fn add_mesh(&mut self, mesh: TriangleMesh, object: u32) -> ShapeRef {
+        self.meshes.push((mesh, object));
+        ShapeRef::Mesh(self.meshes.len() as u32 - 1)
+    }
+    /// Adds a Bézier patch tagged with `object`.
+    pub fn add_patch(&mut self, patch: BezierPatch, object: u32) -> ShapeRef {
+        self.patches.push((patch, object));
+        ShapeRef::Patch(self.patches.len() as u32 - 1)
+    }
+
+    /// Prepares patches (per the patch method) and builds the BVH.
+    pub fn build(self) -> SceneGeometry {
+        let patch_scales: Vec<f64> = self
+            .patches
+            .iter()
+            .map(|(p, _)| p.bounds().diagonal().length())
+            .collect();
+        let mut leaves = Vec::new();
+        if let PatchMethod::Prepared(params) = self.patch_method {
+            for (k, (patch, _)) in self.patches.iter().enumerate() {
+                leaves.extend(subdivide(patch, k as u32, &params));
+            }
+        }
+        let mut primitives = Vec::new();
+        let mut bounds = Vec::new();
+        for (k, (s, _)) in self.spheres.iter().enumerate() {
+            primitives.push(Primitive::Sphere(k as u32));
+            bounds.push(s.bounds());
+        }
+        for (k, (q, _)) in self.quads.iter().enumerate() {
+            primitives.push(Primitive::Quad(k as u32));
+            bounds.push(q.bounds());
+        }
+        for (m, (mesh, _)) in self.meshes.iter().enumerate() {
+            for t in 0..mesh.indices.len() {
+                primitives.push(Primitive::Triangle {
+                    mesh: m as u32,
+                    triangle: t as u32,
+                });
+                bounds.push(mesh.triangle_bounds(t));
+            }
+        }
+        match self.patch_method {
+            PatchMethod::Prepared(_) => {
+                for (k, leaf) in leaves.iter().enumerate() {
+                    primitives.push(Primitive::PatchLeaf(k as u32));
+                    bounds.push(leaf.bounds);
+                }
+            }
+            PatchMethod::PerRay { .. } => {
+                for (k, (p, _)) in self.patches.iter().enumerate() {
+                    primitives.push(Primitive::Patch(k as u32));
+                    bounds.push(p.bounds().padded(1e-9 * patch_scales[k]));
+                }
+            }
+        }
+        let bvh = Bvh::build(&bounds);
+        SceneGeometry {
+            spheres: self.spheres,
+            quads: self.quads,
+            planes: self.planes,
+            meshes: self.meshes,
+            patches: self.patches,
+            patch_scales,
+            leaves,
+            primitives,
+            bvh,
+            patch_method: self.patch_method,
+        }
+    }
+}
+
+/// Shapes and the BVH over them, ready for rays.
+#[derive(Clone, Debug)]
+pub struct SceneGeometry {
+    spheres: Vec<(Sphere, u32)>,
+    quads: Vec<(Quad, u32)>,
+    planes: Vec<(Plane, u32)>,
+    meshes: Vec<(TriangleMesh, u32)>,
+    patches: Vec<(BezierPatch, u32)>,
+    patch_scales: Vec<f64>,
+    leaves: Vec<PatchLeaf>,
+    /// Everything in the BVH; its leaves index this list.
+    primitives: Vec<Primitive>,
+    bvh: Bvh,
+    patch_method: PatchMethod,
+}
+
+/// The raw result of a primitive test, before the hit record is filled in.
+#[derive(Clone, Copy)]
+struct Candidate {
+    t: f64,
+    primitive: Primitive,
+    /// Shape-specific parameters: patch `(u,v)`, quad `(a,b)`, triangle barycentrics.
+    param: DVec2,
+}
+
+impl SceneGeometry {
+    /// Bounds of the bounded shapes (planes excluded).
+    pub fn bounds(&self) -> Aabb {
+        self.bvh.bounds()
+    }
+
+    /// The patches, with their object ids.
+    pub fn patches(&self) -> &[(BezierPatch, u32)] {
+        &self.patches
+    }
+
+    /// The prepared leaves (empty for the per-ray method).
+    pub fn patch_leaves(&self) -> &[PatchLeaf] {
+        &self.leaves
+    }
+
+    /// Counts of what the BVH holds, for statistics.
+    pub fn stats(&self) -> GeometryStats {
+        GeometryStats {
+            primitives: self.primitives.len(),
+            bvh_nodes: self.bvh.nodes.len(),
+            bvh_depth: self.bvh.depth(),
+            patches: self.patches.len(),
+            patch_leaves: self.leaves.len(),
+        }
+    }
+
+    /// Whether the scene holds any Bézier patch.
+    pub fn has_patches(&self) -> bool {
+        !self.patches.is_empty()
+    }
+
+    fn test(
+        &self,
+        primitive: Primitive,
+        ray: &Ray,
+        frame: &Option<RayFrame>,
+        t_max: f64,
+    ) -> Option<Candidate> {
+        let hit = |t: f64, param: DVec2| Candidate { t, primitive, param };
+        match primitive {
+            Primitive::Sphere(i) => self.spheres[i as usize]
+                .0
+                .intersect(ray, 0.0, t_max)
+                .map(|t| hit(t, DVec2::ZERO)),
+            Primitive::Quad(i) => self.quads[i as usize]
+                .0
+                .intersect(ray, 0.0, t_max)
+                .map(|(t, ab)| hit(t, ab)),
+            Primitive::Triangle { mesh, triangle } => self.meshes[mesh as usize]
+                .0
+                .intersect_triangle(triangle as usize, ray, 0.0, t_max)
+                .map(|h| hit(h.t, h.barycentric)),
+            Primitive::PatchLeaf(i) => {
+                let frame = frame.as_ref()?;
+                intersect_leaf(&self.leaves[i as usize], frame, 0.0, t_max).map(|h| hit(h.t, h.uv))
+            }
+            Primitive::Patch(i) => {
+                let depth = match self.patch_method {
+                    PatchMethod::PerRay { depth } => depth,
+                    PatchMethod::Prepared(_) => 0,
+                };
+                intersect_per_ray(
+                    &self.patches[i as usize].0,
+                    self.patch_scales[i as usize],
+                    ray,
+                    0.0,
+                    t_max,
+                    depth,
+                )
+                .map(|h| hit(h.t, h.uv))
+            }
+            Primitive::Plane(i) => self.planes[i as usize]
+                .0
+                .intersect(ray, 0.0, t_max)
+                .map(|t| hit(t, DVec2::ZERO)),
+        }
+    }
+
+    fn nearest(&self, ray: &Ray, t_max: f64) -> Option<Candidate> {
+        let frame = self.has_patches().then(|| RayFrame::new(ray));
+        let mut best: Option<Candidate> = None;
+        let t_max = self.bvh.traverse(ray, t_max, |k, t_max| {
+            let c = self.test(self.primitives[k as usize], ray, &frame, t_max)?;
+            best = Some(c);
+            Some(c.t)
+        });
+        for k in 0..self.planes.len() {
+            let t_max = best.map_or(t_max, |b| b.t);
+            if let Some(c) = self.test(Primitive::Plane(k as u32), ray, &frame, t_max) {
+                best = Some(c);
+            }
+        }
+        best
+    }
+
+    /// The nearest hit of `ray` in `(0, t_max)`.
+    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<Hit> {
+        let c = self.nearest(ray, t_max)?;
+        let point = ray.at(c.t);
+        let (normal, shading_normal, uv, object, shape) = match c.primitive {
+            Primitive::Sphere(i) => {
+                let (s, obj) = &self.spheres[i as usize];
+                let n = s.normal(point);
+                (n, n, s.uv(point), *obj, ShapeRef::Sphere(i))
+            }
+            Primitive::Plane(i) => {
+                let (p, obj) = &self.planes[i as usize];
+                (p.normal, p.normal, p.uv(point), *obj, ShapeRef::Plane(i))
+            }
+            Primitive::Quad(i) => {
+                let (q, obj) = &self.quads[i as usize];
+                let n = q.normal();
+                (n, n, c.param, *obj, ShapeRef::Quad(i))
+            }
+            Primitive::Triangle { mesh, triangle } => {
+                let (m, obj) = &self.meshes[mesh as usize];
+                let n = m.geometric_normal(triangle as usize);
+                let mut ns = m.shading_normal(triangle as usize, c.param);
+                if ns.dot(n) < 0.0 {
+                    ns = -ns;
+                }
+                (
+                    n,
+                    ns,
+                    m.uv(triangle as usize, c.param),
+                    *obj,
+                    ShapeRef::Mesh(mesh),
+                )
+            }
+            Primitive::PatchLeaf(i) => {
+                let patch = self.leaves[i as usize].patch;
+                self.patch_surface(patch, c.param)
+            }
+            Primitive::Patch(patch) => self.patch_surface(patch, c.param),
+        };
+        Some(Hit {
+            t: c.t,
+            point,
+            normal,
+            shading_normal,
+            uv,
+            object,
+            shape,
+        })
+    }
+
+    fn patch_surface(&self, patch: u32, uv: DVec2) -> (DVec3, DVec3, DVec2, u32, ShapeRef) {
+        let (p, obj) = &self.patches[patch as usize];
+        // A patch degenerate everywhere has no normal; any unit vector keeps shading finite.
+        let n = p.normal(uv.x, uv.y).unwrap_or(DVec3::Z);
+        (n, n, uv, *obj, ShapeRef::Patch(patch))
+    }
+
+    /// Whether anything lies on `ray` in `(0, t_max)` (shadow rays).
+    pub fn occluded(&self, ray: &Ray, t_max: f64) -> bool {
+        if self
+            .planes
+            .iter()
+            .any(|(p, _)| p.intersect(ray, 0.0, t_max).is_some())
+        {
+            return true;
+        }
+        let frame = self.has_patches().then(|| RayFrame::new(ray));
+        self.bvh.any(ray, t_max, |k| {
+            self.test(self.primitives[k as usize], ray, &frame, t_max)
+                .is_some()
+        })
+    }
+}
+
+/// Sizes of a built geometry.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct GeometryStats {
+    /// Primitives in the BVH.
+    pub primitives: usize,
+    /// BVH nodes.
+    pub bvh_nodes: usize,
+    /// Deepest BVH leaf.
+    pub bvh_depth: usize,
+    /// Bézier patches.
+    pub patches: usize,
+    /// Prepared patch leaves.
+    pub patch_leaves: usize,
+}

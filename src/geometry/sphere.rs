@@ -1,0 +1,90 @@
+//! Spheres, intersected with the numerically careful quadratic of Haines et al., "Precision
+//! Improvements for Ray/Sphere Intersection" (Ray Tracing Gems, ch. 7), which keeps
+//! smallppm's walls — spheres of radius 1e5 — accurate where the textbook formula is not.
+
+use glam::{DVec2, DVec3};
+
+use super::aabb::Aabb;
+use super::ray::Ray;
+
+/// A sphere.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sphere {
+    /// Centre.
+    pub center: DVec3,
+    /// Radius (positive).
+    pub radius: f64,
+}
+
+impl Sphere {
+    /// Bounds.
+    pub fn bounds(&self) -> Aabb {
+        Aabb::new(self.center - self.radius, self.center + self.radius)
+    }
+
+    /// Nearest distance in `(t_min, t_max)` at which `ray` meets the sphere.
+    pub fn intersect(&self, ray: &Ray, t_min: f64, t_max: f64) -> Option<f64> {
+        let f = ray.origin - self.center;
+        let b = -f.dot(ray.dir);
+        // r² − |f − (f·d)d|², robust for rays far from large spheres.
+        let l = f + b * ray.dir;
+        let disc = self.radius * self.radius - l.length_squared();
+        if disc < 0.0 {
+            return None;
+        }
+        let c = f.length_squared() - self.radius * self.radius;
+        let q = b + b.signum() * disc.sqrt();
+        let (mut t0, mut t1) = if q == 0.0 { (0.0, 0.0) } else { (c / q, q) };
+        if t0 > t1 {
+            std::mem::swap(&mut t0, &mut t1);
+        }
+        [t0, t1].into_iter().find(|&t| t > t_min && t < t_max)
+    }
+
+    /// Outward unit normal at `p` on the sphere.
+    pub fn normal(&self, p: DVec3) -> DVec3 {
+        (p - self.center) / self.radius
+    }
+
+    /// Spherical `(u,v)`: `u = φ/2π` around the y axis, `v = θ/π` from +y.
+    pub fn uv(&self, p: DVec3) -> DVec2 {
+        let n = self.normal(p);
+        let phi = n.z.atan2(n.x);
+        let u = (phi / std::f64::consts::TAU).rem_euclid(1.0);
+        let v = n.y.clamp(-1.0, 1.0).acos() / std::f64::consts::PI;
+        DVec2::new(u, v)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hits_from_outside_and_inside() {
+        let s = Sphere {
+            center: DVec3::ZERO,
+            radius: 2.0,
+        };
+        let out = Ray::new(DVec3::new(0.0, 0.0, -5.0), DVec3::Z);
+        assert_eq!(s.intersect(&out, 0.0, f64::INFINITY), Some(3.0));
+        let inside = Ray::new(DVec3::ZERO, DVec3::X);
+        assert_eq!(s.intersect(&inside, 0.0, f64::INFINITY), Some(2.0));
+        assert_eq!(s.intersect(&out, 0.0, 2.5), None);
+    }
+
+    #[test]
+    fn huge_wall_sphere_is_accurate() {
+        // smallppm's left wall: radius 1e5, the room (x in (1, 99)) inside it, inner surface at x = 1.
+        let wall = Sphere {
+            center: DVec3::new(1e5 + 1.0, 40.8, 81.6),
+            radius: 1e5,
+        };
+        let ray = Ray::new(DVec3::new(50.0, 40.8, 81.6), -DVec3::X);
+        let t = wall.intersect(&ray, 0.0, f64::INFINITY).expect("hit");
+        assert!((t - 49.0).abs() < 1e-10, "t = {t}");
+        let oblique = Ray::new(DVec3::new(50.0, 40.0, 80.0), DVec3::new(-1.0, 0.3, 0.2));
+        let hit = oblique.at(wall.intersect(&oblique, 0.0, f64::INFINITY).expect("hit"));
+        assert!(((hit - wall.center).length() - 1e5).abs() < 1e-9);
+    }
+}

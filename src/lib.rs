@@ -1,0 +1,19 @@
+//! # caustic
+//!
+//! Exact ray tracing of bicubic Bézier patches and progressive photon mapping, with a live
+//! viewer. This crate is the render core: it never depends on the GUI.
+//!
+//! * [`geometry`]: rays, bounds, Bézier patch maths, exact ray/patch intersection (prepared
+//!   sub-patches + Newton, and the seed's per-ray subdivision as a reference), spheres, quads,
+//!   planes, triangle meshes and the SAH BVH holding them.
+//! * [`assets`]: the data the binary carries built in (Newell's teapot).
+//! * [`bench`]: measurement harnesses used by `caustic bench`.
+//!
+//! The architecture of record is DESIGN.md (kept beside the project); module docs name the
+//! paper or source of every algorithm they implement.
+
+#![forbid(unsafe_code)]
+
+pub mod assets;
+pub mod bench;
+pub mod geometry;
