@@ -6,6 +6,8 @@
 //! * [`geometry`]: rays, bounds, Bézier patch maths, exact ray/patch intersection (prepared
 //!   sub-patches + Newton, and the seed's per-ray subdivision as a reference), spheres, quads,
 //!   planes, triangle meshes and the SAH BVH holding them.
+//! * [`scene`]: the TOML scene format, validation, camera, materials, textures, lights.
+//! * [`render`]: the Whitted ray tracer, the film and its PNG/EXR output, random streams.
 //! * [`assets`]: the data the binary carries built in (Newell's teapot).
 //! * [`bench`]: measurement harnesses used by `caustic bench`.
 //!
@@ -17,3 +19,5 @@
 pub mod assets;
 pub mod bench;
 pub mod geometry;
+pub mod render;
+pub mod scene;

@@ -1,17 +1,18 @@
-//! The `caustic` command line.
+//! The `caustic` command line: render scenes to images, export patches as OBJ, benchmark.
 
-use anyhow::{bail, Result};
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
 
 use caustic::bench::{teapot_geometry, teapot_view, time_intersect};
+use caustic::geometry::tessellate::{tessellate, write_obj};
 use caustic::geometry::{PatchMethod, SubdivisionParams};
+use caustic::render::{render_whitted, Metadata};
+use caustic::scene::{RendererKind, Scene};
 
 #[derive(Parser)]
-#[command(
-    name = "caustic",
-    version,
-    about = "Progressive photon mapping of exact Bézier patches"
-)]
+#[command(name = "caustic", version, about = "Progressive photon mapping of exact Bézier patches")]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -19,11 +20,57 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Render a scene to an image (PNG: tonemapped sRGB; EXR: linear float).
+    Render {
+        /// Scene file (TOML); the built-in teapot scene when omitted.
+        scene: Option<PathBuf>,
+        /// Output image: .png or .exr.
+        #[arg(short, long)]
+        out: PathBuf,
+        /// Override the scene's image width.
+        #[arg(long)]
+        width: Option<u32>,
+        /// Override the scene's image height.
+        #[arg(long)]
+        height: Option<u32>,
+        /// Override the scene's seed.
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Override the scene's renderer.
+        #[arg(long, value_enum)]
+        renderer: Option<RendererChoice>,
+        /// PNG exposure in stops (EXR is always linear).
+        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+        exposure: f32,
+        /// Replace the output file if it exists.
+        #[arg(long)]
+        force: bool,
+    },
+    /// Write a scene's Bézier patches, tessellated, as a Wavefront OBJ file.
+    ExportObj {
+        /// Scene file (TOML); the built-in scene when omitted.
+        scene: Option<PathBuf>,
+        /// Output .obj file.
+        #[arg(short, long)]
+        out: PathBuf,
+        /// Quads per patch side.
+        #[arg(long, default_value_t = 16)]
+        resolution: usize,
+        /// Replace the output file if it exists.
+        #[arg(long)]
+        force: bool,
+    },
     /// Measure performance; prints figures (nothing is asserted).
     Bench {
         #[command(subcommand)]
         what: BenchCommand,
     },
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum RendererChoice {
+    Whitted,
+    Ppm,
 }
 
 #[derive(Subcommand)]
@@ -52,6 +99,17 @@ enum BenchCommand {
         #[arg(long, default_value_t = SubdivisionParams::default().max_depth)]
         max_depth: u32,
     },
+    /// Whitted ray tracer: rays per second on a scene, at the given thread counts.
+    Whitted {
+        /// Scene file; the built-in scene when omitted.
+        scene: Option<PathBuf>,
+        /// Image width (height follows the scene's aspect).
+        #[arg(long, default_value_t = 640)]
+        width: u32,
+        /// Thread counts to measure.
+        #[arg(long, value_delimiter = ',', default_value = "1,2")]
+        threads: Vec<usize>,
+    },
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -62,28 +120,190 @@ enum MethodChoice {
 }
 
 fn main() -> Result<()> {
-    let cli = Cli::parse();
-    match cli.command {
-        Command::Bench {
-            what:
-                BenchCommand::Intersect {
-                    size,
-                    repeat,
-                    method,
-                    per_ray_depth,
-                    flatness,
-                    max_size,
-                    max_depth,
-                },
-        } => {
-            let params = SubdivisionParams {
+    match Cli::parse().command {
+        Command::Render {
+            scene,
+            out,
+            width,
+            height,
+            seed,
+            renderer,
+            exposure,
+            force,
+        } => render(scene.as_deref(), &out, width, height, seed, renderer, exposure, force),
+        Command::ExportObj {
+            scene,
+            out,
+            resolution,
+            force,
+        } => export_obj(scene.as_deref(), &out, resolution, force),
+        Command::Bench { what } => match what {
+            BenchCommand::Intersect {
+                size,
+                repeat,
+                method,
+                per_ray_depth,
                 flatness,
                 max_size,
                 max_depth,
-            };
-            bench_intersect(size, repeat, method, per_ray_depth, params)
+            } => {
+                let params = SubdivisionParams {
+                    flatness,
+                    max_size,
+                    max_depth,
+                };
+                bench_intersect(size, repeat, method, per_ray_depth, params)
+            }
+            BenchCommand::Whitted { scene, width, threads } => bench_whitted(scene.as_deref(), width, &threads),
+        },
+    }
+}
+
+fn load_scene(path: Option<&Path>) -> Result<Scene> {
+    match path {
+        Some(p) => Ok(Scene::load(p)?),
+        None => Ok(Scene::builtin()),
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn render(
+    scene_path: Option<&Path>,
+    out: &Path,
+    width: Option<u32>,
+    height: Option<u32>,
+    seed: Option<u64>,
+    renderer: Option<RendererChoice>,
+    exposure: f32,
+    force: bool,
+) -> Result<()> {
+    if caustic::render::film::Format::from_path(out).is_none() {
+        bail!("{}: unknown image format (use .png or .exr)", out.display());
+    }
+    if out.exists() && !force {
+        bail!("{}: the file exists; choose another name or pass --force to overwrite it", out.display());
+    }
+    if !exposure.is_finite() || exposure.abs() > 64.0 {
+        bail!("--exposure must be a finite number of stops between -64 and 64, got {exposure}");
+    }
+    let mut scene = load_scene(scene_path)?;
+    for (flag, v) in [("--width", width), ("--height", height)] {
+        if let Some(v) = v {
+            if !(1..=16384).contains(&v) {
+                bail!("{flag} must be between 1 and 16384 pixels, got {v}");
+            }
         }
     }
+    if let Some(w) = width {
+        scene.camera.width = w;
+    }
+    if let Some(h) = height {
+        scene.camera.height = h;
+    }
+    if let Some(s) = seed {
+        scene.settings.seed = s;
+    }
+    let kind = match renderer {
+        Some(RendererChoice::Whitted) => RendererKind::Whitted,
+        Some(RendererChoice::Ppm) => RendererKind::Ppm,
+        None => scene.settings.renderer,
+    };
+    if kind == RendererKind::Ppm {
+        bail!(
+            "{}: the scene asks for the photon mapper, which this version does not have yet; \
+             render it with --renderer whitted",
+            scene.source.display()
+        );
+    }
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    let bar = indicatif::ProgressBar::new(h as u64).with_style(
+        indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} rows, {elapsed} (eta {eta})")
+            .context("progress bar template")?
+            .progress_chars("=> "),
+    );
+    bar.set_message(format!("ray tracing {w}x{h}"));
+    let (image, stats) = render_whitted(&scene, &|rows| bar.inc(rows as u64));
+    bar.finish_and_clear();
+    let metadata: Metadata = vec![
+        ("Software".into(), format!("caustic {}", env!("CARGO_PKG_VERSION"))),
+        ("caustic:scene".into(), scene.source.display().to_string()),
+        ("caustic:renderer".into(), "whitted".into()),
+        ("caustic:seed".into(), scene.settings.seed.to_string()),
+        ("caustic:size".into(), format!("{w}x{h}")),
+        ("caustic:camera_rays".into(), stats.camera_rays.to_string()),
+        ("caustic:elapsed_secs".into(), format!("{:.3}", stats.elapsed_secs)),
+    ];
+    image.save(out, exposure, &metadata, force)?;
+    println!(
+        "{}: {w}x{h} ray traced in {:.2} s ({} camera rays, {} edge pixels re-sampled, {:.0} rays/s)",
+        out.display(),
+        stats.elapsed_secs,
+        stats.camera_rays,
+        stats.edge_pixels,
+        stats.camera_rays as f64 / stats.elapsed_secs.max(1e-9)
+    );
+    Ok(())
+}
+
+fn export_obj(scene_path: Option<&Path>, out: &Path, resolution: usize, force: bool) -> Result<()> {
+    if !(1..=256).contains(&resolution) {
+        bail!("--resolution must be between 1 and 256, got {resolution}");
+    }
+    if out.exists() && !force {
+        bail!("{}: the file exists; choose another name or pass --force to overwrite it", out.display());
+    }
+    let scene = load_scene(scene_path)?;
+    let meshes: Vec<(String, caustic::geometry::TriangleMesh)> = scene
+        .geometry
+        .patches()
+        .iter()
+        .enumerate()
+        .map(|(k, (p, obj))| {
+            let name = format!("{}_patch{k}", scene.objects[*obj as usize].name.replace(' ', "_"));
+            (name, tessellate(p, resolution))
+        })
+        .collect();
+    if meshes.is_empty() {
+        bail!("{}: the scene has no Bézier patches to export", scene.source.display());
+    }
+    let tmp = out.with_extension("obj.partial");
+    let write = || -> std::io::Result<()> {
+        let mut file = std::io::BufWriter::new(std::fs::File::create(&tmp)?);
+        write_obj(&meshes, &mut file)?;
+        std::io::Write::flush(&mut file)?;
+        std::fs::rename(&tmp, out)
+    };
+    write().with_context(|| format!("{}: cannot write the OBJ file", out.display()))?;
+    let triangles: usize = meshes.iter().map(|(_, m)| m.indices.len()).sum();
+    println!("{}: {} patches, {triangles} triangles", out.display(), meshes.len());
+    Ok(())
+}
+
+fn bench_whitted(scene_path: Option<&Path>, width: u32, threads: &[usize]) -> Result<()> {
+    let mut scene = load_scene(scene_path)?;
+    let aspect = scene.camera.height as f64 / scene.camera.width as f64;
+    scene.camera.width = width.clamp(1, 16384);
+    scene.camera.height = ((width as f64 * aspect).round() as u32).max(1);
+    println!(
+        "Whitted ray tracer on {}, {}x{}",
+        scene.source.display(),
+        scene.camera.width,
+        scene.camera.height
+    );
+    println!("{:>8} {:>10} {:>14} {:>12}", "threads", "seconds", "camera rays/s", "speed-up");
+    let mut base = None;
+    for &n in threads {
+        if n == 0 {
+            bail!("--threads values must be at least 1");
+        }
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(n).build()?;
+        let (_, stats) = pool.install(|| render_whitted(&scene, &|_| {}));
+        let rate = stats.camera_rays as f64 / stats.elapsed_secs;
+        let speedup = base.map_or(1.0, |b: f64| stats.elapsed_secs.recip() * b);
+        base.get_or_insert(stats.elapsed_secs);
+        println!("{n:>8} {:>10.3} {rate:>14.0} {speedup:>11.2}x", stats.elapsed_secs);
+    }
+    Ok(())
 }
 
 fn bench_intersect(

@@ -12,6 +12,7 @@ pub mod quad;
 pub mod ray;
 pub mod scene_geometry;
 pub mod sphere;
+pub mod tessellate;
 
 pub use aabb::Aabb;
 pub use bezier::BezierPatch;

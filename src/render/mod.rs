@@ -1,0 +1,9 @@
+//! Renderers and what they render into: the Whitted ray tracer, the film (linear RGB with
+//! tonemapping and PNG/EXR output) and deterministic random streams. DESIGN.md §3.
+
+pub mod film;
+pub mod rng;
+pub mod whitted;
+
+pub use film::{Image, Metadata};
+pub use whitted::{render_whitted, WhittedStats};

@@ -1,0 +1,103 @@
+//! Materials: Lambertian diffuse with an optional Phong lobe, perfect mirrors, and dielectric
+//! glass with exact Fresnel reflectance and total internal reflection.
+
+use glam::DVec3;
+
+/// A surface's reflectance model.
+#[derive(Clone, Debug, PartialEq)]
+pub enum MaterialKind {
+    /// Lambertian, `f = ρ/π`, plus an energy-normalised Phong lobe when `specular > 0`:
+    /// `f_s = specular · (n+2)/(2π) · cos^n α` (Lafortune & Willems 1994).
+    Diffuse {
+        /// Phong specular reflectance.
+        specular: f64,
+        /// Phong exponent.
+        shininess: f64,
+    },
+    /// Perfect specular reflection tinted by the colour.
+    Mirror,
+    /// Smooth dielectric with index of refraction `ior` (relative to the outside, 1).
+    Glass {
+        /// Index of refraction.
+        ior: f64,
+    },
+}
+
+/// A material: its model, its colour (reflectance or tint), and optionally a texture replacing
+/// the colour.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    /// The name in the scene file.
+    pub name: String,
+    /// The reflectance model.
+    pub kind: MaterialKind,
+    /// Reflectance or tint, components in [0, 1].
+    pub color: DVec3,
+    /// Index into the scene's textures.
+    pub texture: Option<usize>,
+}
+
+impl Material {
+    /// Whether photons stop here and radiance is estimated (diffuse surfaces).
+    pub fn is_diffuse(&self) -> bool {
+        matches!(self.kind, MaterialKind::Diffuse { .. })
+    }
+}
+
+/// Fresnel reflectance of a smooth dielectric interface for unpolarised light (exact, not
+/// Schlick): `cos_i` is the cosine of the incident angle on the incident side, `eta` the ratio
+/// `n_incident / n_transmitted`. Returns 1 under total internal reflection.
+pub fn fresnel_dielectric(cos_i: f64, eta: f64) -> f64 {
+    let cos_i = cos_i.clamp(0.0, 1.0);
+    let sin2_t = eta * eta * (1.0 - cos_i * cos_i);
+    if sin2_t >= 1.0 {
+        return 1.0;
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    let r_parallel = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    let r_perpendicular = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    0.5 * (r_parallel * r_parallel + r_perpendicular * r_perpendicular)
+}
+
+/// Mirror reflection of `d` about the unit normal `n`.
+pub fn reflect(d: DVec3, n: DVec3) -> DVec3 {
+    d - 2.0 * d.dot(n) * n
+}
+
+/// Refraction of the unit direction `d` through a surface with unit normal `n` facing against
+/// `d`, with `eta = n_incident / n_transmitted`; `None` under total internal reflection.
+pub fn refract(d: DVec3, n: DVec3, eta: f64) -> Option<DVec3> {
+    let cos_i = -d.dot(n);
+    let sin2_t = eta * eta * (1.0 - cos_i * cos_i);
+    if sin2_t >= 1.0 {
+        return None;
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    Some((eta * d + (eta * cos_i - cos_t) * n).normalize())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fresnel_at_normal_incidence_and_tir() {
+        let r = fresnel_dielectric(1.0, 1.0 / 1.5);
+        assert!((r - 0.04).abs() < 1e-12);
+        assert_eq!(fresnel_dielectric(0.1, 1.5), 1.0);
+        // Same reflectance from either side at corresponding angles (Stokes).
+        let d = DVec3::new(0.6, 0.0, -0.8);
+        let t = refract(d, DVec3::Z, 1.0 / 1.5).expect("refracts");
+        let outside = fresnel_dielectric(0.8, 1.0 / 1.5);
+        let inside = fresnel_dielectric(-t.z, 1.5);
+        assert!((outside - inside).abs() < 1e-12);
+    }
+
+    #[test]
+    fn snell_holds() {
+        let d = DVec3::new(0.6, 0.0, -0.8);
+        let t = refract(d, DVec3::Z, 1.0 / 1.33).expect("refracts");
+        assert!((0.6 - 1.33 * t.x).abs() < 1e-12);
+        assert!(refract(DVec3::new(0.9, 0.0, -0.43588989435406733), DVec3::Z, 1.5).is_none());
+    }
+}

@@ -1,0 +1,183 @@
+//! Scenes: the file format, validation with errors that name file, line and field, and the
+//! runtime scene the renderers read (camera, materials, textures, lights, geometry).
+//! DESIGN.md §3; the format reference is `scenes/FORMAT.md`.
+
+pub mod camera;
+pub mod format;
+pub mod light;
+mod load;
+pub mod material;
+pub mod texture;
+
+use std::path::PathBuf;
+
+use glam::{DVec2, DVec3};
+
+pub use camera::Camera;
+pub use light::Light;
+pub use load::SceneError;
+pub use material::{Material, MaterialKind};
+pub use texture::Texture;
+
+use crate::geometry::{Hit, SceneGeometry};
+
+/// Which renderer a scene asks for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RendererKind {
+    /// The Whitted ray tracer (preview, and the seed report's first renderer).
+    Whitted,
+    /// Progressive photon mapping.
+    Ppm,
+}
+
+/// `[render]` settings with defaults filled in.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderSettings {
+    /// Renderer.
+    pub renderer: RendererKind,
+    /// Photons per PPM pass.
+    pub photons_per_pass: u64,
+    /// PPM α.
+    pub alpha: f64,
+    /// PPM initial radius (`None`: from the pixel footprint).
+    pub initial_radius: Option<f64>,
+    /// Maximum specular bounces.
+    pub max_depth: u32,
+    /// Seed.
+    pub seed: u64,
+    /// Edge-adaptive anti-aliasing in the ray tracer.
+    pub antialias: bool,
+    /// Lens samples per pixel with an open aperture.
+    pub dof_samples: u32,
+    /// Shadow samples per area light.
+    pub light_samples: u32,
+    /// Ambient radiance for the ray tracer.
+    pub ambient: DVec3,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        Self {
+            renderer: RendererKind::Whitted,
+            photons_per_pass: 200_000,
+            alpha: 0.7,
+            initial_radius: None,
+            max_depth: 8,
+            seed: 1,
+            antialias: true,
+            dof_samples: 16,
+            light_samples: 16,
+            ambient: DVec3::ZERO,
+        }
+    }
+}
+
+/// One `[[objects]]` entry (or an area light's visible surface) at run time.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneObject {
+    /// Name for statistics and errors.
+    pub name: String,
+    /// Index into [`Scene::materials`].
+    pub material: usize,
+    /// Emitted radiance for the visible surface of an area light.
+    pub emission: Option<DVec3>,
+}
+
+/// A loaded, validated scene, ready to render.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// The file it came from (`<built-in>` for the default scene).
+    pub source: PathBuf,
+    /// The camera.
+    pub camera: Camera,
+    /// Render settings.
+    pub settings: RenderSettings,
+    /// Radiance of rays leaving the scene.
+    pub background: DVec3,
+    /// Materials; objects refer to them by index.
+    pub materials: Vec<Material>,
+    /// Textures; materials refer to them by index.
+    pub textures: Vec<Texture>,
+    /// Objects; hits carry their index as `object`.
+    pub objects: Vec<SceneObject>,
+    /// Lights.
+    pub lights: Vec<Light>,
+    /// Everything intersectable, behind one BVH.
+    pub geometry: SceneGeometry,
+}
+
+/// The scene the program shows when started without a file: the Utah teapot on a checkered
+/// floor in a box (the same text as `scenes/teapot.toml`).
+pub const BUILTIN_SCENE: &str = include_str!("../../scenes/teapot.toml");
+
+impl Scene {
+    /// The built-in default scene.
+    pub fn builtin() -> Scene {
+        load::load_str(BUILTIN_SCENE, std::path::Path::new("<built-in>"), None)
+            .expect("the built-in scene is valid")
+    }
+
+    /// Reads and validates a scene file; relative paths inside resolve against its folder.
+    pub fn load(path: &std::path::Path) -> Result<Scene, SceneError> {
+        load::load_file(path)
+    }
+
+    /// Parses scene text; `path` names it in errors and `base_dir` resolves relative files
+    /// (`None`: only built-in data may be referenced).
+    pub fn from_str(text: &str, path: &std::path::Path, base_dir: Option<&std::path::Path>) -> Result<Scene, SceneError> {
+        load::load_str(text, path, base_dir)
+    }
+
+    /// The material of a hit.
+    pub fn material(&self, hit: &Hit) -> &Material {
+        &self.materials[self.objects[hit.object as usize].material]
+    }
+
+    /// The colour (reflectance or tint) of a material at a hit, with its texture applied.
+    pub fn albedo(&self, material: &Material, hit: &Hit) -> DVec3 {
+        match material.texture {
+            Some(t) => self.textures[t].lookup(hit.point, hit.uv),
+            None => material.color,
+        }
+    }
+
+    /// Emitted radiance seen by a ray of direction `dir` at `hit` (area lights only).
+    pub fn emission(&self, hit: &Hit, dir: DVec3) -> DVec3 {
+        match self.objects[hit.object as usize].emission {
+            // Quads emit on their normal side only; spheres outward.
+            Some(l) if dir.dot(hit.normal) < 0.0 => l,
+            _ => DVec3::ZERO,
+        }
+    }
+
+    /// What the scene contains, for skipping work it does not need.
+    pub fn features(&self) -> SceneFeatures {
+        SceneFeatures {
+            patches: self.geometry.has_patches(),
+            glass: self.materials.iter().any(|m| matches!(m.kind, MaterialKind::Glass { .. })),
+            textures: !self.textures.is_empty(),
+            area_lights: self.lights.iter().any(Light::is_area),
+            depth_of_field: self.camera.aperture > 0.0,
+        }
+    }
+
+    /// A jitter-free pixel centre.
+    pub fn pixel_center(x: u32, y: u32) -> DVec2 {
+        DVec2::new(x as f64 + 0.5, y as f64 + 0.5)
+    }
+}
+
+/// What a scene contains.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SceneFeatures {
+    /// Bézier patches.
+    pub patches: bool,
+    /// Refractive materials.
+    pub glass: bool,
+    /// Textures.
+    pub textures: bool,
+    /// Area lights.
+    pub area_lights: bool,
+    /// An open aperture.
+    pub depth_of_field: bool,
+}
