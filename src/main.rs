@@ -12,7 +12,11 @@ use caustic::render::{render_whitted, Metadata};
 use caustic::scene::{RendererKind, Scene};
 
 #[derive(Parser)]
-#[command(name = "caustic", version, about = "Progressive photon mapping of exact Bézier patches")]
+#[command(
+    name = "caustic",
+    version,
+    about = "Progressive photon mapping of exact Bézier patches"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -130,7 +134,16 @@ fn main() -> Result<()> {
             renderer,
             exposure,
             force,
-        } => render(scene.as_deref(), &out, width, height, seed, renderer, exposure, force),
+        } => render(
+            scene.as_deref(),
+            &out,
+            width,
+            height,
+            seed,
+            renderer,
+            exposure,
+            force,
+        ),
         Command::ExportObj {
             scene,
             out,
@@ -154,7 +167,11 @@ fn main() -> Result<()> {
                 };
                 bench_intersect(size, repeat, method, per_ray_depth, params)
             }
-            BenchCommand::Whitted { scene, width, threads } => bench_whitted(scene.as_deref(), width, &threads),
+            BenchCommand::Whitted {
+                scene,
+                width,
+                threads,
+            } => bench_whitted(scene.as_deref(), width, &threads),
         },
     }
 }
@@ -181,7 +198,10 @@ fn render(
         bail!("{}: unknown image format (use .png or .exr)", out.display());
     }
     if out.exists() && !force {
-        bail!("{}: the file exists; choose another name or pass --force to overwrite it", out.display());
+        bail!(
+            "{}: the file exists; choose another name or pass --force to overwrite it",
+            out.display()
+        );
     }
     if !exposure.is_finite() || exposure.abs() > 64.0 {
         bail!("--exposure must be a finite number of stops between -64 and 64, got {exposure}");
@@ -225,13 +245,19 @@ fn render(
     let (image, stats) = render_whitted(&scene, &|rows| bar.inc(rows as u64));
     bar.finish_and_clear();
     let metadata: Metadata = vec![
-        ("Software".into(), format!("caustic {}", env!("CARGO_PKG_VERSION"))),
+        (
+            "Software".into(),
+            format!("caustic {}", env!("CARGO_PKG_VERSION")),
+        ),
         ("caustic:scene".into(), scene.source.display().to_string()),
         ("caustic:renderer".into(), "whitted".into()),
         ("caustic:seed".into(), scene.settings.seed.to_string()),
         ("caustic:size".into(), format!("{w}x{h}")),
         ("caustic:camera_rays".into(), stats.camera_rays.to_string()),
-        ("caustic:elapsed_secs".into(), format!("{:.3}", stats.elapsed_secs)),
+        (
+            "caustic:elapsed_secs".into(),
+            format!("{:.3}", stats.elapsed_secs),
+        ),
     ];
     image.save(out, exposure, &metadata, force)?;
     println!(
@@ -250,7 +276,10 @@ fn export_obj(scene_path: Option<&Path>, out: &Path, resolution: usize, force: b
         bail!("--resolution must be between 1 and 256, got {resolution}");
     }
     if out.exists() && !force {
-        bail!("{}: the file exists; choose another name or pass --force to overwrite it", out.display());
+        bail!(
+            "{}: the file exists; choose another name or pass --force to overwrite it",
+            out.display()
+        );
     }
     let scene = load_scene(scene_path)?;
     let meshes: Vec<(String, caustic::geometry::TriangleMesh)> = scene
@@ -264,7 +293,10 @@ fn export_obj(scene_path: Option<&Path>, out: &Path, resolution: usize, force: b
         })
         .collect();
     if meshes.is_empty() {
-        bail!("{}: the scene has no Bézier patches to export", scene.source.display());
+        bail!(
+            "{}: the scene has no Bézier patches to export",
+            scene.source.display()
+        );
     }
     let tmp = out.with_extension("obj.partial");
     let write = || -> std::io::Result<()> {
@@ -275,7 +307,11 @@ fn export_obj(scene_path: Option<&Path>, out: &Path, resolution: usize, force: b
     };
     write().with_context(|| format!("{}: cannot write the OBJ file", out.display()))?;
     let triangles: usize = meshes.iter().map(|(_, m)| m.indices.len()).sum();
-    println!("{}: {} patches, {triangles} triangles", out.display(), meshes.len());
+    println!(
+        "{}: {} patches, {triangles} triangles",
+        out.display(),
+        meshes.len()
+    );
     Ok(())
 }
 
@@ -290,7 +326,10 @@ fn bench_whitted(scene_path: Option<&Path>, width: u32, threads: &[usize]) -> Re
         scene.camera.width,
         scene.camera.height
     );
-    println!("{:>8} {:>10} {:>14} {:>12}", "threads", "seconds", "camera rays/s", "speed-up");
+    println!(
+        "{:>8} {:>10} {:>14} {:>12}",
+        "threads", "seconds", "camera rays/s", "speed-up"
+    );
     let mut base = None;
     for &n in threads {
         if n == 0 {
@@ -301,7 +340,10 @@ fn bench_whitted(scene_path: Option<&Path>, width: u32, threads: &[usize]) -> Re
         let rate = stats.camera_rays as f64 / stats.elapsed_secs;
         let speedup = base.map_or(1.0, |b: f64| stats.elapsed_secs.recip() * b);
         base.get_or_insert(stats.elapsed_secs);
-        println!("{n:>8} {:>10.3} {rate:>14.0} {speedup:>11.2}x", stats.elapsed_secs);
+        println!(
+            "{n:>8} {:>10.3} {rate:>14.0} {speedup:>11.2}x",
+            stats.elapsed_secs
+        );
     }
     Ok(())
 }

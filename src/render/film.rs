@@ -94,13 +94,23 @@ impl Image {
 
     /// Mean of all pixels' channels (a quick brightness figure for summaries and tests).
     pub fn mean(&self) -> f64 {
-        let sum: f64 = self.pixels.iter().map(|p| p.iter().map(|&c| c as f64).sum::<f64>()).sum();
+        let sum: f64 = self
+            .pixels
+            .iter()
+            .map(|p| p.iter().map(|&c| c as f64).sum::<f64>())
+            .sum();
         sum / (3.0 * self.pixels.len().max(1) as f64)
     }
 
     /// Writes the image in the format of `path`'s extension. Refuses to replace an existing
     /// file unless `overwrite`.
-    pub fn save(&self, path: &Path, exposure_stops: f32, metadata: &Metadata, overwrite: bool) -> Result<(), FilmError> {
+    pub fn save(
+        &self,
+        path: &Path,
+        exposure_stops: f32,
+        metadata: &Metadata,
+        overwrite: bool,
+    ) -> Result<(), FilmError> {
         let format = Format::from_path(path).ok_or_else(|| FilmError::UnknownFormat(path.to_owned()))?;
         if !overwrite && path.exists() {
             return Err(FilmError::Exists(path.to_owned()));
@@ -136,7 +146,9 @@ impl Image {
         encoder.set_depth(png::BitDepth::Eight);
         encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
         for (k, v) in metadata {
-            encoder.add_itxt_chunk(k.clone(), v.clone()).map_err(|e| e.to_string())?;
+            encoder
+                .add_itxt_chunk(k.clone(), v.clone())
+                .map_err(|e| e.to_string())?;
         }
         let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
         writer
@@ -154,11 +166,10 @@ impl Image {
         });
         let mut image = Image::from_channels((w, self.height as usize), channels);
         for (k, v) in metadata {
-            image
-                .layer_data
-                .attributes
-                .other
-                .insert(Text::from(k.as_str()), AttributeValue::Text(Text::from(v.as_str())));
+            image.layer_data.attributes.other.insert(
+                Text::from(k.as_str()),
+                AttributeValue::Text(Text::from(v.as_str())),
+            );
         }
         image.write().to_file(path).map_err(|e| e.to_string())
     }

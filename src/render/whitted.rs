@@ -75,7 +75,11 @@ impl Tracer<'_> {
                 let wo = -ray.dir;
                 let mut radiance = emitted + scene.settings.ambient * color;
                 for (k, light) in scene.lights.iter().enumerate() {
-                    let samples = if light.is_area() { scene.settings.light_samples } else { 1 };
+                    let samples = if light.is_area() {
+                        scene.settings.light_samples
+                    } else {
+                        1
+                    };
                     let grid = (samples as f64).sqrt().ceil() as u32;
                     let mut sum = DVec3::ZERO;
                     let mut visible = 0u32;
@@ -84,7 +88,9 @@ impl Tracer<'_> {
                         let cell = DVec2::new((s % grid) as f64, (s / grid % grid) as f64);
                         let jitter = DVec2::new(state.rng.random(), state.rng.random());
                         let u = (cell + jitter) / grid as f64;
-                        let Some(ls) = light.sample(hit.point, u) else { continue };
+                        let Some(ls) = light.sample(hit.point, u) else {
+                            continue;
+                        };
                         let cos = n.dot(ls.wi);
                         if cos <= 0.0 {
                             continue;
@@ -103,7 +109,13 @@ impl Tracer<'_> {
                         sum += f * ls.incident * cos;
                     }
                     // Shadow boundaries are edges too: fully lit, partly lit, or dark.
-                    let lit = if visible == 0 { 0 } else if visible == samples { 2 } else { 1 };
+                    let lit = if visible == 0 {
+                        0
+                    } else if visible == samples {
+                        2
+                    } else {
+                        1
+                    };
                     state.touch(((k as u64) << 2) | lit);
                     radiance += sum / samples as f64;
                 }
@@ -155,8 +167,11 @@ pub fn render_whitted(scene: &Scene, progress: &(dyn Fn(usize) + Sync)) -> (Imag
                         let mut sum = DVec3::ZERO;
                         for s in 0..n {
                             let cell = DVec2::new((s % grid) as f64, (s / grid % grid) as f64);
-                            let lens = concentric_disk((cell + DVec2::new(rng.random(), rng.random())) / grid as f64);
-                            let px = DVec2::new(x as f64 + rng.random::<f64>(), y as f64 + rng.random::<f64>());
+                            let lens = concentric_disk(
+                                (cell + DVec2::new(rng.random(), rng.random())) / grid as f64,
+                            );
+                            let px =
+                                DVec2::new(x as f64 + rng.random::<f64>(), y as f64 + rng.random::<f64>());
                             let mut state = PathState { id: 0, rng: &mut rng };
                             sum += tracer.trace(&camera.ray(px, lens), 0, &mut state);
                         }
@@ -196,7 +211,10 @@ pub fn render_whitted(scene: &Scene, progress: &(dyn Fn(usize) + Sync)) -> (Imag
                 let mut sum = DVec3::ZERO;
                 for sy in 0..4 {
                     for sx in 0..4 {
-                        let px = DVec2::new(x as f64 + (sx as f64 + 0.5) / 4.0, y as f64 + (sy as f64 + 0.5) / 4.0);
+                        let px = DVec2::new(
+                            x as f64 + (sx as f64 + 0.5) / 4.0,
+                            y as f64 + (sy as f64 + 0.5) / 4.0,
+                        );
                         let mut state = PathState { id: 0, rng: &mut rng };
                         sum += tracer.trace(&camera.ray(px, DVec2::ZERO), 0, &mut state);
                     }

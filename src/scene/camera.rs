@@ -121,7 +121,10 @@ pub fn concentric_disk(u: DVec2) -> DVec2 {
     let (r, theta) = if o.x.abs() > o.y.abs() {
         (o.x, std::f64::consts::FRAC_PI_4 * (o.y / o.x))
     } else {
-        (o.y, std::f64::consts::FRAC_PI_2 - std::f64::consts::FRAC_PI_4 * (o.x / o.y))
+        (
+            o.y,
+            std::f64::consts::FRAC_PI_2 - std::f64::consts::FRAC_PI_4 * (o.x / o.y),
+        )
     };
     r * DVec2::new(theta.cos(), theta.sin())
 }
@@ -132,7 +135,16 @@ mod tests {
 
     #[test]
     fn projection_inverts_the_pinhole_ray() {
-        let cam = Camera::look_at(DVec3::new(1.0, 2.0, 3.0), DVec3::ZERO, DVec3::Y, 50.0, 320, 200, 0.0, None);
+        let cam = Camera::look_at(
+            DVec3::new(1.0, 2.0, 3.0),
+            DVec3::ZERO,
+            DVec3::Y,
+            50.0,
+            320,
+            200,
+            0.0,
+            None,
+        );
         let px = DVec2::new(37.25, 151.5);
         let ray = cam.ray(px, DVec2::ZERO);
         let back = cam.project(ray.at(5.0)).expect("in front");

@@ -47,12 +47,27 @@ pub struct Real(pub f64);
 
 impl<'de> Deserialize<'de> for Real {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        let v = f64::deserialize(d)?;
-        if v.is_finite() {
-            Ok(Real(v))
-        } else {
-            Err(serde::de::Error::custom(format!("expected a finite number, found {v}")))
+        struct RealVisitor;
+        impl serde::de::Visitor<'_> for RealVisitor {
+            type Value = Real;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a finite number")
+            }
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<Real, E> {
+                if v.is_finite() {
+                    Ok(Real(v))
+                } else {
+                    Err(E::custom(format!("expected a finite number, found {v}")))
+                }
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<Real, E> {
+                Ok(Real(v as f64))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<Real, E> {
+                Ok(Real(v as f64))
+            }
         }
+        d.deserialize_any(RealVisitor)
     }
 }
 

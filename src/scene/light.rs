@@ -208,7 +208,11 @@ mod tests {
 
     #[test]
     fn sphere_light_samples_land_on_the_sphere() {
-        let l = Light::Sphere { center: DVec3::new(0.0, 0.0, 5.0), radius: 1.0, radiance: DVec3::ONE };
+        let l = Light::Sphere {
+            center: DVec3::new(0.0, 0.0, 5.0),
+            radius: 1.0,
+            radiance: DVec3::ONE,
+        };
         for k in 0..50 {
             let u = DVec2::new((k as f64 + 0.5) / 50.0, (k * 7 % 50) as f64 / 50.0);
             let s = l.sample(DVec3::ZERO, u).expect("outside");

@@ -66,7 +66,10 @@ impl Ctx<'_> {
     /// A file named in the scene, resolved against the scene's folder and checked to exist.
     fn resolve(&self, span: &Range<usize>, what: &str, file: &str) -> Result<PathBuf> {
         let Some(base) = self.base_dir else {
-            return Err(self.err(span, format!("{what}: '{file}': a built-in scene cannot refer to files")));
+            return Err(self.err(
+                span,
+                format!("{what}: '{file}': a built-in scene cannot refer to files"),
+            ));
         };
         let path = base.join(file);
         if !path.is_file() {
@@ -156,7 +159,10 @@ pub(super) fn load_str(text: &str, path: &Path, base_dir: Option<&Path>) -> Resu
     };
     let background = file.background.as_ref().map(v3).unwrap_or(DVec3::ZERO);
     if background.cmplt(DVec3::ZERO).any() {
-        return Err(ctx.err(&(0..0), format!("'background' must not be negative, got {background}")));
+        return Err(ctx.err(
+            &(0..0),
+            format!("'background' must not be negative, got {background}"),
+        ));
     }
 
     let mut materials = Vec::new();
@@ -198,7 +204,13 @@ pub(super) fn load_str(text: &str, path: &Path, base_dir: Option<&Path>) -> Resu
             } => {
                 let material = emitter_material();
                 let id = objects.len() as u32;
-                builder.add_sphere(Sphere { center: *center, radius: *radius }, id);
+                builder.add_sphere(
+                    Sphere {
+                        center: *center,
+                        radius: *radius,
+                    },
+                    id,
+                );
                 objects.push(SceneObject {
                     name: format!("light {k}"),
                     material,
@@ -278,8 +290,20 @@ fn camera(ctx: &Ctx, desc: &Spanned<CameraDesc>) -> Result<Camera> {
         }
     }
     let aperture = t.non_negative("aperture", d.aperture.map_or(0.0, |r| r.0))?;
-    let focal_distance = d.focal_distance.map(|r| t.positive("focal_distance", r.0)).transpose()?;
-    let mut camera = Camera::look_at(position, look_at, up, fov, d.width, d.height, aperture, focal_distance);
+    let focal_distance = d
+        .focal_distance
+        .map(|r| t.positive("focal_distance", r.0))
+        .transpose()?;
+    let mut camera = Camera::look_at(
+        position,
+        look_at,
+        up,
+        fov,
+        d.width,
+        d.height,
+        aperture,
+        focal_distance,
+    );
     camera.near = t.non_negative("near", d.near.map_or(0.0, |r| r.0))?;
     Ok(camera)
 }
@@ -295,7 +319,11 @@ fn render_settings(ctx: &Ctx, desc: &Spanned<RenderDesc>) -> Result<RenderSettin
     let renderer = match d.renderer.as_deref() {
         None | Some("whitted") => RendererKind::Whitted,
         Some("ppm") => RendererKind::Ppm,
-        Some(other) => return Err(t.err(format!("'renderer' must be \"whitted\" or \"ppm\", got \"{other}\""))),
+        Some(other) => {
+            return Err(t.err(format!(
+                "'renderer' must be \"whitted\" or \"ppm\", got \"{other}\""
+            )))
+        }
     };
     let alpha = d.alpha.map_or(defaults.alpha, |r| r.0);
     if !(alpha > 0.0 && alpha <= 1.0) {
@@ -324,7 +352,10 @@ fn render_settings(ctx: &Ctx, desc: &Spanned<RenderDesc>) -> Result<RenderSettin
         renderer,
         photons_per_pass,
         alpha,
-        initial_radius: d.initial_radius.map(|r| t.positive("initial_radius", r.0)).transpose()?,
+        initial_radius: d
+            .initial_radius
+            .map(|r| t.positive("initial_radius", r.0))
+            .transpose()?,
         max_depth,
         seed: d.seed.unwrap_or(defaults.seed),
         antialias: d.antialias.unwrap_or(defaults.antialias),
@@ -334,7 +365,12 @@ fn render_settings(ctx: &Ctx, desc: &Spanned<RenderDesc>) -> Result<RenderSettin
     })
 }
 
-fn material(ctx: &Ctx, name: &str, desc: &Spanned<MaterialDesc>, textures: &mut Vec<Texture>) -> Result<Material> {
+fn material(
+    ctx: &Ctx,
+    name: &str,
+    desc: &Spanned<MaterialDesc>,
+    textures: &mut Vec<Texture>,
+) -> Result<Material> {
     let d = desc.get_ref();
     let t = Table {
         ctx,
@@ -348,7 +384,12 @@ fn material(ctx: &Ctx, name: &str, desc: &Spanned<MaterialDesc>, textures: &mut 
         ("shininess", d.shininess.is_some()),
         ("ior", d.ior.is_some()),
     ];
-    let color = d.color.as_ref().map(v3).map(|c| t.reflectance("color", c)).transpose()?;
+    let color = d
+        .color
+        .as_ref()
+        .map(v3)
+        .map(|c| t.reflectance("color", c))
+        .transpose()?;
     let kind = match d.kind.as_str() {
         "diffuse" => {
             t.only("diffuse", &given, &["color", "texture"])?;
@@ -402,18 +443,23 @@ fn material(ctx: &Ctx, name: &str, desc: &Spanned<MaterialDesc>, textures: &mut 
 fn texture(t: &Table, d: &TextureDesc) -> Result<Texture> {
     let source = match (&d.file, &d.checker) {
         (Some(file), None) => {
-            let path = t.ctx.resolve(&t.span, &format!("{}: 'texture.file'", t.name), file)?;
+            let path = t
+                .ctx
+                .resolve(&t.span, &format!("{}: 'texture.file'", t.name), file)?;
             TextureSource::load(&path).map_err(|e| t.err(format!("'texture.file': {e}")))?
         }
-        (None, Some([a, b])) => {
-            TextureSource::Checker([t.reflectance("texture.checker", v3(a))?, t.reflectance("texture.checker", v3(b))?])
-        }
+        (None, Some([a, b])) => TextureSource::Checker([
+            t.reflectance("texture.checker", v3(a))?,
+            t.reflectance("texture.checker", v3(b))?,
+        ]),
         _ => return Err(t.err("'texture' needs exactly one of 'file' or 'checker'")),
     };
     let mapping = match d.mapping.as_deref() {
         None | Some("uv") => Mapping::Uv,
         Some("planar") => {
-            let n = t.nonzero("texture.normal", d.normal.as_ref().map(v3).unwrap_or(DVec3::Z))?.normalize();
+            let n = t
+                .nonzero("texture.normal", d.normal.as_ref().map(v3).unwrap_or(DVec3::Z))?
+                .normalize();
             let (axis_u, axis_v) = n.any_orthonormal_pair();
             Mapping::Planar { axis_u, axis_v }
         }
@@ -454,7 +500,9 @@ fn transform(t: &Table, d: Option<&TransformDesc>) -> Result<(DAffine3, Option<f
         Some(ScaleDesc::PerAxis2(_)) => return Err(t.err("'transform.scale' takes one or three numbers")),
     };
     if scale.cmpeq(DVec3::ZERO).any() {
-        return Err(t.err(format!("'transform.scale' must not be zero on any axis, got {scale}")));
+        return Err(t.err(format!(
+            "'transform.scale' must not be zero on any axis, got {scale}"
+        )));
     }
     let r = d.rotate.as_ref().map(v3).unwrap_or(DVec3::ZERO);
     let rotation = DMat3::from_rotation_z(r.z.to_radians())
@@ -489,7 +537,11 @@ fn object(
         t.err(format!(
             "unknown material '{}' (defined: {})",
             d.material,
-            if known.is_empty() { "none".to_owned() } else { known.join(", ") }
+            if known.is_empty() {
+                "none".to_owned()
+            } else {
+                known.join(", ")
+            }
         ))
     })?;
     let given = [
@@ -639,7 +691,8 @@ fn light(ctx: &Ctx, k: usize, desc: &Spanned<LightDesc>) -> Result<Light> {
     if color.cmplt(DVec3::ZERO).any() || color == DVec3::ZERO {
         return Err(t.err(format!("'color' must be non-negative and not black, got {color}")));
     }
-    let power = |t: &Table| -> Result<DVec3> { Ok(color * t.positive("power", t.required("power", d.power)?.0)?) };
+    let power =
+        |t: &Table| -> Result<DVec3> { Ok(color * t.positive("power", t.required("power", d.power)?.0)?) };
     match d.kind.as_str() {
         "point" => {
             t.only("point", &given, &["position", "power", "intensity", "color"])?;
@@ -652,12 +705,27 @@ fn light(ctx: &Ctx, k: usize, desc: &Spanned<LightDesc>) -> Result<Light> {
             Ok(Light::Point { position, intensity })
         }
         "spot" => {
-            t.only("spot", &given, &["position", "power", "color", "direction", "cone_angle", "cone_falloff"])?;
+            t.only(
+                "spot",
+                &given,
+                &[
+                    "position",
+                    "power",
+                    "color",
+                    "direction",
+                    "cone_angle",
+                    "cone_falloff",
+                ],
+            )?;
             let position = v3(t.required("position", d.position.as_ref())?);
-            let direction = t.nonzero("direction", v3(t.required("direction", d.direction.as_ref())?))?.normalize();
+            let direction = t
+                .nonzero("direction", v3(t.required("direction", d.direction.as_ref())?))?
+                .normalize();
             let angle = t.required("cone_angle", d.cone_angle)?.0;
             if !(angle > 0.0 && angle < 180.0) {
-                return Err(t.err(format!("'cone_angle' must be between 0 and 180 degrees, got {angle}")));
+                return Err(t.err(format!(
+                    "'cone_angle' must be between 0 and 180 degrees, got {angle}"
+                )));
             }
             let falloff = d.cone_falloff.map_or(5.0, |r| r.0).clamp(0.0, angle);
             let cos_outer = (0.5 * angle).to_radians().cos();
@@ -697,6 +765,8 @@ fn light(ctx: &Ctx, k: usize, desc: &Spanned<LightDesc>) -> Result<Light> {
                 radiance: power(&t)? / (PI * area),
             })
         }
-        other => Err(t.err(format!("unknown light type '{other}' (expected point, spot, sphere or quad)"))),
+        other => Err(t.err(format!(
+            "unknown light type '{other}' (expected point, spot, sphere or quad)"
+        ))),
     }
 }

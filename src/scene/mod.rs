@@ -124,7 +124,11 @@ impl Scene {
 
     /// Parses scene text; `path` names it in errors and `base_dir` resolves relative files
     /// (`None`: only built-in data may be referenced).
-    pub fn from_str(text: &str, path: &std::path::Path, base_dir: Option<&std::path::Path>) -> Result<Scene, SceneError> {
+    pub fn from_str(
+        text: &str,
+        path: &std::path::Path,
+        base_dir: Option<&std::path::Path>,
+    ) -> Result<Scene, SceneError> {
         load::load_str(text, path, base_dir)
     }
 
@@ -154,7 +158,10 @@ impl Scene {
     pub fn features(&self) -> SceneFeatures {
         SceneFeatures {
             patches: self.geometry.has_patches(),
-            glass: self.materials.iter().any(|m| matches!(m.kind, MaterialKind::Glass { .. })),
+            glass: self
+                .materials
+                .iter()
+                .any(|m| matches!(m.kind, MaterialKind::Glass { .. })),
             textures: !self.textures.is_empty(),
             area_lights: self.lights.iter().any(Light::is_area),
             depth_of_field: self.camera.aperture > 0.0,

@@ -1,0 +1,174 @@
+//! The `caustic` binary as a user runs it: render to PNG/EXR with metadata, never overwrite
+//! silently, export patches as OBJ, and clear errors for bad input.
+
+use std::path::Path;
+use std::process::Command;
+
+fn caustic(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_caustic"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("run caustic")
+}
+
+fn text(out: &std::process::Output) -> String {
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    )
+}
+
+#[test]
+fn render_writes_png_and_exr_with_metadata_and_refuses_to_overwrite() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let png = dir.path().join("leaf.png");
+    let png_s = png.to_str().expect("utf-8 path");
+    let out = caustic(&[
+        "render",
+        "scenes/leaf.toml",
+        "--out",
+        png_s,
+        "--width",
+        "40",
+        "--height",
+        "30",
+    ]);
+    assert!(out.status.success(), "{}", text(&out));
+    let img = image::open(&png).expect("readable PNG").to_rgb8();
+    assert_eq!((img.width(), img.height()), (40, 30));
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&png).expect("open")));
+    let reader = decoder.read_info().expect("png info");
+    let keys: Vec<&str> = reader
+        .info()
+        .utf8_text
+        .iter()
+        .map(|t| t.keyword.as_str())
+        .collect();
+    assert!(
+        keys.contains(&"caustic:scene") && keys.contains(&"caustic:seed"),
+        "{keys:?}"
+    );
+
+    // A second render to the same name is refused and leaves the file alone.
+    let before = std::fs::read(&png).expect("read");
+    let again = caustic(&[
+        "render",
+        "scenes/leaf.toml",
+        "--out",
+        png_s,
+        "--width",
+        "8",
+        "--height",
+        "6",
+    ]);
+    assert!(!again.status.success());
+    assert!(
+        text(&again).contains("the file exists; choose another name or pass --force"),
+        "{}",
+        text(&again)
+    );
+    assert_eq!(std::fs::read(&png).expect("read"), before);
+    let forced = caustic(&[
+        "render",
+        "scenes/leaf.toml",
+        "--out",
+        png_s,
+        "--width",
+        "8",
+        "--height",
+        "6",
+        "--force",
+    ]);
+    assert!(forced.status.success(), "{}", text(&forced));
+    assert_eq!(image::open(&png).expect("PNG").width(), 8);
+
+    let exr = dir.path().join("leaf.exr");
+    let out = caustic(&[
+        "render",
+        "scenes/leaf.toml",
+        "--out",
+        exr.to_str().expect("utf-8"),
+        "--width",
+        "20",
+        "--height",
+        "15",
+    ]);
+    assert!(out.status.success(), "{}", text(&out));
+    let linear = image::open(&exr).expect("readable EXR").to_rgb32f();
+    assert_eq!((linear.width(), linear.height()), (20, 15));
+    assert!(linear.pixels().any(|p| p[1] > 0.0));
+    let meta = exr::meta::MetaData::read_from_file(&exr, false).expect("EXR header");
+    let attrs = &meta.headers[0].own_attributes.other;
+    assert!(attrs.keys().any(|k| k == "caustic:scene"), "{attrs:?}");
+    assert!(std::fs::read_dir(dir.path()).expect("dir").all(|e| !e
+        .expect("entry")
+        .file_name()
+        .to_string_lossy()
+        .contains("partial")));
+}
+
+#[test]
+fn export_obj_writes_the_tessellated_patches() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let obj = dir.path().join("teapot.obj");
+    let out = caustic(&[
+        "export-obj",
+        "--out",
+        obj.to_str().expect("utf-8"),
+        "--resolution",
+        "8",
+    ]);
+    assert!(out.status.success(), "{}", text(&out));
+    let mesh = caustic::geometry::TriangleMesh::load_obj(&obj).expect("tobj reads our OBJ");
+    assert_eq!(mesh.indices.len(), 32 * 8 * 8 * 2);
+    assert_eq!(mesh.texcoords.len(), mesh.positions.len());
+    let again = caustic(&["export-obj", "--out", obj.to_str().expect("utf-8")]);
+    assert!(!again.status.success() && text(&again).contains("--force"));
+}
+
+#[test]
+fn bad_input_gives_clear_errors() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out_png = dir.path().join("x.png");
+    let out_s = out_png.to_str().expect("utf-8");
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (
+            vec!["render", "scenes/nope.toml", "--out", out_s],
+            "scenes/nope.toml:0: cannot read the scene file",
+        ),
+        (
+            vec!["render", "scenes/leaf.toml", "--out", "x.bmp"],
+            "x.bmp: unknown image format (use .png or .exr)",
+        ),
+        (
+            vec!["render", "scenes/leaf.toml", "--out", out_s, "--width", "0"],
+            "--width must be between 1 and 16384",
+        ),
+        (
+            vec!["render", "scenes/leaf.toml", "--out", out_s, "--exposure", "NaN"],
+            "--exposure must be a finite number",
+        ),
+        (
+            vec!["render", "scenes/leaf.toml", "--out", out_s, "--width", "many"],
+            "invalid value 'many' for '--width",
+        ),
+        (
+            vec!["render", "scenes/smallppm.toml", "--out", out_s],
+            "render it with --renderer whitted",
+        ),
+        (
+            vec!["export-obj", "scenes/smallppm.toml", "--out", out_s],
+            "has no Bézier patches to export",
+        ),
+    ];
+    for (args, expected) in cases {
+        let out = caustic(&args);
+        assert!(!out.status.success(), "{args:?} succeeded");
+        let t = text(&out);
+        assert!(t.contains(expected), "{args:?}: expected '{expected}' in:\n{t}");
+        assert!(!t.contains("panicked"), "{args:?} panicked:\n{t}");
+    }
+    assert!(!Path::new(out_s).exists(), "a failed render left a file");
+}
