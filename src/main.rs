@@ -8,6 +8,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 use caustic::bench::{teapot_geometry, teapot_view, time_intersect};
 use caustic::geometry::tessellate::{tessellate, write_obj};
 use caustic::geometry::{PatchMethod, SubdivisionParams};
+use caustic::render::ppm::{Control, IndexKind, Ppm, PpmOptions};
 use caustic::render::{render_whitted, Metadata};
 use caustic::scene::{RendererKind, Scene};
 
@@ -49,6 +50,8 @@ enum Command {
         /// Replace the output file if it exists.
         #[arg(long)]
         force: bool,
+        #[command(flatten)]
+        ppm: PpmArgs,
     },
     /// Write a scene's Bézier patches, tessellated, as a Wavefront OBJ file.
     ExportObj {
@@ -69,6 +72,38 @@ enum Command {
         #[command(subcommand)]
         what: BenchCommand,
     },
+}
+
+/// Photon-mapping flags of `render`.
+#[derive(clap::Args, Clone, Debug)]
+struct PpmArgs {
+    /// Photon mapping: passes to run.
+    #[arg(long, default_value_t = 16)]
+    passes: u32,
+    /// Photon mapping: stop after this many seconds even if passes remain.
+    #[arg(long)]
+    time_limit: Option<f64>,
+    /// Photon mapping: photons per pass (default: the scene's).
+    #[arg(long)]
+    photons: Option<u64>,
+    /// Photon mapping: radius reduction α in (0, 1] (default: the scene's).
+    #[arg(long)]
+    alpha: Option<f64>,
+    /// Photon mapping: initial radius in scene units (default: the scene's, or automatic).
+    #[arg(long)]
+    radius: Option<f64>,
+    /// Photon mapping: spatial index over visible points.
+    #[arg(long, value_enum, default_value_t = IndexChoice::Grid)]
+    index: IndexChoice,
+    /// Photon mapping: direct light from point/spot lights by shadow rays.
+    #[arg(long)]
+    direct_light: bool,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum IndexChoice {
+    Grid,
+    Kd,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -134,6 +169,7 @@ fn main() -> Result<()> {
             renderer,
             exposure,
             force,
+            ppm,
         } => render(
             scene.as_deref(),
             &out,
@@ -143,6 +179,7 @@ fn main() -> Result<()> {
             renderer,
             exposure,
             force,
+            &ppm,
         ),
         Command::ExportObj {
             scene,
@@ -193,6 +230,7 @@ fn render(
     renderer: Option<RendererChoice>,
     exposure: f32,
     force: bool,
+    ppm: &PpmArgs,
 ) -> Result<()> {
     if caustic::render::film::Format::from_path(out).is_none() {
         bail!("{}: unknown image format (use .png or .exr)", out.display());
@@ -229,11 +267,7 @@ fn render(
         None => scene.settings.renderer,
     };
     if kind == RendererKind::Ppm {
-        bail!(
-            "{}: the scene asks for the photon mapper, which this version does not have yet; \
-             render it with --renderer whitted",
-            scene.source.display()
-        );
+        return render_ppm(scene, out, exposure, force, ppm);
     }
     let (w, h) = (scene.camera.width, scene.camera.height);
     let bar = indicatif::ProgressBar::new(h as u64).with_style(
@@ -268,6 +302,104 @@ fn render(
         stats.edge_pixels,
         stats.camera_rays as f64 / stats.elapsed_secs.max(1e-9)
     );
+    Ok(())
+}
+
+fn render_ppm(mut scene: Scene, out: &Path, exposure: f32, force: bool, args: &PpmArgs) -> Result<()> {
+    if args.passes == 0 {
+        bail!("--passes must be at least 1");
+    }
+    if let Some(t) = args.time_limit {
+        if !(t.is_finite() && t > 0.0) {
+            bail!("--time-limit must be a positive number of seconds, got {t}");
+        }
+    }
+    if let Some(p) = args.photons {
+        if p == 0 || p > 1_000_000_000 {
+            bail!("--photons must be between 1 and 1000000000, got {p}");
+        }
+        scene.settings.photons_per_pass = p;
+    }
+    if let Some(a) = args.alpha {
+        if !(a > 0.0 && a <= 1.0) {
+            bail!("--alpha must be in (0, 1], got {a}");
+        }
+        scene.settings.alpha = a;
+    }
+    if let Some(r) = args.radius {
+        if !(r.is_finite() && r > 0.0) {
+            bail!("--radius must be a positive number of scene units, got {r}");
+        }
+        scene.settings.initial_radius = Some(r);
+    }
+    let options = PpmOptions {
+        index: match args.index {
+            IndexChoice::Grid => IndexKind::HashGrid,
+            IndexChoice::Kd => IndexKind::KdTree,
+        },
+        direct_light: args.direct_light,
+        force_stochastic: false,
+    };
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    let mut ppm = Ppm::new(&scene, options);
+    let bar = indicatif::ProgressBar::new(args.passes as u64).with_style(
+        indicatif::ProgressStyle::with_template("{msg} [{bar:40}] pass {pos}/{len}, {elapsed} (eta {eta})")
+            .context("progress bar template")?
+            .progress_chars("=> "),
+    );
+    bar.set_message(format!("photon mapping {w}x{h}"));
+    let start = std::time::Instant::now();
+    for _ in 0..args.passes {
+        if args
+            .time_limit
+            .is_some_and(|t| start.elapsed().as_secs_f64() >= t)
+        {
+            break;
+        }
+        ppm.run_pass(&scene, &mut |_| Control::Continue);
+        let s = ppm.stats();
+        bar.set_message(format!(
+            "photon mapping {w}x{h}, {:.2} M photons/s",
+            s.photons as f64 / s.photon_secs.max(1e-9) / 1e6
+        ));
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    let s = ppm.stats().clone();
+    let image = caustic::render::Image {
+        width: w,
+        height: h,
+        pixels: ppm.radiance(),
+    };
+    let metadata: Metadata = vec![
+        (
+            "Software".into(),
+            format!("caustic {}", env!("CARGO_PKG_VERSION")),
+        ),
+        ("caustic:scene".into(), scene.source.display().to_string()),
+        ("caustic:renderer".into(), "ppm".into()),
+        ("caustic:seed".into(), scene.settings.seed.to_string()),
+        ("caustic:size".into(), format!("{w}x{h}")),
+        ("caustic:passes".into(), s.passes.to_string()),
+        ("caustic:photons".into(), s.photons.to_string()),
+        ("caustic:alpha".into(), ppm.alpha.to_string()),
+        ("caustic:mean_radius".into(), format!("{:.6}", s.mean_radius)),
+        ("caustic:elapsed_secs".into(), format!("{:.3}", s.elapsed_secs)),
+    ];
+    image.save(out, exposure, &metadata, force)?;
+    println!(
+        "{}: {w}x{h}, {} passes, {} photons in {:.2} s ({:.0} photons/s while tracing photons), mean radius {:.4}, {} visible points",
+        out.display(),
+        s.passes,
+        s.photons,
+        s.elapsed_secs,
+        s.photons as f64 / s.photon_secs.max(1e-9),
+        s.mean_radius,
+        s.visible_points
+    );
+    for skipped in &s.skipped {
+        println!("  skipped: {skipped}");
+    }
     Ok(())
 }
 

@@ -251,6 +251,26 @@ impl SceneGeometry {
         &self.patches
     }
 
+    /// Moves control point `index` (0–15, `4i + j`) of patch `patch` to `position` and
+    /// rebuilds the patch's leaves and the BVH. Returns `false` (changing nothing) for an index
+    /// out of range or a non-finite position.
+    pub fn set_control_point(&mut self, patch: usize, index: usize, position: DVec3) -> bool {
+        if patch >= self.patches.len() || index >= 16 || !position.is_finite() {
+            return false;
+        }
+        self.patches[patch].0.points[index] = position;
+        let builder = GeometryBuilder {
+            spheres: std::mem::take(&mut self.spheres),
+            quads: std::mem::take(&mut self.quads),
+            planes: std::mem::take(&mut self.planes),
+            meshes: std::mem::take(&mut self.meshes),
+            patches: std::mem::take(&mut self.patches),
+            patch_method: self.patch_method,
+        };
+        *self = builder.build();
+        true
+    }
+
     /// The prepared leaves (empty for the per-ray method).
     pub fn patch_leaves(&self) -> &[PatchLeaf] {
         &self.leaves

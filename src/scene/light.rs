@@ -176,6 +176,116 @@ impl Light {
     }
 }
 
+/// A photon leaving a light: where, which way, and its flux relative to the light's power.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Emission {
+    /// Origin on the light.
+    pub origin: DVec3,
+    /// Unit direction.
+    pub dir: DVec3,
+    /// Flux carried, as a multiple of the light's power divided by the photons emitted from it
+    /// (1 for uniform emission; a spot's falloff, or aiming at the scene, changes it).
+    pub weight: f64,
+}
+
+/// A uniformly distributed unit vector.
+pub fn uniform_sphere(u: DVec2) -> DVec3 {
+    let z = 1.0 - 2.0 * u.x;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = std::f64::consts::TAU * u.y;
+    DVec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+/// A cosine-distributed unit vector around `n` (Malley's method).
+pub fn cosine_hemisphere(n: DVec3, u: DVec2) -> DVec3 {
+    let r = u.x.sqrt();
+    let phi = std::f64::consts::TAU * u.y;
+    let (t, b) = n.any_orthonormal_pair();
+    (r * phi.cos() * t + r * phi.sin() * b + (1.0 - u.x).max(0.0).sqrt() * n).normalize()
+}
+
+/// A unit vector uniform in the cone of half-angle `acos(cos_max)` around `axis`.
+pub fn uniform_cone(axis: DVec3, cos_max: f64, u: DVec2) -> DVec3 {
+    let cos_theta = 1.0 - u.x * (1.0 - cos_max);
+    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    let phi = std::f64::consts::TAU * u.y;
+    let (t, b) = axis.any_orthonormal_pair();
+    cos_theta * axis + sin_theta * (phi.cos() * t + phi.sin() * b)
+}
+
+impl Light {
+    /// Samples a photon leaving the light from four uniform numbers. `target`, the bounding
+    /// sphere `(centre, radius)` of the scene, lets a point light outside it aim its photons at
+    /// the scene instead of wasting them (the weight then carries the cone's share of 4π).
+    pub fn emit(&self, u: [f64; 4], target: Option<(DVec3, f64)>) -> Emission {
+        use std::f64::consts::PI;
+        let (u1, u2) = (DVec2::new(u[0], u[1]), DVec2::new(u[2], u[3]));
+        match self {
+            Light::Point { position, .. } => {
+                if let Some((center, radius)) = target {
+                    let to = center - *position;
+                    let d2 = to.length_squared();
+                    if d2 > radius * radius * 1.0001 {
+                        let cos_max = (1.0 - radius * radius / d2).sqrt();
+                        let dir = uniform_cone(to / d2.sqrt(), cos_max, u1);
+                        let weight = 2.0 * PI * (1.0 - cos_max) / (4.0 * PI);
+                        return Emission {
+                            origin: *position,
+                            dir,
+                            weight,
+                        };
+                    }
+                }
+                Emission {
+                    origin: *position,
+                    dir: uniform_sphere(u1),
+                    weight: 1.0,
+                }
+            }
+            Light::Spot {
+                position,
+                direction,
+                cos_inner,
+                cos_outer,
+                ..
+            } => {
+                // Uniform in the outer cone; the falloff becomes the weight, normalised so
+                // the mean weight is 1 (the light's power is what the cone carries).
+                let dir = uniform_cone(*direction, *cos_outer, u1);
+                let falloff = spot_falloff(dir.dot(*direction), *cos_inner, *cos_outer);
+                let cone = 2.0 * PI * (1.0 - cos_outer);
+                let effective = 2.0 * PI * (1.0 - 0.5 * (cos_inner + cos_outer));
+                Emission {
+                    origin: *position,
+                    dir,
+                    weight: falloff * cone / effective,
+                }
+            }
+            Light::Sphere { center, radius, .. } => {
+                let n = uniform_sphere(u1);
+                Emission {
+                    origin: *center + n * *radius,
+                    dir: cosine_hemisphere(n, u2),
+                    weight: 1.0,
+                }
+            }
+            Light::Quad {
+                corner,
+                edge_u,
+                edge_v,
+                ..
+            } => {
+                let n = edge_u.cross(*edge_v).normalize();
+                Emission {
+                    origin: *corner + u1.x * *edge_u + u1.y * *edge_v,
+                    dir: cosine_hemisphere(n, u2),
+                    weight: 1.0,
+                }
+            }
+        }
+    }
+}
+
 /// Smooth spot-light falloff: 1 inside the inner cone, 0 outside the outer, smoothstep between.
 pub fn spot_falloff(cos_angle: f64, cos_inner: f64, cos_outer: f64) -> f64 {
     if cos_angle >= cos_inner {

@@ -1,0 +1,445 @@
+//! Progressive photon mapping (Hachisuka, Ogaki & Jensen 2008) and its stochastic variant
+//! (Hachisuka & Jensen 2009), as the seed report §3.2 describes it, physically scaled.
+//!
+//! Each pass: (1) the eye pass records visible points ([`visible`]) — once for a pinhole
+//! camera without anti-aliasing (classic PPM, glass paths split), or every pass with jittered
+//! pixel and lens samples (stochastic PPM, one point per pixel, per-pixel statistics); (2) a
+//! spatial index over the points is built ([`HashGrid`] or the seed's [`KdTree`]); (3) photons
+//! are traced ([`photon`]) and hand flux to points within their radius; (4) every statistics
+//! slot is updated with the paper's rule
+//!
+//! `N' = N + αM`, `R'² = R²·(N + αM)/(N + M)`, `τ' = (τ + φ)·(N + αM)/(N + M)`;
+//!
+//! and the radiance is `L = τ / (π R² N_emitted)` plus light seen directly. No brightness
+//! factor: exposure belongs to the viewer.
+//!
+//! Determinism: photon `i` of the render uses the random stream `(seed, photon, i)`, pixels
+//! `(seed, pass, pixel)`; photons are traced in fixed chunks whose deposits are applied in
+//! chunk order, so the image is bit-identical for any number of threads.
+
+pub mod hash_grid;
+pub mod kd_tree;
+pub mod photon;
+pub mod visible;
+
+use std::f64::consts::PI;
+use std::time::Instant;
+
+use glam::{DVec2, DVec3};
+use rand::Rng;
+use rayon::prelude::*;
+
+pub use hash_grid::HashGrid;
+pub use kd_tree::KdTree;
+use photon::{PhotonCounts, PhotonSource};
+use visible::{trace_eye, Branching, VisiblePoint};
+
+use super::rng::stream_rng;
+use crate::scene::camera::concentric_disk;
+use crate::scene::Scene;
+
+/// Random stream ids of photon mapping.
+mod streams {
+    pub const EYE: u64 = 10;
+    pub const PHOTON: u64 = 11;
+}
+
+/// Photons per chunk: the unit of parallel work and of deterministic reduction.
+const CHUNK: u64 = 4096;
+/// Chunks per batch: commands are looked at between batches.
+const CHUNKS_PER_BATCH: u64 = 8;
+
+/// Which spatial index finds the visible points near a photon.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum IndexKind {
+    /// Hashed uniform grid, rebuilt per pass (default).
+    #[default]
+    HashGrid,
+    /// The seed report's kd-tree with per-subtree maximum radius.
+    KdTree,
+}
+
+/// Photon-mapping options beyond the scene's `[render]` settings.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PpmOptions {
+    /// The spatial index.
+    pub index: IndexKind,
+    /// Direct light from point/spot lights by shadow rays at visible points, photons from them
+    /// deposited only after their first bounce.
+    pub direct_light: bool,
+    /// Force stochastic PPM (a new eye pass every pass) even for a pinhole camera.
+    pub force_stochastic: bool,
+}
+
+/// A built spatial index.
+pub enum SpatialIndex {
+    /// Hash grid.
+    Grid(HashGrid),
+    /// kd-tree.
+    Kd(KdTree),
+}
+
+impl SpatialIndex {
+    /// Calls `f` with candidate points near `p` (the caller checks the radius).
+    #[inline]
+    pub fn for_candidates(&self, points: &[VisiblePoint], p: DVec3, f: &mut impl FnMut(u32)) {
+        match self {
+            SpatialIndex::Grid(g) => g.candidates(p).iter().for_each(|&k| f(k)),
+            SpatialIndex::Kd(t) => t.for_candidates(points, p, f),
+        }
+    }
+}
+
+/// Accumulated statistics of one gathering point (classic PPM) or pixel (stochastic PPM).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Slot {
+    /// The pixel it contributes to.
+    pub pixel: u32,
+    /// Search radius².
+    pub radius2: f64,
+    /// Accumulated photon count `N`.
+    pub n: f64,
+    /// Accumulated flux `τ`.
+    pub tau: DVec3,
+}
+
+/// Run statistics.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PpmStats {
+    /// Completed passes.
+    pub passes: u32,
+    /// Photons emitted in completed passes.
+    pub photons: u64,
+    /// Photon bounces traced.
+    pub bounces: u64,
+    /// Flux deposits made.
+    pub deposits: u64,
+    /// Visible points in the last pass.
+    pub visible_points: usize,
+    /// Mean search radius over slots that have gathered photons (scene units).
+    pub mean_radius: f64,
+    /// Seconds spent in completed passes.
+    pub elapsed_secs: f64,
+    /// Seconds spent tracing photons.
+    pub photon_secs: f64,
+    /// Eye passes run.
+    pub eye_passes: u32,
+    /// Work the scene did not need, in words.
+    pub skipped: Vec<String>,
+}
+
+/// Whether a pass ran to the end.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PassOutcome {
+    /// Finished and folded into the statistics.
+    Completed,
+    /// Abandoned between two batches at the caller's request; nothing of it was kept.
+    Aborted,
+}
+
+/// What the caller wants between two photon batches (it may also change α, which the
+/// callback receives by reference and which applies to this pass's update).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Control {
+    /// Go on.
+    Continue,
+    /// Drop this pass.
+    Abort,
+}
+
+/// A progressive photon mapping render in progress.
+pub struct Ppm {
+    options: PpmOptions,
+    stochastic: bool,
+    /// α for the next update.
+    pub alpha: f64,
+    /// Photons per pass from the next pass on.
+    pub photons_per_pass: u64,
+    initial_radius: Option<f64>,
+    slots: Vec<Slot>,
+    points: Vec<VisiblePoint>,
+    direct: Vec<DVec3>,
+    stats: PpmStats,
+    width: u32,
+    height: u32,
+    seed: u64,
+}
+
+impl Ppm {
+    /// A new render of `scene` (its `[render]` settings give α, photons per pass, radius, seed).
+    pub fn new(scene: &Scene, options: PpmOptions) -> Self {
+        let cam = &scene.camera;
+        let stochastic = options.force_stochastic || cam.aperture > 0.0 || scene.settings.antialias;
+        let features = scene.features();
+        let mut skipped = Vec::new();
+        if !stochastic {
+            skipped.push("eye pass traced once and reused (pinhole camera, no anti-aliasing)".to_owned());
+        }
+        if !features.patches {
+            skipped.push("no Bézier patches: no patch intersection set up".to_owned());
+        }
+        if !features.glass {
+            skipped.push("no glass: no refraction paths".to_owned());
+        }
+        if !features.textures {
+            skipped.push("no textures: constant colours, no lookups".to_owned());
+        }
+        if options.direct_light {
+            skipped
+                .push("first photon bounce from point/spot lights: direct light by shadow rays".to_owned());
+        }
+        let source = PhotonSource::new(scene, false);
+        if let Some((c, r)) = source.target {
+            if scene.lights.iter().any(
+                |l| matches!(l, crate::scene::Light::Point { position, .. } if (*position - c).length() > r),
+            ) {
+                skipped.push("photons from point lights outside the scene aimed at its bounds".to_owned());
+            }
+        }
+        let pixels = cam.width as usize * cam.height as usize;
+        Self {
+            options,
+            stochastic,
+            alpha: scene.settings.alpha,
+            photons_per_pass: scene.settings.photons_per_pass,
+            initial_radius: scene.settings.initial_radius,
+            slots: Vec::new(),
+            points: Vec::new(),
+            direct: vec![DVec3::ZERO; pixels],
+            stats: PpmStats {
+                skipped,
+                ..Default::default()
+            },
+            width: cam.width,
+            height: cam.height,
+            seed: scene.settings.seed,
+        }
+    }
+
+    /// Statistics so far.
+    pub fn stats(&self) -> &PpmStats {
+        &self.stats
+    }
+
+    /// Whether a new eye pass runs every pass.
+    pub fn is_stochastic(&self) -> bool {
+        self.stochastic
+    }
+
+    /// Image size.
+    pub fn size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+
+    fn eye_pass(&mut self, scene: &Scene) {
+        let (w, h) = (self.width as u64, self.height as u64);
+        let pass = self.stats.passes as u64;
+        let stochastic = self.stochastic;
+        let direct_light = self.options.direct_light;
+        let seed = self.seed;
+        let results: Vec<visible::EyeResult> = (0..w * h)
+            .into_par_iter()
+            .map(|i| {
+                let (x, y) = (i % w, i / w);
+                let mut rng = stream_rng(seed, streams::EYE, pass * w * h + i);
+                if stochastic {
+                    let px = DVec2::new(x as f64 + rng.random::<f64>(), y as f64 + rng.random::<f64>());
+                    let lens = concentric_disk(DVec2::new(rng.random(), rng.random()));
+                    trace_eye(
+                        scene,
+                        px,
+                        lens,
+                        i as u32,
+                        Branching::Choose,
+                        direct_light,
+                        &mut rng,
+                    )
+                } else {
+                    let px = Scene::pixel_center(x as u32, y as u32);
+                    trace_eye(
+                        scene,
+                        px,
+                        DVec2::ZERO,
+                        0,
+                        Branching::Split,
+                        direct_light,
+                        &mut rng,
+                    )
+                }
+            })
+            .collect();
+        self.stats.eye_passes += 1;
+        self.points.clear();
+        for (pixel, r) in results.into_iter().enumerate() {
+            self.direct[pixel] += r.direct;
+            for mut vp in r.points {
+                if !stochastic {
+                    vp.slot = self.slots.len() as u32;
+                    self.slots.push(Slot {
+                        pixel: pixel as u32,
+                        radius2: 0.0,
+                        n: 0.0,
+                        tau: DVec3::ZERO,
+                    });
+                }
+                self.points.push(vp);
+            }
+        }
+        if stochastic && self.slots.is_empty() {
+            self.slots = (0..w * h)
+                .map(|i| Slot {
+                    pixel: i as u32,
+                    radius2: 0.0,
+                    n: 0.0,
+                    tau: DVec3::ZERO,
+                })
+                .collect();
+        }
+        // Initial radius: given, or twice the footprint of a pixel on the visible points'
+        // bounds (smallppm's rule).
+        if self.stats.passes == 0 && self.slots.iter().all(|s| s.radius2 == 0.0) {
+            let r0 = self.initial_radius.unwrap_or_else(|| {
+                let (lo, hi) = self
+                    .points
+                    .iter()
+                    .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
+                        (lo.min(p.position), hi.max(p.position))
+                    });
+                let size = if self.points.is_empty() {
+                    DVec3::ONE
+                } else {
+                    hi - lo
+                };
+                ((size.x + size.y) / 2.0 / ((w + h) as f64 / 2.0) * 2.0).max(1e-9)
+            });
+            for s in &mut self.slots {
+                s.radius2 = r0 * r0;
+            }
+        }
+        for vp in &mut self.points {
+            vp.radius2 = self.slots[vp.slot as usize].radius2;
+        }
+    }
+
+    /// Runs one pass: eye pass if needed, photons in batches (calling `control(&mut α)`
+    /// between batches; `Abort` drops the pass), then the radius/flux update.
+    pub fn run_pass(&mut self, scene: &Scene, control: &mut dyn FnMut(&mut f64) -> Control) -> PassOutcome {
+        let start = Instant::now();
+        if self.stochastic || self.stats.eye_passes == 0 {
+            self.eye_pass(scene);
+        } else {
+            for vp in &mut self.points {
+                vp.radius2 = self.slots[vp.slot as usize].radius2;
+            }
+        }
+        let index = match self.options.index {
+            IndexKind::HashGrid => SpatialIndex::Grid(HashGrid::build(&self.points)),
+            IndexKind::KdTree => SpatialIndex::Kd(KdTree::build(&self.points)),
+        };
+        let source = PhotonSource::new(scene, self.options.direct_light);
+        let mut phi = vec![DVec3::ZERO; self.slots.len()];
+        let mut m = vec![0u32; self.slots.len()];
+        let photons = self.photons_per_pass;
+        let first_photon = self.stats.photons;
+        let chunks = photons.div_ceil(CHUNK);
+        let mut counts = PhotonCounts::default();
+        let photon_start = Instant::now();
+        let mut chunk = 0;
+        while chunk < chunks {
+            if control(&mut self.alpha) == Control::Abort {
+                return PassOutcome::Aborted;
+            }
+            let end = (chunk + CHUNKS_PER_BATCH).min(chunks);
+            let results: Vec<(Vec<(u32, DVec3)>, PhotonCounts)> = (chunk..end)
+                .into_par_iter()
+                .map(|c| {
+                    let mut deposits = Vec::new();
+                    let mut counts = PhotonCounts::default();
+                    let lo = c * CHUNK;
+                    let hi = ((c + 1) * CHUNK).min(photons);
+                    for i in lo..hi {
+                        let mut rng = stream_rng(self.seed, streams::PHOTON, first_photon + i);
+                        let points = &self.points;
+                        source.trace(&mut rng, &mut counts, &mut |p, n, flux| {
+                            // Hand the flux to every visible point on this side of the surface
+                            // whose search sphere holds the photon.
+                            index.for_candidates(points, p, &mut |k| {
+                                let vp = &points[k as usize];
+                                if vp.normal.dot(n) > 1e-3 && (vp.position - p).length_squared() <= vp.radius2
+                                {
+                                    deposits.push((vp.slot, vp.weight * flux));
+                                }
+                            });
+                        });
+                    }
+                    (deposits, counts)
+                })
+                .collect();
+            // Fold in chunk order: the same sums whatever the thread count.
+            for (deposits, c) in results {
+                counts.deposits += deposits.len() as u64;
+                for (slot, flux) in deposits {
+                    phi[slot as usize] += flux;
+                    m[slot as usize] += 1;
+                }
+                counts.paths += c.paths;
+                counts.bounces += c.bounces;
+            }
+            chunk = end;
+        }
+        self.stats.photon_secs += photon_start.elapsed().as_secs_f64();
+
+        // Compute new photon counts, radii and flux (Hachisuka et al. 2008, eqs. 6–11).
+        let alpha = self.alpha;
+        for (k, s) in self.slots.iter_mut().enumerate() {
+            let mk = m[k] as f64;
+            if mk > 0.0 {
+                let g = (s.n + alpha * mk) / (s.n + mk);
+                s.radius2 *= g;
+                s.tau = (s.tau + phi[k]) * g;
+                s.n += alpha * mk;
+            }
+        }
+        self.stats.passes += 1;
+        self.stats.photons += photons;
+        self.stats.bounces += counts.bounces;
+        self.stats.deposits += counts.deposits;
+        self.stats.visible_points = self.points.len();
+        let gathered: Vec<f64> = self
+            .slots
+            .iter()
+            .filter(|s| s.n > 0.0)
+            .map(|s| s.radius2.sqrt())
+            .collect();
+        self.stats.mean_radius = gathered.iter().sum::<f64>() / gathered.len().max(1) as f64;
+        self.stats.elapsed_secs += start.elapsed().as_secs_f64();
+        PassOutcome::Completed
+    }
+
+    /// Linear RGB radiance per pixel: `τ/(π R² N_emitted)` of every slot of the pixel plus the
+    /// mean of the light seen directly.
+    pub fn radiance(&self) -> Vec<[f32; 3]> {
+        let mut out = vec![DVec3::ZERO; self.direct.len()];
+        if self.stats.photons > 0 {
+            let emitted = self.stats.photons as f64;
+            for s in &self.slots {
+                if s.radius2 > 0.0 {
+                    out[s.pixel as usize] += s.tau / (PI * s.radius2 * emitted);
+                }
+            }
+        }
+        let eye = self.stats.eye_passes.max(1) as f64;
+        out.iter()
+            .zip(&self.direct)
+            .map(|(l, d)| {
+                let c = *l + *d / eye;
+                [c.x as f32, c.y as f32, c.z as f32]
+            })
+            .collect()
+    }
+
+    /// The statistics slots (for the viewer's probe).
+    pub fn slots(&self) -> &[Slot] {
+        &self.slots
+    }
+}

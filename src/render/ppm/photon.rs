@@ -1,0 +1,157 @@
+//! Photon tracing (Jensen 2001; Hachisuka et al. 2008 §3.2; seed report §3.2.2): photons leave
+//! the lights in proportion to their power, bounce off mirrors and through glass (Fresnel
+//! chooses reflection or refraction), and at every diffuse surface hand their flux to the
+//! visible points whose search sphere holds them — on the same side of the surface — before
+//! continuing diffusely under Russian roulette with the surface's albedo as the survival
+//! probability.
+
+use glam::{DVec2, DVec3};
+use rand::Rng;
+use rand_pcg::Pcg64Mcg;
+
+use crate::geometry::Ray;
+use crate::scene::light::cosine_hemisphere;
+use crate::scene::material::{fresnel_dielectric, reflect, refract};
+use crate::scene::{MaterialKind, Scene};
+
+/// Counters of one batch of photons.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PhotonCounts {
+    /// Photon paths traced.
+    pub paths: u64,
+    /// Surface interactions (bounces).
+    pub bounces: u64,
+    /// Deposits made (counted by the caller's gather).
+    pub deposits: u64,
+}
+
+/// Where the light's photons go: which light, with what flux.
+pub struct PhotonSource<'a> {
+    /// The scene.
+    pub scene: &'a Scene,
+    /// Cumulative distribution over lights, by power.
+    pub cdf: Vec<f64>,
+    /// Photon flux of each light, `power / p_light`, before the emission weight: radiance
+    /// estimates divide by the total number of photons emitted (smallppm's convention), so the
+    /// number of photons per pass may change between passes.
+    pub flux: Vec<DVec3>,
+    /// The scene's bounding sphere, for aiming lights outside it.
+    pub target: Option<(DVec3, f64)>,
+    /// Skip the deposit at a photon's first diffuse hit from point/spot lights (their direct
+    /// light is computed exactly by shadow rays at the visible points).
+    pub skip_first_from_point_lights: bool,
+}
+
+impl<'a> PhotonSource<'a> {
+    /// Photons distributed over the scene's lights in proportion to their power.
+    pub fn new(scene: &'a Scene, direct_light: bool) -> Self {
+        let powers: Vec<f64> = scene
+            .lights
+            .iter()
+            .map(|l| l.power().element_sum() / 3.0)
+            .collect();
+        let total: f64 = powers.iter().sum();
+        let mut acc = 0.0;
+        let cdf = powers
+            .iter()
+            .map(|p| {
+                acc += p / total;
+                acc
+            })
+            .collect();
+        let flux = scene
+            .lights
+            .iter()
+            .zip(&powers)
+            .map(|(l, p)| l.power() / (p / total))
+            .collect();
+        let b = scene.geometry.bounds();
+        let target = (!b.is_empty()).then(|| (b.centroid(), 0.5 * b.diagonal().length()));
+        Self {
+            scene,
+            cdf,
+            flux,
+            target,
+            skip_first_from_point_lights: direct_light,
+        }
+    }
+
+    /// Traces one photon path with `rng`. At every diffuse hit whose flux should be gathered
+    /// (all but a point/spot light's first one when direct light is computed separately),
+    /// calls `gather(point, normal facing the photon, flux)`.
+    pub fn trace(
+        &self,
+        rng: &mut Pcg64Mcg,
+        counts: &mut PhotonCounts,
+        gather: &mut impl FnMut(DVec3, DVec3, DVec3),
+    ) {
+        let scene = self.scene;
+        let pick: f64 = rng.random();
+        let light_index = self
+            .cdf
+            .iter()
+            .position(|&c| pick < c)
+            .unwrap_or(self.cdf.len() - 1);
+        let light = &scene.lights[light_index];
+        let e = light.emit(
+            [rng.random(), rng.random(), rng.random(), rng.random()],
+            self.target,
+        );
+        let mut flux = self.flux[light_index] * e.weight;
+        let mut ray = Ray::new(e.origin, e.dir);
+        let skip_first = self.skip_first_from_point_lights && !light.is_area();
+        counts.paths += 1;
+        let mut diffuse_hits = 0u32;
+        for _depth in 0..scene.settings.max_depth.max(1) * 4 {
+            let Some(hit) = scene.geometry.intersect(&ray, f64::INFINITY) else {
+                return;
+            };
+            counts.bounces += 1;
+            if scene.objects[hit.object as usize].emission.is_some() {
+                return;
+            }
+            let material = scene.material(&hit);
+            let color = scene.albedo(material, &hit);
+            let front = ray.dir.dot(hit.normal) < 0.0;
+            let n = if front {
+                hit.shading_normal
+            } else {
+                -hit.shading_normal
+            };
+            match material.kind {
+                MaterialKind::Diffuse { .. } => {
+                    if !(skip_first && diffuse_hits == 0) {
+                        gather(hit.point, n, flux);
+                    }
+                    diffuse_hits += 1;
+                    // Russian roulette on the albedo, then a cosine-distributed bounce.
+                    let survive = color.max_element();
+                    if survive <= 0.0 || rng.random::<f64>() >= survive {
+                        return;
+                    }
+                    flux *= color / survive;
+                    let dir = cosine_hemisphere(n, DVec2::new(rng.random(), rng.random()));
+                    ray = hit.spawn(dir);
+                }
+                MaterialKind::Mirror => {
+                    flux *= color;
+                    ray = hit.spawn(reflect(ray.dir, n));
+                }
+                MaterialKind::Glass { ior } => {
+                    let eta = if front { 1.0 / ior } else { ior };
+                    let fresnel = fresnel_dielectric(-ray.dir.dot(n), eta);
+                    match refract(ray.dir, n, eta) {
+                        Some(t) if rng.random::<f64>() >= fresnel => {
+                            flux *= color;
+                            ray = hit.spawn(t);
+                        }
+                        _ => ray = hit.spawn(reflect(ray.dir, n)),
+                    }
+                }
+            }
+            if flux.max_element() <= 0.0 {
+                return;
+            }
+        }
+    }
+}

@@ -1,0 +1,221 @@
+//! The eye pass of photon mapping (Hachisuka, Ogaki & Jensen 2008 §3.1; seed report §3.2.1):
+//! trace eye rays through mirrors and glass to the first diffuse surface and record a visible
+//! point there — position, normal, and the weight (path throughput × BRDF) that turns photon
+//! flux arriving there into pixel radiance. Emission seen directly along the way, and optionally
+//! direct light from point and spot lights (shadow rays), is returned separately.
+
+use std::f64::consts::PI;
+
+use glam::{DVec2, DVec3};
+use rand::Rng;
+use rand_pcg::Pcg64Mcg;
+
+use crate::geometry::Ray;
+use crate::scene::material::{fresnel_dielectric, reflect, refract};
+use crate::scene::{Light, MaterialKind, Scene};
+
+/// Where photons are gathered for one pixel (or one branch of one pixel's eye path).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VisiblePoint {
+    /// The statistics slot this point gathers into.
+    pub slot: u32,
+    /// Position on the diffuse surface.
+    pub position: DVec3,
+    /// Unit normal facing the eye path.
+    pub normal: DVec3,
+    /// Path throughput × BRDF (ρ/π), RGB.
+    pub weight: DVec3,
+    /// Search radius² (copied from the slot when the index is built).
+    pub radius2: f64,
+}
+
+/// How the eye pass treats glass.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Branching {
+    /// Follow both the reflected and the refracted ray, weighted by Fresnel (classic PPM:
+    /// the eye pass runs once, so every branch must be kept).
+    Split,
+    /// Follow one, chosen with the Fresnel probability (stochastic PPM: a new eye pass each
+    /// pass averages the choices).
+    Choose,
+}
+
+/// One eye path's outputs: visible points and light seen directly.
+pub struct EyeResult {
+    /// Visible points (0, 1, or several with [`Branching::Split`]).
+    pub points: Vec<VisiblePoint>,
+    /// Emission seen directly plus (if enabled) direct light from point/spot lights.
+    pub direct: DVec3,
+}
+
+/// Traces the eye ray for `pixel` (pixel coordinates) through `lens` (unit disk).
+#[allow(clippy::too_many_arguments)]
+pub fn trace_eye(
+    scene: &Scene,
+    pixel: DVec2,
+    lens: DVec2,
+    slot: u32,
+    branching: Branching,
+    direct_light: bool,
+    rng: &mut Pcg64Mcg,
+) -> EyeResult {
+    let mut out = EyeResult {
+        points: Vec::new(),
+        direct: DVec3::ZERO,
+    };
+    let ray = scene.camera.ray(pixel, lens);
+    walk(
+        scene,
+        &ray,
+        DVec3::ONE,
+        0,
+        slot,
+        branching,
+        direct_light,
+        rng,
+        &mut out,
+    );
+    out
+}
+
+#[allow(clippy::too_many_arguments)]
+fn walk(
+    scene: &Scene,
+    ray: &Ray,
+    throughput: DVec3,
+    depth: u32,
+    slot: u32,
+    branching: Branching,
+    direct_light: bool,
+    rng: &mut Pcg64Mcg,
+    out: &mut EyeResult,
+) {
+    if throughput.max_element() <= 0.0 {
+        return;
+    }
+    let Some(hit) = scene.geometry.intersect(ray, f64::INFINITY) else {
+        out.direct += throughput * scene.background;
+        return;
+    };
+    out.direct += throughput * scene.emission(&hit, ray.dir);
+    if scene.objects[hit.object as usize].emission.is_some() || depth >= scene.settings.max_depth {
+        return;
+    }
+    let material = scene.material(&hit);
+    let color = scene.albedo(material, &hit);
+    let front = ray.dir.dot(hit.normal) < 0.0;
+    let n = if front {
+        hit.shading_normal
+    } else {
+        -hit.shading_normal
+    };
+    match material.kind {
+        MaterialKind::Diffuse { .. } => {
+            // The Phong lobe is a ray-tracer preview nicety; photon mapping uses the diffuse part.
+            let weight = throughput * color / PI;
+            if direct_light {
+                for light in scene.lights.iter().filter(|l| !l.is_area()) {
+                    let Some(ls) = light.sample(hit.point, DVec2::ZERO) else {
+                        continue;
+                    };
+                    let cos = n.dot(ls.wi);
+                    if cos > 0.0
+                        && !scene
+                            .geometry
+                            .occluded(&hit.spawn(ls.wi), ls.distance * (1.0 - 1e-7))
+                    {
+                        out.direct += weight * ls.incident * cos;
+                    }
+                }
+            }
+            out.points.push(VisiblePoint {
+                slot,
+                position: hit.point,
+                normal: n,
+                weight,
+                radius2: 0.0,
+            });
+        }
+        MaterialKind::Mirror => {
+            let r = hit.spawn(reflect(ray.dir, n));
+            walk(
+                scene,
+                &r,
+                throughput * color,
+                depth + 1,
+                slot,
+                branching,
+                direct_light,
+                rng,
+                out,
+            );
+        }
+        MaterialKind::Glass { ior } => {
+            let eta = if front { 1.0 / ior } else { ior };
+            let fresnel = fresnel_dielectric(-ray.dir.dot(n), eta);
+            let reflected = hit.spawn(reflect(ray.dir, n));
+            let refracted = refract(ray.dir, n, eta).map(|t| hit.spawn(t));
+            match (branching, refracted) {
+                (_, None) => walk(
+                    scene,
+                    &reflected,
+                    throughput,
+                    depth + 1,
+                    slot,
+                    branching,
+                    direct_light,
+                    rng,
+                    out,
+                ),
+                (Branching::Split, Some(t)) => {
+                    walk(
+                        scene,
+                        &reflected,
+                        throughput * fresnel,
+                        depth + 1,
+                        slot,
+                        branching,
+                        direct_light,
+                        rng,
+                        out,
+                    );
+                    let tt = throughput * (1.0 - fresnel) * color;
+                    walk(scene, &t, tt, depth + 1, slot, branching, direct_light, rng, out);
+                }
+                (Branching::Choose, Some(t)) => {
+                    if rng.random::<f64>() < fresnel {
+                        walk(
+                            scene,
+                            &reflected,
+                            throughput,
+                            depth + 1,
+                            slot,
+                            branching,
+                            direct_light,
+                            rng,
+                            out,
+                        );
+                    } else {
+                        walk(
+                            scene,
+                            &t,
+                            throughput * color,
+                            depth + 1,
+                            slot,
+                            branching,
+                            direct_light,
+                            rng,
+                            out,
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Whether direct light from this light is computed by shadow rays when that option is on
+/// (point and spot lights; area lights are left to photons).
+pub fn direct_by_shadow_rays(light: &Light) -> bool {
+    !light.is_area()
+}

@@ -1,0 +1,287 @@
+//! The render session (DESIGN.md §1): photon-mapping passes on a thread of their own, steered
+//! by [`Command`]s over an unbounded channel and reporting a [`Frame`] after each pass over a
+//! `bounded(1)` channel with `try_send` — the renderer never waits for whoever watches; a
+//! frame nobody took is simply replaced by a newer one.
+//!
+//! Commands are looked at between photon batches, so a slider takes effect within one batch.
+//! α and photons per pass change the coming update/pass without discarding anything; the
+//! camera, aperture, focal distance, initial radius, depth and geometry restart accumulation
+//! under a new `epoch`; pause and resume lose nothing (a paused pass continues where it
+//! stopped, so the image is the one an uninterrupted run gives).
+
+use std::sync::Arc;
+use std::thread::JoinHandle;
+use std::time::Instant;
+
+use crossbeam_channel::{bounded, unbounded, Receiver, Sender, TryRecvError};
+use glam::DVec3;
+
+use super::ppm::{Control, PassOutcome, Ppm, PpmOptions, PpmStats};
+use crate::scene::{Camera, Scene};
+
+/// What the UI (or a test) asks of the renderer.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Command {
+    /// Radius reduction α for future updates (no restart).
+    SetAlpha(f64),
+    /// Photons per pass from the next pass on (no restart).
+    SetPhotonsPerPass(u64),
+    /// Initial radius (`None`: automatic); restarts.
+    SetInitialRadius(Option<f64>),
+    /// Maximum specular depth; restarts.
+    SetMaxDepth(u32),
+    /// A new camera; restarts.
+    SetCamera(Camera),
+    /// Lens radius; restarts.
+    SetAperture(f64),
+    /// Distance of the focal plane; restarts.
+    SetFocalDistance(f64),
+    /// Moves control point `index` of patch `patch`; restarts.
+    MoveControlPoint {
+        /// Patch index in the scene geometry.
+        patch: usize,
+        /// Control point `4i + j`.
+        index: usize,
+        /// New position.
+        position: DVec3,
+    },
+    /// Stop between batches, keeping everything.
+    Pause,
+    /// Continue after [`Command::Pause`].
+    Resume,
+    /// Discard the accumulation and start again (new epoch).
+    Restart,
+    /// End the session's thread.
+    Shutdown,
+}
+
+/// One finished pass, as the viewer needs it.
+#[derive(Clone, Debug)]
+pub struct Frame {
+    /// Increases whenever accumulated statistics are discarded.
+    pub epoch: u64,
+    /// Passes completed in this epoch.
+    pub pass: u32,
+    /// Photons emitted in this epoch.
+    pub photons: u64,
+    /// Seconds since this epoch started.
+    pub elapsed_secs: f64,
+    /// Statistics of the render.
+    pub stats: PpmStats,
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// Linear RGB radiance, `width × height` pixels, rows from the top.
+    pub radiance: Arc<[[f32; 3]]>,
+    /// Search radius per pixel (largest of the pixel's slots), for the viewer's probe.
+    pub radius: Arc<[f32]>,
+}
+
+/// A render running on its own thread.
+pub struct RenderSession {
+    commands: Sender<Command>,
+    frames: Receiver<Frame>,
+    thread: Option<JoinHandle<()>>,
+}
+
+/// Called after each frame is offered (the viewer passes `ctx.request_repaint`).
+pub type Waker = Box<dyn Fn() + Send>;
+
+impl RenderSession {
+    /// Starts rendering `scene` on a new thread (named `caustic-render`), in the global rayon
+    /// pool.
+    pub fn start(scene: Scene, options: PpmOptions, waker: Option<Waker>) -> Self {
+        let (commands, command_rx) = unbounded();
+        let (frame_tx, frames) = bounded(1);
+        // The render thread holds a receiver too, to replace a frame nobody has taken.
+        let stale = frames.clone();
+        let thread = std::thread::Builder::new()
+            .name("caustic-render".into())
+            .spawn(move || run(scene, options, command_rx, (frame_tx, stale), waker))
+            .expect("spawn the render thread");
+        Self {
+            commands,
+            frames,
+            thread: Some(thread),
+        }
+    }
+
+    /// Sends a command (ignored once the thread has ended).
+    pub fn send(&self, command: Command) {
+        let _ = self.commands.send(command);
+    }
+
+    /// The frames channel: at most one waiting frame, the newest.
+    pub fn frames(&self) -> &Receiver<Frame> {
+        &self.frames
+    }
+
+    /// Asks the thread to stop and waits for it.
+    pub fn shutdown(mut self) {
+        self.stop();
+    }
+
+    fn stop(&mut self) {
+        let _ = self.commands.send(Command::Shutdown);
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}
+
+impl Drop for RenderSession {
+    fn drop(&mut self) {
+        self.stop();
+    }
+}
+
+/// Whether a command discards the accumulation, and is valid for a scene with `patches`.
+fn restarts(command: &Command, patches: usize) -> Option<bool> {
+    match command {
+        Command::SetAlpha(a) => (*a > 0.0 && *a <= 1.0).then_some(false),
+        Command::SetPhotonsPerPass(n) => (*n > 0).then_some(false),
+        Command::Pause | Command::Resume | Command::Shutdown => Some(false),
+        Command::SetInitialRadius(r) => r.is_none_or(|r| r.is_finite() && r > 0.0).then_some(true),
+        Command::SetMaxDepth(d) => (1..=64).contains(d).then_some(true),
+        Command::SetCamera(_) | Command::Restart => Some(true),
+        Command::SetAperture(a) => (a.is_finite() && *a >= 0.0).then_some(true),
+        Command::SetFocalDistance(f) => (f.is_finite() && *f > 0.0).then_some(true),
+        Command::MoveControlPoint {
+            patch,
+            index,
+            position,
+        } => (*patch < patches && *index < 16 && position.is_finite()).then_some(true),
+    }
+}
+
+/// Applies a command that restarts the accumulation to the scene.
+fn apply_to_scene(scene: &mut Scene, command: Command) {
+    match command {
+        Command::SetInitialRadius(r) => scene.settings.initial_radius = r,
+        Command::SetMaxDepth(d) => scene.settings.max_depth = d,
+        Command::SetCamera(c) => scene.camera = c,
+        Command::SetAperture(a) => scene.camera.aperture = a,
+        Command::SetFocalDistance(f) => scene.camera.focal_distance = f,
+        Command::MoveControlPoint {
+            patch,
+            index,
+            position,
+        } => {
+            scene.geometry.set_control_point(patch, index, position);
+        }
+        _ => {}
+    }
+}
+
+/// The per-pixel search radius (largest of the pixel's slots).
+fn radius_image(ppm: &Ppm) -> Arc<[f32]> {
+    let (w, h) = ppm.size();
+    let mut r = vec![0.0f32; w as usize * h as usize];
+    for s in ppm.slots() {
+        let px = &mut r[s.pixel as usize];
+        *px = px.max(s.radius2.sqrt() as f32);
+    }
+    r.into()
+}
+
+fn run(
+    scene: Scene,
+    options: PpmOptions,
+    commands: Receiver<Command>,
+    (frames, stale): (Sender<Frame>, Receiver<Frame>),
+    waker: Option<Waker>,
+) {
+    let mut scene = scene;
+    let mut ppm = Ppm::new(&scene, options);
+    let mut epoch = 0u64;
+    let mut epoch_start = Instant::now();
+    let mut paused = false;
+    let photons_per_pass = std::cell::Cell::new(scene.settings.photons_per_pass);
+    loop {
+        let patches = scene.geometry.patches().len();
+        let mut pending: Vec<Command> = Vec::new();
+        let mut shutdown = false;
+        // Between batches (and passes): apply commands; while paused, wait for them.
+        let mut control = |alpha: &mut f64| -> Control {
+            loop {
+                let next = if paused && pending.is_empty() {
+                    commands.recv().map_err(|_| TryRecvError::Disconnected)
+                } else {
+                    commands.try_recv()
+                };
+                let command = match next {
+                    Ok(c) => c,
+                    Err(TryRecvError::Empty) => break,
+                    Err(TryRecvError::Disconnected) => {
+                        shutdown = true;
+                        return Control::Abort;
+                    }
+                };
+                match (restarts(&command, patches), command) {
+                    (None, _) => {} // out of range: ignored (the UI validates before sending)
+                    (Some(true), c) => pending.push(c),
+                    (Some(false), Command::SetAlpha(a)) => *alpha = a,
+                    (Some(false), Command::SetPhotonsPerPass(n)) => photons_per_pass.set(n),
+                    (Some(false), Command::Pause) => paused = true,
+                    (Some(false), Command::Resume) => paused = false,
+                    (Some(false), _) => {
+                        shutdown = true;
+                        return Control::Abort;
+                    }
+                }
+            }
+            if pending.is_empty() {
+                Control::Continue
+            } else {
+                Control::Abort
+            }
+        };
+        let mut alpha = ppm.alpha;
+        let outcome = if control(&mut alpha) == Control::Continue {
+            ppm.alpha = alpha;
+            ppm.photons_per_pass = photons_per_pass.get();
+            Some(ppm.run_pass(&scene, &mut control))
+        } else {
+            ppm.alpha = alpha;
+            None
+        };
+        if shutdown {
+            return;
+        }
+        if !pending.is_empty() {
+            for c in pending {
+                apply_to_scene(&mut scene, c);
+            }
+            scene.settings.alpha = ppm.alpha;
+            scene.settings.photons_per_pass = photons_per_pass.get();
+            epoch += 1;
+            epoch_start = Instant::now();
+            ppm = Ppm::new(&scene, options);
+            continue;
+        }
+        if outcome == Some(PassOutcome::Completed) {
+            let (width, height) = ppm.size();
+            let stats = ppm.stats().clone();
+            let frame = Frame {
+                epoch,
+                pass: stats.passes,
+                photons: stats.photons,
+                elapsed_secs: epoch_start.elapsed().as_secs_f64(),
+                stats,
+                width,
+                height,
+                radiance: ppm.radiance().into(),
+                radius: radius_image(&ppm),
+            };
+            // Never wait for the viewer: a frame it has not taken yet is replaced.
+            if let Err(crossbeam_channel::TrySendError::Full(frame)) = frames.try_send(frame) {
+                let _ = stale.try_recv();
+                let _ = frames.try_send(frame);
+            }
+            if let Some(w) = &waker {
+                w();
+            }
+        }
+    }
+}

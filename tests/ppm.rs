@@ -1,0 +1,304 @@
+//! Progressive photon mapping: convergence to a closed form, energy conservation through
+//! glass, determinism across thread counts, index agreement, and the render session's rules.
+
+use std::f64::consts::PI;
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+use caustic::render::ppm::photon::{PhotonCounts, PhotonSource};
+use caustic::render::ppm::{Control, IndexKind, Ppm, PpmOptions};
+use caustic::render::rng::stream_rng;
+use caustic::render::session::{Command, Frame, RenderSession};
+use caustic::scene::Scene;
+use glam::{DVec2, DVec3};
+
+const PLANE: &str = r#"
+[camera]
+position = [0.0, 5.0, 0.5]
+look_at = [0, 0, 0]
+up = [0, 0, 1]
+fov = 30
+width = 24
+height = 18
+
+[render]
+antialias = false
+photons_per_pass = 100000
+alpha = 0.7
+
+[materials.floor]
+type = "diffuse"
+color = [0.8, 0.6, 0.4]
+
+[[lights]]
+type = "point"
+position = [0.5, 3.0, 0.2]
+power = 400
+
+[[objects]]
+type = "plane"
+point = [0, 0, 0]
+normal = [0, 1, 0]
+material = "floor"
+"#;
+
+/// The closed form ρ/π · I cos θ / r² at the plane point seen through each pixel centre.
+fn expected_plane(scene: &Scene) -> Vec<DVec3> {
+    let rho = DVec3::new(0.8, 0.6, 0.4);
+    let light = DVec3::new(0.5, 3.0, 0.2);
+    let intensity = 400.0 / (4.0 * PI);
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .map(|(x, y)| {
+            let ray = scene.camera.ray(Scene::pixel_center(x, y), DVec2::ZERO);
+            let p = ray.at(-ray.origin.y / ray.dir.y);
+            let d = light - p;
+            rho / PI * intensity * d.normalize().y / d.length_squared()
+        })
+        .collect()
+}
+
+fn relative_errors(image: &[[f32; 3]], expected: &[DVec3]) -> (f64, f64) {
+    let (mut sum_ratio, mut sum_sq) = (0.0, 0.0);
+    for (p, e) in image.iter().zip(expected) {
+        let ratio = p[0] as f64 / e.x;
+        sum_ratio += ratio;
+        sum_sq += (ratio - 1.0).powi(2);
+    }
+    let n = image.len() as f64;
+    (sum_ratio / n, (sum_sq / n).sqrt())
+}
+
+#[test]
+fn ppm_converges_to_the_point_lit_plane() {
+    let scene = Scene::from_str(PLANE, Path::new("plane.toml"), None).expect("scene");
+    let expected = expected_plane(&scene);
+    let mut ppm = Ppm::new(&scene, PpmOptions::default());
+    let mut errors = Vec::new();
+    for pass in 1..=40 {
+        ppm.run_pass(&scene, &mut |_| Control::Continue);
+        if pass == 4 || pass == 40 {
+            errors.push(relative_errors(&ppm.radiance(), &expected));
+        }
+    }
+    let (mean_ratio, rms) = errors[1];
+    assert!(
+        (mean_ratio - 1.0).abs() < 0.01,
+        "mean PPM / closed form = {mean_ratio}"
+    );
+    assert!(rms < errors[0].1 * 0.75, "RMS error did not shrink: {errors:?}");
+    assert!(rms < 0.06, "per-pixel RMS relative error {rms}");
+}
+
+#[test]
+fn direct_light_option_is_exact_for_direct_illumination() {
+    let scene = Scene::from_str(PLANE, Path::new("plane.toml"), None).expect("scene");
+    let expected = expected_plane(&scene);
+    let options = PpmOptions {
+        direct_light: true,
+        ..Default::default()
+    };
+    let mut ppm = Ppm::new(&scene, options);
+    ppm.run_pass(&scene, &mut |_| Control::Continue);
+    // Only the plane: photons bounce off it once and leave, so all light is direct.
+    let (mean_ratio, rms) = relative_errors(&ppm.radiance(), &expected);
+    assert!(
+        (mean_ratio - 1.0).abs() < 1e-6 && rms < 1e-6,
+        "{mean_ratio} {rms}"
+    );
+}
+
+#[test]
+fn glass_conserves_photon_flux() {
+    // A closed black box with a glass sphere under the light: every photon ends on a wall, so
+    // the flux gathered at first diffuse hits is the light's power.
+    let text = r#"
+[camera]
+position = [0, 0, -0.9]
+look_at = [0, 0, 0]
+fov = 40
+width = 4
+height = 4
+
+[render]
+max_depth = 16
+
+[materials.black]
+type = "diffuse"
+color = [0, 0, 0]
+
+[materials.glass]
+type = "glass"
+color = [1, 1, 1]
+ior = 1.5
+
+[[lights]]
+type = "point"
+position = [0, 0.8, 0]
+power = 100
+
+[[objects]]
+type = "sphere"
+center = [0, 0, 0]
+radius = 0.5
+material = "glass"
+
+[[objects]]
+type = "sphere"
+center = [0, 0, 0]
+radius = 1.0
+material = "black"
+"#;
+    let scene = Scene::from_str(text, Path::new("box.toml"), None).expect("scene");
+    let source = PhotonSource::new(&scene, false);
+    let mut counts = PhotonCounts::default();
+    let mut total = DVec3::ZERO;
+    let mut through_glass = 0u64;
+    let n = 200_000u64;
+    for i in 0..n {
+        let mut rng = stream_rng(7, 99, i);
+        let before = counts.bounces;
+        source.trace(&mut rng, &mut counts, &mut |_, _, flux| total += flux);
+        through_glass += u64::from(counts.bounces - before > 1);
+    }
+    let ratio = total.x / (100.0 * n as f64);
+    assert!(
+        through_glass > n / 10,
+        "few photons met the glass: {through_glass}"
+    );
+    assert!(
+        ratio > 0.998 && ratio < 1.0 + 1e-9,
+        "gathered flux / power = {ratio}"
+    );
+}
+
+fn cornell_small(aperture: f64) -> Scene {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell.toml");
+    let mut scene = Scene::load(&path).expect("cornell");
+    scene.camera.width = 40;
+    scene.camera.height = 30;
+    scene.camera.aperture = aperture;
+    scene.settings.photons_per_pass = 20_000;
+    scene.settings.antialias = false;
+    scene
+}
+
+fn render_passes(scene: &Scene, options: PpmOptions, passes: u32) -> Vec<[f32; 3]> {
+    let mut ppm = Ppm::new(scene, options);
+    for _ in 0..passes {
+        ppm.run_pass(scene, &mut |_| Control::Continue);
+    }
+    ppm.radiance()
+}
+
+#[test]
+fn ppm_is_identical_for_one_and_two_threads() {
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("pool");
+    let two = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .expect("pool");
+    for aperture in [0.0, 0.2] {
+        let scene = cornell_small(aperture);
+        let a = one.install(|| render_passes(&scene, PpmOptions::default(), 3));
+        let b = two.install(|| render_passes(&scene, PpmOptions::default(), 3));
+        assert_eq!(a, b, "aperture {aperture}");
+        assert!(a.iter().flatten().all(|c| c.is_finite()) && a.iter().any(|p| p[0] > 0.0));
+    }
+}
+
+#[test]
+fn kd_tree_and_hash_grid_find_the_same_points() {
+    let scene = cornell_small(0.0);
+    let grid = render_passes(&scene, PpmOptions::default(), 2);
+    let kd = render_passes(
+        &scene,
+        PpmOptions {
+            index: IndexKind::KdTree,
+            ..Default::default()
+        },
+        2,
+    );
+    for (a, b) in grid.iter().zip(&kd) {
+        for c in 0..3 {
+            assert!(
+                (a[c] - b[c]).abs() <= 1e-5 * a[c].abs().max(1e-3),
+                "{a:?} vs {b:?}"
+            );
+        }
+    }
+}
+
+fn next_frame(session: &RenderSession, timeout: Duration) -> Frame {
+    session.frames().recv_timeout(timeout).expect("a frame")
+}
+
+#[test]
+fn session_epochs_follow_the_rules_and_never_block() {
+    let scene = cornell_small(0.0);
+    let session = RenderSession::start(scene, PpmOptions::default(), None);
+    let first = next_frame(&session, Duration::from_secs(60));
+    assert_eq!(first.epoch, 0);
+    // Nobody reads for a while: the renderer keeps going and the channel holds the newest.
+    std::thread::sleep(Duration::from_millis(1500));
+    let later = next_frame(&session, Duration::from_secs(60));
+    assert!(
+        later.pass > first.pass + 1,
+        "renderer stalled: {} then {}",
+        first.pass,
+        later.pass
+    );
+    // α applies without a restart.
+    session.send(Command::SetAlpha(0.5));
+    let f = next_frame(&session, Duration::from_secs(60));
+    assert_eq!(f.epoch, 0);
+    session.send(Command::SetPhotonsPerPass(5_000));
+    assert_eq!(next_frame(&session, Duration::from_secs(60)).epoch, 0);
+    // The aperture restarts under a new epoch.
+    session.send(Command::SetAperture(0.1));
+    let deadline = Instant::now() + Duration::from_secs(60);
+    let f = loop {
+        let f = next_frame(&session, Duration::from_secs(60));
+        if f.epoch > 0 || Instant::now() > deadline {
+            break f;
+        }
+    };
+    assert_eq!(f.epoch, 1);
+    assert!(f.pass <= 3, "a new epoch starts from scratch (pass {})", f.pass);
+    // Editing a control point restarts too.
+    session.send(Command::MoveControlPoint {
+        patch: 0,
+        index: 5,
+        position: DVec3::new(5.0, 3.0, 5.0),
+    });
+    let f = loop {
+        let f = next_frame(&session, Duration::from_secs(60));
+        if f.epoch > 1 || Instant::now() > deadline {
+            break f;
+        }
+    };
+    assert_eq!(f.epoch, 2);
+    session.shutdown();
+}
+
+#[test]
+fn pause_and_resume_lose_nothing() {
+    let scene = cornell_small(0.0);
+    let reference_scene = scene.clone();
+    let session = RenderSession::start(scene, PpmOptions::default(), None);
+    session.send(Command::Pause);
+    std::thread::sleep(Duration::from_millis(300));
+    session.send(Command::Resume);
+    std::thread::sleep(Duration::from_millis(100));
+    session.send(Command::Pause);
+    std::thread::sleep(Duration::from_millis(200));
+    session.send(Command::Resume);
+    let f = next_frame(&session, Duration::from_secs(60));
+    session.shutdown();
+    let reference = render_passes(&reference_scene, PpmOptions::default(), f.pass);
+    assert_eq!(&f.radiance[..], &reference[..], "pass {}", f.pass);
+}
