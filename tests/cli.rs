@@ -110,6 +110,37 @@ fn render_writes_png_and_exr_with_metadata_and_refuses_to_overwrite() {
 }
 
 #[test]
+fn render_with_photon_mapping_reports_its_statistics() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let exr = dir.path().join("smallppm.exr");
+    let out = caustic(&[
+        "render",
+        "scenes/smallppm.toml",
+        "--out",
+        exr.to_str().expect("utf-8"),
+        "--width",
+        "64",
+        "--height",
+        "48",
+        "--passes",
+        "3",
+        "--photons",
+        "20000",
+    ]);
+    let t = text(&out);
+    assert!(out.status.success(), "{t}");
+    assert!(t.contains("3 passes, 60000 photons"), "{t}");
+    assert!(t.contains("skipped: eye pass traced once and reused"), "{t}");
+    assert!(t.contains("skipped: no Bézier patches"), "{t}");
+    let linear = image::open(&exr).expect("readable EXR").to_rgb32f();
+    assert!(linear.pixels().all(|p| p.0.iter().all(|c| c.is_finite())));
+    assert!(linear.pixels().filter(|p| p[0] > 0.0).count() > 64 * 48 / 2);
+    let meta = exr::meta::MetaData::read_from_file(&exr, false).expect("EXR header");
+    let attrs = &meta.headers[0].own_attributes.other;
+    assert!(attrs.keys().any(|k| k == "caustic:photons"), "{attrs:?}");
+}
+
+#[test]
 fn export_obj_writes_the_tessellated_patches() {
     let dir = tempfile::tempdir().expect("temp dir");
     let obj = dir.path().join("teapot.obj");

@@ -302,3 +302,67 @@ fn pause_and_resume_lose_nothing() {
     let reference = render_passes(&reference_scene, PpmOptions::default(), f.pass);
     assert_eq!(&f.radiance[..], &reference[..], "pass {}", f.pass);
 }
+
+#[test]
+fn direct_light_option_keeps_caustics() {
+    // A point light above a glass ball above a floor: under the ball all light is caustic (the
+    // shadow ray is blocked), so computing direct light by shadow rays must not lose it.
+    let text = r#"
+[camera]
+position = [2.5, 0.4, 0.0]
+look_at = [0, 0, 0]
+fov = 12
+width = 32
+height = 24
+
+[render]
+antialias = false
+photons_per_pass = 40000
+max_depth = 12
+
+[materials.floor]
+type = "diffuse"
+color = [0.7, 0.7, 0.7]
+
+[materials.glass]
+type = "glass"
+color = [1, 1, 1]
+ior = 1.5
+
+[[lights]]
+type = "point"
+position = [0, 6, 0]
+power = 500
+
+[[objects]]
+type = "sphere"
+center = [0, 2.2, 0]
+radius = 1.0
+material = "glass"
+
+[[objects]]
+type = "plane"
+point = [0, 0, 0]
+normal = [0, 1, 0]
+material = "floor"
+"#;
+    let scene = Scene::from_str(text, Path::new("caustic.toml"), None).expect("scene");
+    let mean = |direct_light: bool| {
+        let image = render_passes(
+            &scene,
+            PpmOptions {
+                direct_light,
+                ..Default::default()
+            },
+            12,
+        );
+        image.iter().map(|p| p[0] as f64).sum::<f64>() / image.len() as f64
+    };
+    let (photons_only, with_direct) = (mean(false), mean(true));
+    assert!(photons_only > 0.0);
+    let ratio = with_direct / photons_only;
+    assert!(
+        (ratio - 1.0).abs() < 0.1,
+        "direct-light option changes the caustic: ratio {ratio}"
+    );
+}

@@ -4,6 +4,7 @@
 //! about twice as many buckets as entries and stored compactly (counting sort, no per-cell vectors).
 
 use glam::{DVec3, IVec3};
+use rayon::prelude::*;
 
 use super::visible::VisiblePoint;
 
@@ -51,10 +52,10 @@ impl HashGrid {
             .collect();
         // The distinct buckets of each point's cells: two of its cells may hash to the same
         // bucket, and a point listed twice there would be handed a photon twice.
-        let buckets_guess = (2 * points.len() * 8).next_power_of_two().max(2);
+        let buckets_guess = (2 * points.len() * 4).next_power_of_two().max(2);
         let mask = buckets_guess as u64 - 1;
         let point_buckets: Vec<Vec<u64>> = ranges
-            .iter()
+            .par_iter()
             .map(|(lo, hi)| {
                 let mut b = Vec::with_capacity(8);
                 for z in lo.z..=hi.z {

@@ -47,7 +47,7 @@ mod streams {
 /// Photons per chunk: the unit of parallel work and of deterministic reduction.
 const CHUNK: u64 = 4096;
 /// Chunks per batch: commands are looked at between batches.
-const CHUNKS_PER_BATCH: u64 = 8;
+const CHUNKS_PER_BATCH: u64 = 16;
 
 /// Which spatial index finds the visible points near a photon.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -337,6 +337,13 @@ impl Ppm {
             IndexKind::KdTree => SpatialIndex::Kd(KdTree::build(&self.points)),
         };
         let source = PhotonSource::new(scene, self.options.direct_light);
+        // Positions and radii packed tightly: the candidate test reads nothing else.
+        let reach: Vec<[f64; 4]> = self
+            .points
+            .iter()
+            .map(|v| [v.position.x, v.position.y, v.position.z, v.radius2])
+            .collect();
+        let reach = &reach;
         let mut phi = vec![DVec3::ZERO; self.slots.len()];
         let mut m = vec![0u32; self.slots.len()];
         let photons = self.photons_per_pass;
@@ -364,10 +371,12 @@ impl Ppm {
                             // Hand the flux to every visible point on this side of the surface
                             // whose search sphere holds the photon.
                             index.for_candidates(points, p, &mut |k| {
-                                let vp = &points[k as usize];
-                                if vp.normal.dot(n) > 1e-3 && (vp.position - p).length_squared() <= vp.radius2
-                                {
-                                    deposits.push((vp.slot, vp.weight * flux));
+                                let [x, y, z, r2] = reach[k as usize];
+                                if (DVec3::new(x, y, z) - p).length_squared() <= r2 {
+                                    let vp = &points[k as usize];
+                                    if vp.normal.dot(n) > 1e-3 {
+                                        deposits.push((vp.slot, vp.weight * flux));
+                                    }
                                 }
                             });
                         });

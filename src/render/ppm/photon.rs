@@ -37,8 +37,10 @@ pub struct PhotonSource<'a> {
     pub flux: Vec<DVec3>,
     /// The scene's bounding sphere, for aiming lights outside it.
     pub target: Option<(DVec3, f64)>,
-    /// Skip the deposit at a photon's first diffuse hit from point/spot lights (their direct
-    /// light is computed exactly by shadow rays at the visible points).
+    /// Skip the deposit where a photon from a point/spot light first meets anything, when that
+    /// is a diffuse surface: that is direct light, computed exactly by shadow rays at the
+    /// visible points. Photons that reached the surface through mirrors or glass (caustics) are
+    /// still gathered — a shadow ray cannot see them.
     pub skip_first_from_point_lights: bool,
 }
 
@@ -77,7 +79,7 @@ impl<'a> PhotonSource<'a> {
     }
 
     /// Traces one photon path with `rng`. At every diffuse hit whose flux should be gathered
-    /// (all but a point/spot light's first one when direct light is computed separately),
+    /// (all but direct hits from point/spot lights when direct light is computed separately),
     /// calls `gather(point, normal facing the photon, flux)`.
     pub fn trace(
         &self,
@@ -101,7 +103,7 @@ impl<'a> PhotonSource<'a> {
         let mut ray = Ray::new(e.origin, e.dir);
         let skip_first = self.skip_first_from_point_lights && !light.is_area();
         counts.paths += 1;
-        let mut diffuse_hits = 0u32;
+        let mut first_interaction = true;
         for _depth in 0..scene.settings.max_depth.max(1) * 4 {
             let Some(hit) = scene.geometry.intersect(&ray, f64::INFINITY) else {
                 return;
@@ -120,10 +122,9 @@ impl<'a> PhotonSource<'a> {
             };
             match material.kind {
                 MaterialKind::Diffuse { .. } => {
-                    if !(skip_first && diffuse_hits == 0) {
+                    if !(skip_first && first_interaction) {
                         gather(hit.point, n, flux);
                     }
-                    diffuse_hits += 1;
                     // Russian roulette on the albedo, then a cosine-distributed bounce.
                     let survive = color.max_element();
                     if survive <= 0.0 || rng.random::<f64>() >= survive {
@@ -149,6 +150,7 @@ impl<'a> PhotonSource<'a> {
                     }
                 }
             }
+            first_interaction = false;
             if flux.max_element() <= 0.0 {
                 return;
             }
