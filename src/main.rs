@@ -81,16 +81,16 @@ struct PpmArgs {
     #[arg(long, default_value_t = 16)]
     passes: u32,
     /// Photon mapping: stop after this many seconds even if passes remain.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     time_limit: Option<f64>,
     /// Photon mapping: photons per pass (default: the scene's).
     #[arg(long)]
     photons: Option<u64>,
     /// Photon mapping: radius reduction α in (0, 1] (default: the scene's).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     alpha: Option<f64>,
     /// Photon mapping: initial radius in scene units (default: the scene's, or automatic).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     radius: Option<f64>,
     /// Photon mapping: spatial index over visible points.
     #[arg(long, value_enum, default_value_t = IndexChoice::Grid)]

@@ -186,8 +186,27 @@ fn bad_input_gives_clear_errors() {
             "invalid value 'many' for '--width",
         ),
         (
-            vec!["render", "scenes/smallppm.toml", "--out", out_s],
-            "render it with --renderer whitted",
+            vec!["render", "scenes/smallppm.toml", "--out", out_s, "--alpha", "1.5"],
+            "--alpha must be in (0, 1]",
+        ),
+        (
+            vec!["render", "scenes/smallppm.toml", "--out", out_s, "--radius", "-1"],
+            "--radius must be a positive number",
+        ),
+        (
+            vec!["render", "scenes/smallppm.toml", "--out", out_s, "--passes", "0"],
+            "--passes must be at least 1",
+        ),
+        (
+            vec![
+                "render",
+                "scenes/smallppm.toml",
+                "--out",
+                out_s,
+                "--time-limit",
+                "-3",
+            ],
+            "--time-limit must be a positive number of seconds",
         ),
         (
             vec!["export-obj", "scenes/smallppm.toml", "--out", out_s],
