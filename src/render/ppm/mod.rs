@@ -49,6 +49,27 @@ const CHUNK: u64 = 4096;
 /// Chunks per batch: commands are looked at between batches.
 const CHUNKS_PER_BATCH: u64 = 16;
 
+/// Deposits one chunk may hold before they are merged per slot: bounds memory when radii are
+/// large (every photon then reaches thousands of points).
+const MAX_CHUNK_DEPOSITS: usize = 1 << 20;
+
+/// Merges deposits to the same slot, keeping each slot's additions in photon order (a stable
+/// sort), so the sums depend only on the chunk's photons, not on threads.
+fn compact(deposits: &mut Vec<(u32, DVec3, u32)>) {
+    deposits.sort_by_key(|d| d.0);
+    let mut merged: Vec<(u32, DVec3, u32)> = Vec::with_capacity(deposits.len() / 4);
+    for &(slot, flux, count) in deposits.iter() {
+        match merged.last_mut() {
+            Some(last) if last.0 == slot => {
+                last.1 += flux;
+                last.2 += count;
+            }
+            _ => merged.push((slot, flux, count)),
+        }
+    }
+    *deposits = merged;
+}
+
 /// Which spatial index finds the visible points near a photon.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum IndexKind {
@@ -295,22 +316,27 @@ impl Ppm {
                 })
                 .collect();
         }
-        // Initial radius: given, or twice the footprint of a pixel on the visible points'
-        // bounds (smallppm's rule).
+        // Initial radius: given, or twice the footprint of one pixel at the median distance
+        // of the visible points from the eye. (smallppm's rule — the visible points' bounding
+        // box over the image size — explodes for an infinite floor reaching the horizon.)
         if self.stats.passes == 0 && self.slots.iter().all(|s| s.radius2 == 0.0) {
             let r0 = self.initial_radius.unwrap_or_else(|| {
-                let (lo, hi) = self
+                let mut distances: Vec<f64> = self
                     .points
                     .iter()
-                    .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
-                        (lo.min(p.position), hi.max(p.position))
-                    });
-                let size = if self.points.is_empty() {
-                    DVec3::ONE
-                } else {
-                    hi - lo
-                };
-                ((size.x + size.y) / 2.0 / ((w + h) as f64 / 2.0) * 2.0).max(1e-9)
+                    .map(|p| {
+                        (p.position - scene.camera.position)
+                            .dot(scene.camera.forward)
+                            .abs()
+                    })
+                    .collect();
+                if distances.is_empty() {
+                    return 1e-3;
+                }
+                let mid = distances.len() / 2;
+                let median = *distances.select_nth_unstable_by(mid, f64::total_cmp).1;
+                let pixel = 2.0 * (0.5 * scene.camera.fov_y).tan() / h as f64;
+                (2.0 * median * pixel).max(1e-9)
             });
             for s in &mut self.slots {
                 s.radius2 = r0 * r0;
@@ -357,10 +383,10 @@ impl Ppm {
                 return PassOutcome::Aborted;
             }
             let end = (chunk + CHUNKS_PER_BATCH).min(chunks);
-            let results: Vec<(Vec<(u32, DVec3)>, PhotonCounts)> = (chunk..end)
+            let results: Vec<(Vec<(u32, DVec3, u32)>, PhotonCounts)> = (chunk..end)
                 .into_par_iter()
                 .map(|c| {
-                    let mut deposits = Vec::new();
+                    let mut deposits: Vec<(u32, DVec3, u32)> = Vec::new();
                     let mut counts = PhotonCounts::default();
                     let lo = c * CHUNK;
                     let hi = ((c + 1) * CHUNK).min(photons);
@@ -375,21 +401,24 @@ impl Ppm {
                                 if (DVec3::new(x, y, z) - p).length_squared() <= r2 {
                                     let vp = &points[k as usize];
                                     if vp.normal.dot(n) > 1e-3 {
-                                        deposits.push((vp.slot, vp.weight * flux));
+                                        deposits.push((vp.slot, vp.weight * flux, 1));
                                     }
                                 }
                             });
                         });
+                        if deposits.len() > MAX_CHUNK_DEPOSITS {
+                            compact(&mut deposits);
+                        }
                     }
                     (deposits, counts)
                 })
                 .collect();
             // Fold in chunk order: the same sums whatever the thread count.
             for (deposits, c) in results {
-                counts.deposits += deposits.len() as u64;
-                for (slot, flux) in deposits {
+                for (slot, flux, count) in deposits {
                     phi[slot as usize] += flux;
-                    m[slot as usize] += 1;
+                    m[slot as usize] += count;
+                    counts.deposits += count as u64;
                 }
                 counts.paths += c.paths;
                 counts.bounces += c.bounces;
