@@ -264,6 +264,34 @@ fn main() -> Result<()> {
     }
 }
 
+/// A progress bar over `len` steps (drawn only on a terminal).
+fn progress_bar(len: u64, template: &str, message: String) -> Result<indicatif::ProgressBar> {
+    let bar = indicatif::ProgressBar::new(len).with_style(
+        indicatif::ProgressStyle::with_template(template)
+            .context("progress bar template")?
+            .progress_chars("=> "),
+    );
+    bar.set_message(message);
+    Ok(bar)
+}
+
+/// Metadata every output image carries; renderer-specific pairs are appended.
+fn base_metadata(scene: &Scene, renderer: &str) -> Metadata {
+    vec![
+        (
+            "Software".into(),
+            format!("caustic {}", env!("CARGO_PKG_VERSION")),
+        ),
+        ("caustic:scene".into(), scene.source.display().to_string()),
+        ("caustic:renderer".into(), renderer.into()),
+        ("caustic:seed".into(), scene.settings.seed.to_string()),
+        (
+            "caustic:size".into(),
+            format!("{}x{}", scene.camera.width, scene.camera.height),
+        ),
+    ]
+}
+
 fn load_scene(path: Option<&Path>) -> Result<Scene> {
     match path {
         Some(p) => Ok(Scene::load(p)?),
@@ -321,29 +349,19 @@ fn render(
         return render_ppm(scene, out, exposure, force, ppm);
     }
     let (w, h) = (scene.camera.width, scene.camera.height);
-    let bar = indicatif::ProgressBar::new(h as u64).with_style(
-        indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} rows, {elapsed} (eta {eta})")
-            .context("progress bar template")?
-            .progress_chars("=> "),
-    );
-    bar.set_message(format!("ray tracing {w}x{h}"));
+    let bar = progress_bar(
+        h as u64,
+        "{msg} [{bar:40}] {pos}/{len} rows, {elapsed} (eta {eta})",
+        format!("ray tracing {w}x{h}"),
+    )?;
     let (image, stats) = render_whitted(&scene, &|rows| bar.inc(rows as u64));
     bar.finish_and_clear();
-    let metadata: Metadata = vec![
-        (
-            "Software".into(),
-            format!("caustic {}", env!("CARGO_PKG_VERSION")),
-        ),
-        ("caustic:scene".into(), scene.source.display().to_string()),
-        ("caustic:renderer".into(), "whitted".into()),
-        ("caustic:seed".into(), scene.settings.seed.to_string()),
-        ("caustic:size".into(), format!("{w}x{h}")),
-        ("caustic:camera_rays".into(), stats.camera_rays.to_string()),
-        (
-            "caustic:elapsed_secs".into(),
-            format!("{:.3}", stats.elapsed_secs),
-        ),
-    ];
+    let mut metadata = base_metadata(&scene, "whitted");
+    metadata.push(("caustic:camera_rays".into(), stats.camera_rays.to_string()));
+    metadata.push((
+        "caustic:elapsed_secs".into(),
+        format!("{:.3}", stats.elapsed_secs),
+    ));
     image.save(out, exposure, &metadata, force)?;
     println!(
         "{}: {w}x{h} ray traced in {:.2} s ({} camera rays, {} edge pixels re-sampled, {:.0} rays/s)",
@@ -393,12 +411,11 @@ fn render_ppm(mut scene: Scene, out: &Path, exposure: f32, force: bool, args: &P
     };
     let (w, h) = (scene.camera.width, scene.camera.height);
     let mut ppm = Ppm::new(&scene, options);
-    let bar = indicatif::ProgressBar::new(args.passes as u64).with_style(
-        indicatif::ProgressStyle::with_template("{msg} [{bar:40}] pass {pos}/{len}, {elapsed} (eta {eta})")
-            .context("progress bar template")?
-            .progress_chars("=> "),
-    );
-    bar.set_message(format!("photon mapping {w}x{h}"));
+    let bar = progress_bar(
+        args.passes as u64,
+        "{msg} [{bar:40}] pass {pos}/{len}, {elapsed} (eta {eta})",
+        format!("photon mapping {w}x{h}"),
+    )?;
     let start = std::time::Instant::now();
     for _ in 0..args.passes {
         if args
@@ -422,21 +439,14 @@ fn render_ppm(mut scene: Scene, out: &Path, exposure: f32, force: bool, args: &P
         height: h,
         pixels: ppm.radiance(),
     };
-    let metadata: Metadata = vec![
-        (
-            "Software".into(),
-            format!("caustic {}", env!("CARGO_PKG_VERSION")),
-        ),
-        ("caustic:scene".into(), scene.source.display().to_string()),
-        ("caustic:renderer".into(), "ppm".into()),
-        ("caustic:seed".into(), scene.settings.seed.to_string()),
-        ("caustic:size".into(), format!("{w}x{h}")),
+    let mut metadata = base_metadata(&scene, "ppm");
+    metadata.extend([
         ("caustic:passes".into(), s.passes.to_string()),
         ("caustic:photons".into(), s.photons.to_string()),
         ("caustic:alpha".into(), ppm.alpha.to_string()),
         ("caustic:mean_radius".into(), format!("{:.6}", s.mean_radius)),
         ("caustic:elapsed_secs".into(), format!("{:.3}", s.elapsed_secs)),
-    ];
+    ]);
     image.save(out, exposure, &metadata, force)?;
     println!(
         "{}: {w}x{h}, {} passes, {} photons in {:.2} s ({:.0} photons/s while tracing photons), mean radius {:.4}, {} visible points",

@@ -64,13 +64,9 @@ impl Tracer<'_> {
         if scene.objects[hit.object as usize].emission.is_some() || depth >= scene.settings.max_depth {
             return emitted;
         }
-        let material = scene.material(&hit);
-        let color = scene.albedo(material, &hit);
-        // Normals facing the side the ray came from.
-        let front = ray.dir.dot(hit.normal) < 0.0;
-        let facing = |n: DVec3| if front { n } else { -n };
-        let n = facing(hit.shading_normal);
-        match material.kind {
+        let surface = scene.surface(&hit, ray.dir);
+        let (color, front, n) = (surface.color, surface.front, surface.normal);
+        match surface.material.kind {
             MaterialKind::Diffuse { specular, shininess } => {
                 let wo = -ray.dir;
                 let mut radiance = emitted + scene.settings.ambient * color;

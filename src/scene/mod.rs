@@ -145,6 +145,23 @@ impl Scene {
         }
     }
 
+    /// The surface a ray of direction `dir` met at `hit`, as shading sees it: material, colour
+    /// (texture applied), which side was hit, and the shading normal turned towards that side.
+    pub fn surface(&self, hit: &Hit, dir: DVec3) -> Surface<'_> {
+        let material = self.material(hit);
+        let front = dir.dot(hit.normal) < 0.0;
+        Surface {
+            material,
+            color: self.albedo(material, hit),
+            front,
+            normal: if front {
+                hit.shading_normal
+            } else {
+                -hit.shading_normal
+            },
+        }
+    }
+
     /// Emitted radiance seen by a ray of direction `dir` at `hit` (area lights only).
     pub fn emission(&self, hit: &Hit, dir: DVec3) -> DVec3 {
         match self.objects[hit.object as usize].emission {
@@ -172,6 +189,19 @@ impl Scene {
     pub fn pixel_center(x: u32, y: u32) -> DVec2 {
         DVec2::new(x as f64 + 0.5, y as f64 + 0.5)
     }
+}
+
+/// A hit surface as shading sees it ([`Scene::surface`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Surface<'s> {
+    /// Its material.
+    pub material: &'s Material,
+    /// Reflectance or tint at the hit, texture applied.
+    pub color: DVec3,
+    /// Whether the ray hit the side the geometric normal points to.
+    pub front: bool,
+    /// Unit shading normal on the side the ray came from.
+    pub normal: DVec3,
 }
 
 /// What a scene contains.

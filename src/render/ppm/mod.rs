@@ -53,11 +53,14 @@ const CHUNKS_PER_BATCH: u64 = 16;
 /// large (every photon then reaches thousands of points).
 const MAX_CHUNK_DEPOSITS: usize = 1 << 20;
 
+/// Flux handed to a statistics slot: `(slot, flux × point weight, photon count)`.
+type Deposit = (u32, DVec3, u32);
+
 /// Merges deposits to the same slot, keeping each slot's additions in photon order (a stable
 /// sort), so the sums depend only on the chunk's photons, not on threads.
-fn compact(deposits: &mut Vec<(u32, DVec3, u32)>) {
+fn compact(deposits: &mut Vec<Deposit>) {
     deposits.sort_by_key(|d| d.0);
-    let mut merged: Vec<(u32, DVec3, u32)> = Vec::with_capacity(deposits.len() / 4);
+    let mut merged: Vec<Deposit> = Vec::with_capacity(deposits.len() / 4);
     for &(slot, flux, count) in deposits.iter() {
         match merged.last_mut() {
             Some(last) if last.0 == slot => {
@@ -383,10 +386,10 @@ impl Ppm {
                 return PassOutcome::Aborted;
             }
             let end = (chunk + CHUNKS_PER_BATCH).min(chunks);
-            let results: Vec<(Vec<(u32, DVec3, u32)>, PhotonCounts)> = (chunk..end)
+            let results: Vec<(Vec<Deposit>, PhotonCounts)> = (chunk..end)
                 .into_par_iter()
                 .map(|c| {
-                    let mut deposits: Vec<(u32, DVec3, u32)> = Vec::new();
+                    let mut deposits: Vec<Deposit> = Vec::new();
                     let mut counts = PhotonCounts::default();
                     let lo = c * CHUNK;
                     let hi = ((c + 1) * CHUNK).min(photons);

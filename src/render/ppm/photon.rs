@@ -112,15 +112,9 @@ impl<'a> PhotonSource<'a> {
             if scene.objects[hit.object as usize].emission.is_some() {
                 return;
             }
-            let material = scene.material(&hit);
-            let color = scene.albedo(material, &hit);
-            let front = ray.dir.dot(hit.normal) < 0.0;
-            let n = if front {
-                hit.shading_normal
-            } else {
-                -hit.shading_normal
-            };
-            match material.kind {
+            let surface = scene.surface(&hit, ray.dir);
+            let (color, front, n) = (surface.color, surface.front, surface.normal);
+            match surface.material.kind {
                 MaterialKind::Diffuse { .. } => {
                     if !(skip_first && first_interaction) {
                         gather(hit.point, n, flux);

@@ -63,150 +63,87 @@ pub fn trace_eye(
         points: Vec::new(),
         direct: DVec3::ZERO,
     };
-    let ray = scene.camera.ray(pixel, lens);
-    walk(
+    let walk = EyeWalk {
         scene,
-        &ray,
-        DVec3::ONE,
-        0,
         slot,
         branching,
         direct_light,
-        rng,
-        &mut out,
-    );
+    };
+    walk.walk(&scene.camera.ray(pixel, lens), DVec3::ONE, 0, rng, &mut out);
     out
 }
 
-#[allow(clippy::too_many_arguments)]
-fn walk(
-    scene: &Scene,
-    ray: &Ray,
-    throughput: DVec3,
-    depth: u32,
+/// What stays fixed along one pixel's eye path.
+struct EyeWalk<'s> {
+    scene: &'s Scene,
     slot: u32,
     branching: Branching,
     direct_light: bool,
-    rng: &mut Pcg64Mcg,
-    out: &mut EyeResult,
-) {
-    if throughput.max_element() <= 0.0 {
-        return;
-    }
-    let Some(hit) = scene.geometry.intersect(ray, f64::INFINITY) else {
-        out.direct += throughput * scene.background;
-        return;
-    };
-    out.direct += throughput * scene.emission(&hit, ray.dir);
-    if scene.objects[hit.object as usize].emission.is_some() || depth >= scene.settings.max_depth {
-        return;
-    }
-    let material = scene.material(&hit);
-    let color = scene.albedo(material, &hit);
-    let front = ray.dir.dot(hit.normal) < 0.0;
-    let n = if front {
-        hit.shading_normal
-    } else {
-        -hit.shading_normal
-    };
-    match material.kind {
-        MaterialKind::Diffuse { .. } => {
-            // The Phong lobe is a ray-tracer preview nicety; photon mapping uses the diffuse part.
-            let weight = throughput * color / PI;
-            if direct_light {
-                for light in scene.lights.iter().filter(|l| !l.is_area()) {
-                    let Some(ls) = light.sample(hit.point, DVec2::ZERO) else {
-                        continue;
-                    };
-                    let cos = n.dot(ls.wi);
-                    if cos > 0.0
-                        && !scene
-                            .geometry
-                            .occluded(&hit.spawn(ls.wi), ls.distance * (1.0 - 1e-7))
-                    {
-                        out.direct += weight * ls.incident * cos;
+}
+
+impl EyeWalk<'_> {
+    /// Follows `ray` carrying `throughput` to the diffuse surfaces it reaches.
+    fn walk(&self, ray: &Ray, throughput: DVec3, depth: u32, rng: &mut Pcg64Mcg, out: &mut EyeResult) {
+        let scene = self.scene;
+        if throughput.max_element() <= 0.0 {
+            return;
+        }
+        let Some(hit) = scene.geometry.intersect(ray, f64::INFINITY) else {
+            out.direct += throughput * scene.background;
+            return;
+        };
+        out.direct += throughput * scene.emission(&hit, ray.dir);
+        if scene.objects[hit.object as usize].emission.is_some() || depth >= scene.settings.max_depth {
+            return;
+        }
+        let surface = scene.surface(&hit, ray.dir);
+        let (color, n) = (surface.color, surface.normal);
+        match surface.material.kind {
+            MaterialKind::Diffuse { .. } => {
+                // The Phong lobe is a ray-tracer preview nicety; photon mapping uses the
+                // diffuse part.
+                let weight = throughput * color / PI;
+                if self.direct_light {
+                    for light in scene.lights.iter().filter(|l| direct_by_shadow_rays(l)) {
+                        let Some(ls) = light.sample(hit.point, DVec2::ZERO) else {
+                            continue;
+                        };
+                        let cos = n.dot(ls.wi);
+                        let shadow = hit.spawn(ls.wi);
+                        if cos > 0.0 && !scene.geometry.occluded(&shadow, ls.distance * (1.0 - 1e-7)) {
+                            out.direct += weight * ls.incident * cos;
+                        }
                     }
                 }
+                out.points.push(VisiblePoint {
+                    slot: self.slot,
+                    position: hit.point,
+                    normal: n,
+                    weight,
+                    radius2: 0.0,
+                });
             }
-            out.points.push(VisiblePoint {
-                slot,
-                position: hit.point,
-                normal: n,
-                weight,
-                radius2: 0.0,
-            });
-        }
-        MaterialKind::Mirror => {
-            let r = hit.spawn(reflect(ray.dir, n));
-            walk(
-                scene,
-                &r,
-                throughput * color,
-                depth + 1,
-                slot,
-                branching,
-                direct_light,
-                rng,
-                out,
-            );
-        }
-        MaterialKind::Glass { ior } => {
-            let eta = if front { 1.0 / ior } else { ior };
-            let fresnel = fresnel_dielectric(-ray.dir.dot(n), eta);
-            let reflected = hit.spawn(reflect(ray.dir, n));
-            let refracted = refract(ray.dir, n, eta).map(|t| hit.spawn(t));
-            match (branching, refracted) {
-                (_, None) => walk(
-                    scene,
-                    &reflected,
-                    throughput,
-                    depth + 1,
-                    slot,
-                    branching,
-                    direct_light,
-                    rng,
-                    out,
-                ),
-                (Branching::Split, Some(t)) => {
-                    walk(
-                        scene,
-                        &reflected,
-                        throughput * fresnel,
-                        depth + 1,
-                        slot,
-                        branching,
-                        direct_light,
-                        rng,
-                        out,
-                    );
-                    let tt = throughput * (1.0 - fresnel) * color;
-                    walk(scene, &t, tt, depth + 1, slot, branching, direct_light, rng, out);
-                }
-                (Branching::Choose, Some(t)) => {
-                    if rng.random::<f64>() < fresnel {
-                        walk(
-                            scene,
-                            &reflected,
-                            throughput,
-                            depth + 1,
-                            slot,
-                            branching,
-                            direct_light,
-                            rng,
-                            out,
-                        );
-                    } else {
-                        walk(
-                            scene,
-                            &t,
-                            throughput * color,
-                            depth + 1,
-                            slot,
-                            branching,
-                            direct_light,
-                            rng,
-                            out,
-                        );
+            MaterialKind::Mirror => {
+                let r = hit.spawn(reflect(ray.dir, n));
+                self.walk(&r, throughput * color, depth + 1, rng, out);
+            }
+            MaterialKind::Glass { ior } => {
+                let eta = if surface.front { 1.0 / ior } else { ior };
+                let fresnel = fresnel_dielectric(-ray.dir.dot(n), eta);
+                let reflected = hit.spawn(reflect(ray.dir, n));
+                let refracted = refract(ray.dir, n, eta).map(|t| hit.spawn(t));
+                match (self.branching, refracted) {
+                    (_, None) => self.walk(&reflected, throughput, depth + 1, rng, out),
+                    (Branching::Split, Some(t)) => {
+                        self.walk(&reflected, throughput * fresnel, depth + 1, rng, out);
+                        self.walk(&t, throughput * (1.0 - fresnel) * color, depth + 1, rng, out);
+                    }
+                    (Branching::Choose, Some(t)) => {
+                        if rng.random::<f64>() < fresnel {
+                            self.walk(&reflected, throughput, depth + 1, rng, out);
+                        } else {
+                            self.walk(&t, throughput * color, depth + 1, rng, out);
+                        }
                     }
                 }
             }
