@@ -181,29 +181,17 @@ pub(super) fn load_str(text: &str, path: &Path, base_dir: Option<&Path>) -> Resu
     }
 
     let mut lights = Vec::new();
+    let mut emitter_material: Option<usize> = None;
     for (k, desc) in file.lights.iter().enumerate() {
         let light = light(&ctx, k, desc)?;
-        // Area lights are visible: their surface joins the geometry as a black emitter.
-        let mut emitter_material = || {
-            materials.push(Material {
-                name: format!("lights[{k}]"),
-                kind: MaterialKind::Diffuse {
-                    specular: 0.0,
-                    shininess: 0.0,
-                },
-                color: DVec3::ZERO,
-                texture: None,
-            });
-            materials.len() - 1
-        };
-        match &light {
+        // Area lights are visible: their surface joins the geometry as an emitter.
+        let id = objects.len() as u32;
+        let emission = match &light {
             Light::Sphere {
                 center,
                 radius,
                 radiance,
             } => {
-                let material = emitter_material();
-                let id = objects.len() as u32;
                 builder.add_sphere(
                     Sphere {
                         center: *center,
@@ -211,11 +199,7 @@ pub(super) fn load_str(text: &str, path: &Path, base_dir: Option<&Path>) -> Resu
                     },
                     id,
                 );
-                objects.push(SceneObject {
-                    name: format!("light {k}"),
-                    material,
-                    emission: Some(*radiance),
-                });
+                Some(*radiance)
             }
             Light::Quad {
                 corner,
@@ -223,8 +207,6 @@ pub(super) fn load_str(text: &str, path: &Path, base_dir: Option<&Path>) -> Resu
                 edge_v,
                 radiance,
             } => {
-                let material = emitter_material();
-                let id = objects.len() as u32;
                 builder.add_quad(
                     Quad {
                         corner: *corner,
@@ -233,13 +215,29 @@ pub(super) fn load_str(text: &str, path: &Path, base_dir: Option<&Path>) -> Resu
                     },
                     id,
                 );
-                objects.push(SceneObject {
-                    name: format!("light {k}"),
-                    material,
-                    emission: Some(*radiance),
-                });
+                Some(*radiance)
             }
-            Light::Point { .. } | Light::Spot { .. } => {}
+            Light::Point { .. } | Light::Spot { .. } => None,
+        };
+        if let Some(radiance) = emission {
+            // Emitters reflect nothing: one shared black material serves them all.
+            let material = *emitter_material.get_or_insert_with(|| {
+                materials.push(Material {
+                    name: "area light".to_owned(),
+                    kind: MaterialKind::Diffuse {
+                        specular: 0.0,
+                        shininess: 0.0,
+                    },
+                    color: DVec3::ZERO,
+                    texture: None,
+                });
+                materials.len() - 1
+            });
+            objects.push(SceneObject {
+                name: format!("lights[{k}]"),
+                material,
+                emission: Some(radiance),
+            });
         }
         lights.push(light);
     }
