@@ -246,6 +246,13 @@ impl SceneGeometry {
         self.bvh.bounds()
     }
 
+    /// The sphere around [`SceneGeometry::bounds`] (centre, radius), or `None` when the scene
+    /// holds nothing bounded.
+    pub fn bounding_sphere(&self) -> Option<(DVec3, f64)> {
+        let b = self.bounds();
+        (!b.is_empty()).then(|| (b.centroid(), 0.5 * b.diagonal().length()))
+    }
+
     /// The patches, with their object ids.
     pub fn patches(&self) -> &[(BezierPatch, u32)] {
         &self.patches

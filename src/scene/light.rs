@@ -214,6 +214,13 @@ pub fn uniform_cone(axis: DVec3, cos_max: f64, u: DVec2) -> DVec3 {
 }
 
 impl Light {
+    /// Whether [`Light::emit`] aims this light's photons at the bounding sphere `target`
+    /// (a point light clearly outside it) instead of emitting them in every direction.
+    pub fn aims_at(&self, (center, radius): (DVec3, f64)) -> bool {
+        matches!(self, Light::Point { position, .. }
+            if (center - *position).length_squared() > radius * radius * 1.0001)
+    }
+
     /// Samples a photon leaving the light from four uniform numbers. `target`, the bounding
     /// sphere `(centre, radius)` of the scene, lets a point light outside it aim its photons at
     /// the scene instead of wasting them (the weight then carries the cone's share of 4π).
@@ -222,19 +229,17 @@ impl Light {
         let (u1, u2) = (DVec2::new(u[0], u[1]), DVec2::new(u[2], u[3]));
         match self {
             Light::Point { position, .. } => {
-                if let Some((center, radius)) = target {
+                if let Some((center, radius)) = target.filter(|t| self.aims_at(*t)) {
                     let to = center - *position;
                     let d2 = to.length_squared();
-                    if d2 > radius * radius * 1.0001 {
-                        let cos_max = (1.0 - radius * radius / d2).sqrt();
-                        let dir = uniform_cone(to / d2.sqrt(), cos_max, u1);
-                        let weight = 2.0 * PI * (1.0 - cos_max) / (4.0 * PI);
-                        return Emission {
-                            origin: *position,
-                            dir,
-                            weight,
-                        };
-                    }
+                    let cos_max = (1.0 - radius * radius / d2).sqrt();
+                    let dir = uniform_cone(to / d2.sqrt(), cos_max, u1);
+                    let weight = 2.0 * PI * (1.0 - cos_max) / (4.0 * PI);
+                    return Emission {
+                        origin: *position,
+                        dir,
+                        weight,
+                    };
                 }
                 Emission {
                     origin: *position,

@@ -212,11 +212,8 @@ impl Ppm {
             skipped
                 .push("first photon bounce from point/spot lights: direct light by shadow rays".to_owned());
         }
-        let source = PhotonSource::new(scene, false);
-        if let Some((c, r)) = source.target {
-            if scene.lights.iter().any(
-                |l| matches!(l, crate::scene::Light::Point { position, .. } if (*position - c).length() > r),
-            ) {
+        if let Some(target) = scene.geometry.bounding_sphere() {
+            if scene.lights.iter().any(|l| l.aims_at(target)) {
                 skipped.push("photons from point lights outside the scene aimed at its bounds".to_owned());
             }
         }

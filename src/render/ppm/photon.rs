@@ -67,13 +67,11 @@ impl<'a> PhotonSource<'a> {
             .zip(&powers)
             .map(|(l, p)| l.power() / (p / total))
             .collect();
-        let b = scene.geometry.bounds();
-        let target = (!b.is_empty()).then(|| (b.centroid(), 0.5 * b.diagonal().length()));
         Self {
             scene,
             cdf,
             flux,
-            target,
+            target: scene.geometry.bounding_sphere(),
             skip_first_from_point_lights: direct_light,
         }
     }
