@@ -16,6 +16,8 @@
 
 #![forbid(unsafe_code)]
 
+#[cfg(feature = "viewer")]
+pub mod app;
 pub mod assets;
 pub mod bench;
 pub mod geometry;

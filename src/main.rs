@@ -9,7 +9,7 @@ use caustic::bench::{teapot_geometry, teapot_view, time_intersect};
 use caustic::geometry::tessellate::{tessellate, write_obj};
 use caustic::geometry::{PatchMethod, SubdivisionParams};
 use caustic::render::ppm::{Control, IndexKind, Ppm, PpmOptions};
-use caustic::render::{render_whitted, Metadata};
+use caustic::render::{image_metadata, render_whitted};
 use caustic::scene::{RendererKind, Scene};
 
 #[derive(Parser)]
@@ -19,12 +19,32 @@ use caustic::scene::{RendererKind, Scene};
     about = "Progressive photon mapping of exact Bézier patches"
 )]
 struct Cli {
+    /// What to do; without one, the viewer opens on the built-in scene.
     #[command(subcommand)]
-    command: Command,
+    command: Option<Command>,
 }
 
 #[derive(Subcommand)]
 enum Command {
+    /// Open the viewer window on a scene (the built-in teapot scene when omitted).
+    View {
+        /// Scene file (TOML).
+        scene: Option<PathBuf>,
+        /// Save a screenshot of the window (PNG) once the render has reached
+        /// --after-passes passes, then close.
+        #[arg(long, value_name = "FILE.png")]
+        screenshot: Option<PathBuf>,
+        /// Passes to wait for before --screenshot.
+        #[arg(long, default_value_t = 4, value_name = "N")]
+        after_passes: u32,
+        /// Replace an existing --screenshot file.
+        #[arg(long)]
+        force: bool,
+        /// Measure launch-to-first-image, UI frame rate while rendering and the latency from
+        /// an aperture change to the new image; print them and close.
+        #[arg(long)]
+        bench: bool,
+    },
     /// Render a scene to an image (PNG: tonemapped sRGB; EXR: linear float).
     Render {
         /// Scene file (TOML); the built-in teapot scene when omitted.
@@ -196,7 +216,25 @@ enum MethodChoice {
 }
 
 fn main() -> Result<()> {
-    match Cli::parse().command {
+    let launched = std::time::Instant::now();
+    let command = Cli::parse().command.unwrap_or(Command::View {
+        scene: None,
+        screenshot: None,
+        after_passes: 4,
+        force: false,
+        bench: false,
+    });
+    match command {
+        Command::View {
+            scene,
+            screenshot,
+            after_passes,
+            force,
+            bench,
+        } => view(
+            scene,
+            caustic_launch(screenshot, after_passes, force, bench, launched),
+        ),
         Command::Render {
             scene,
             out,
@@ -275,21 +313,44 @@ fn progress_bar(len: u64, template: &str, message: String) -> Result<indicatif::
     Ok(bar)
 }
 
-/// Metadata every output image carries; renderer-specific pairs are appended.
-fn base_metadata(scene: &Scene, renderer: &str) -> Metadata {
-    vec![
-        (
-            "Software".into(),
-            format!("caustic {}", env!("CARGO_PKG_VERSION")),
-        ),
-        ("caustic:scene".into(), scene.source.display().to_string()),
-        ("caustic:renderer".into(), renderer.into()),
-        ("caustic:seed".into(), scene.settings.seed.to_string()),
-        (
-            "caustic:size".into(),
-            format!("{}x{}", scene.camera.width, scene.camera.height),
-        ),
-    ]
+/// Options of a viewer launch (only with the `viewer` feature).
+#[cfg(feature = "viewer")]
+fn caustic_launch(
+    screenshot: Option<PathBuf>,
+    after_passes: u32,
+    force: bool,
+    bench: bool,
+    launched: std::time::Instant,
+) -> caustic::app::LaunchOptions {
+    if let Some(p) = &screenshot {
+        if p.extension().is_none_or(|e| !e.eq_ignore_ascii_case("png")) {
+            eprintln!(
+                "caustic view: --screenshot {}: the screenshot is written as PNG; name it .png",
+                p.display()
+            );
+            std::process::exit(2);
+        }
+    }
+    caustic::app::LaunchOptions {
+        screenshot,
+        screenshot_after_passes: after_passes.max(1),
+        force,
+        bench,
+        launched,
+    }
+}
+
+#[cfg(feature = "viewer")]
+fn view(scene: Option<PathBuf>, launch: caustic::app::LaunchOptions) -> Result<()> {
+    caustic::app::run(scene, launch)
+}
+
+#[cfg(not(feature = "viewer"))]
+fn caustic_launch(_: Option<PathBuf>, _: u32, _: bool, _: bool, _: std::time::Instant) {}
+
+#[cfg(not(feature = "viewer"))]
+fn view(_: Option<PathBuf>, _: ()) -> Result<()> {
+    bail!("this caustic was built without the viewer (the `viewer` feature); use `caustic render`")
 }
 
 fn load_scene(path: Option<&Path>) -> Result<Scene> {
@@ -356,7 +417,7 @@ fn render(
     )?;
     let (image, stats) = render_whitted(&scene, &|rows| bar.inc(rows as u64));
     bar.finish_and_clear();
-    let mut metadata = base_metadata(&scene, "whitted");
+    let mut metadata = image_metadata(&scene, "whitted");
     metadata.push(("caustic:camera_rays".into(), stats.camera_rays.to_string()));
     metadata.push((
         "caustic:elapsed_secs".into(),
@@ -407,7 +468,7 @@ fn render_ppm(mut scene: Scene, out: &Path, exposure: f32, force: bool, args: &P
             IndexChoice::Kd => IndexKind::KdTree,
         },
         direct_light: args.direct_light,
-        force_stochastic: false,
+        ..Default::default()
     };
     let (w, h) = (scene.camera.width, scene.camera.height);
     let mut ppm = Ppm::new(&scene, options);
@@ -439,7 +500,7 @@ fn render_ppm(mut scene: Scene, out: &Path, exposure: f32, force: bool, args: &P
         height: h,
         pixels: ppm.radiance(),
     };
-    let mut metadata = base_metadata(&scene, "ppm");
+    let mut metadata = image_metadata(&scene, "ppm");
     metadata.extend([
         ("caustic:passes".into(), s.passes.to_string()),
         ("caustic:photons".into(), s.photons.to_string()),
@@ -606,7 +667,7 @@ fn bench_convergence(
         let options = PpmOptions {
             index,
             direct_light,
-            force_stochastic: false,
+            ..Default::default()
         };
         let mut ppm = Ppm::new(&scene, options);
         let mut curve = Vec::new();

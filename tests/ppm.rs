@@ -91,6 +91,28 @@ fn ppm_converges_to_the_point_lit_plane() {
     assert!(rms < 0.06, "per-pixel RMS relative error {rms}");
 }
 
+/// A bounded object far from the lit plane must not make the point light aim its photons at
+/// that object alone: no sphere holds an infinite plane. (This once left the plane black
+/// outside the object's cone.)
+#[test]
+fn photons_are_not_aimed_away_from_an_infinite_plane() {
+    let with_ball = format!(
+        "{PLANE}\n[[objects]]\ntype = \"sphere\"\ncenter = [0, 8, 40]\nradius = 0.5\nmaterial = \"floor\"\n"
+    );
+    let scene = Scene::from_str(&with_ball, Path::new("plane_ball.toml"), None).expect("scene");
+    assert_eq!(scene.geometry.bounding_sphere(), None);
+    let expected = expected_plane(&scene);
+    let mut ppm = Ppm::new(&scene, PpmOptions::default());
+    for _ in 0..8 {
+        ppm.run_pass(&scene, &mut |_| Control::Continue);
+    }
+    let (mean_ratio, _) = relative_errors(&ppm.radiance(), &expected);
+    assert!(
+        (mean_ratio - 1.0).abs() < 0.03,
+        "mean PPM / closed form = {mean_ratio}"
+    );
+}
+
 #[test]
 fn direct_light_option_is_exact_for_direct_illumination() {
     let scene = Scene::from_str(PLANE, Path::new("plane.toml"), None).expect("scene");
@@ -181,6 +203,8 @@ fn cornell_small(aperture: f64) -> Scene {
     scene.camera.aperture = aperture;
     scene.settings.photons_per_pass = 20_000;
     scene.settings.antialias = false;
+    // The file asks for the ray tracer; the session follows the scene's renderer.
+    scene.settings.renderer = caustic::scene::RendererKind::Ppm;
     scene
 }
 
@@ -282,6 +306,38 @@ fn session_epochs_follow_the_rules_and_never_block() {
         }
     };
     assert_eq!(f.epoch, 2);
+    session.shutdown();
+}
+
+#[test]
+fn session_switches_to_the_ray_tracer_and_reports_a_panic() {
+    let scene = cornell_small(0.0);
+    let mut whitted_scene = scene.clone();
+    whitted_scene.settings.renderer = caustic::scene::RendererKind::Whitted;
+    let session = RenderSession::start(scene, PpmOptions::default(), None);
+    assert_eq!(
+        next_frame(&session, Duration::from_secs(60)).renderer,
+        caustic::scene::RendererKind::Ppm
+    );
+    session.send(Command::SetRenderer(caustic::scene::RendererKind::Whitted));
+    let f = loop {
+        let f = next_frame(&session, Duration::from_secs(60));
+        if f.renderer == caustic::scene::RendererKind::Whitted {
+            break f;
+        }
+    };
+    assert_eq!((f.epoch, f.pass, f.photons), (1, 1, 0));
+    let (expected, _) = caustic::render::render_whitted(&whitted_scene, &|_| {});
+    assert_eq!(&f.radiance[..], &expected.pixels[..]);
+    // One ray-traced frame per epoch; then the thread waits for commands.
+    assert!(session.frames().recv_timeout(Duration::from_millis(300)).is_err());
+    assert_eq!(session.failure(), None);
+    session.send(Command::Fail("boom".into()));
+    let start = Instant::now();
+    while session.failure().is_none() && start.elapsed() < Duration::from_secs(30) {
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    assert_eq!(session.failure().as_deref(), Some("boom"));
     session.shutdown();
 }
 

@@ -246,11 +246,12 @@ impl SceneGeometry {
         self.bvh.bounds()
     }
 
-    /// The sphere around [`SceneGeometry::bounds`] (centre, radius), or `None` when the scene
-    /// holds nothing bounded.
+    /// The sphere around all geometry (centre, radius), or `None` when there is none or when
+    /// the scene has an infinite plane, which no sphere holds (photons aimed at a sphere would
+    /// then miss the plane outside it).
     pub fn bounding_sphere(&self) -> Option<(DVec3, f64)> {
         let b = self.bounds();
-        (!b.is_empty()).then(|| (b.centroid(), 0.5 * b.diagonal().length()))
+        (!b.is_empty() && self.planes.is_empty()).then(|| (b.centroid(), 0.5 * b.diagonal().length()))
     }
 
     /// The patches, with their object ids.

@@ -8,4 +8,22 @@ pub mod session;
 pub mod whitted;
 
 pub use film::{Image, Metadata};
-pub use whitted::{render_whitted, WhittedStats};
+pub use whitted::{render_whitted, render_whitted_until, WhittedStats};
+
+/// Metadata every output image carries (software, scene, renderer, seed, size); callers
+/// append renderer-specific pairs.
+pub fn image_metadata(scene: &crate::scene::Scene, renderer: &str) -> Metadata {
+    vec![
+        (
+            "Software".into(),
+            format!("caustic {}", env!("CARGO_PKG_VERSION")),
+        ),
+        ("caustic:scene".into(), scene.source.display().to_string()),
+        ("caustic:renderer".into(), renderer.into()),
+        ("caustic:seed".into(), scene.settings.seed.to_string()),
+        (
+            "caustic:size".into(),
+            format!("{}x{}", scene.camera.width, scene.camera.height),
+        ),
+    ]
+}

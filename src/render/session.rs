@@ -1,15 +1,19 @@
-//! The render session (DESIGN.md §1): photon-mapping passes on a thread of their own, steered
-//! by [`Command`]s over an unbounded channel and reporting a [`Frame`] after each pass over a
-//! `bounded(1)` channel with `try_send` — the renderer never waits for whoever watches; a
-//! frame nobody took is simply replaced by a newer one.
+//! The render session (DESIGN.md §1): photon-mapping passes (or one ray-traced frame) on a
+//! thread of their own, steered by [`Command`]s over an unbounded channel and reporting a
+//! [`Frame`] after each pass over a `bounded(1)` channel with `try_send` — the renderer never
+//! waits for whoever watches; a frame nobody took is simply replaced by a newer one.
 //!
 //! Commands are looked at between photon batches, so a slider takes effect within one batch.
 //! α and photons per pass change the coming update/pass without discarding anything; the
-//! camera, aperture, focal distance, initial radius, depth and geometry restart accumulation
-//! under a new `epoch`; pause and resume lose nothing (a paused pass continues where it
-//! stopped, so the image is the one an uninterrupted run gives).
+//! camera, aperture, focal distance, initial radius, depth, renderer and geometry restart
+//! accumulation under a new `epoch`; pause and resume lose nothing (a paused pass continues
+//! where it stopped, so the image is the one an uninterrupted run gives).
+//!
+//! A panic on the render thread is caught and kept as [`RenderSession::failure`], so a viewer
+//! can show it and stay up.
 
-use std::sync::Arc;
+use std::panic::AssertUnwindSafe;
+use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::Instant;
 
@@ -17,7 +21,8 @@ use crossbeam_channel::{bounded, unbounded, Receiver, Sender, TryRecvError};
 use glam::DVec3;
 
 use super::ppm::{Control, PassOutcome, Ppm, PpmOptions, PpmStats};
-use crate::scene::{Camera, Scene};
+use super::whitted::render_whitted_until;
+use crate::scene::{Camera, RendererKind, Scene};
 
 /// What the UI (or a test) asks of the renderer.
 #[derive(Clone, Debug, PartialEq)]
@@ -36,6 +41,8 @@ pub enum Command {
     SetAperture(f64),
     /// Distance of the focal plane; restarts.
     SetFocalDistance(f64),
+    /// Photon mapping or the ray tracer; restarts.
+    SetRenderer(RendererKind),
     /// Moves control point `index` of patch `patch`; restarts.
     MoveControlPoint {
         /// Patch index in the scene geometry.
@@ -53,6 +60,9 @@ pub enum Command {
     Restart,
     /// End the session's thread.
     Shutdown,
+    /// Makes the render thread panic with this message. It exists to exercise the error path
+    /// of whoever watches the session (the viewer's tests and `caustic view --fail-render`).
+    Fail(String),
 }
 
 /// One finished pass, as the viewer needs it.
@@ -60,13 +70,15 @@ pub enum Command {
 pub struct Frame {
     /// Increases whenever accumulated statistics are discarded.
     pub epoch: u64,
-    /// Passes completed in this epoch.
+    /// Which renderer made it.
+    pub renderer: RendererKind,
+    /// Passes completed in this epoch (1 for a ray-traced frame).
     pub pass: u32,
     /// Photons emitted in this epoch.
     pub photons: u64,
     /// Seconds since this epoch started.
     pub elapsed_secs: f64,
-    /// Statistics of the render.
+    /// Statistics of the render (photon mapping; only `elapsed_secs` for the ray tracer).
     pub stats: PpmStats,
     /// Image width.
     pub width: u32,
@@ -76,12 +88,28 @@ pub struct Frame {
     pub radiance: Arc<[[f32; 3]]>,
     /// Search radius per pixel (largest of the pixel's slots), for the viewer's probe.
     pub radius: Arc<[f32]>,
+    /// Accumulated photon count `N` per pixel (summed over the pixel's slots).
+    pub gathered: Arc<[f32]>,
+}
+
+/// How a session renders, beyond the scene's own settings.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SessionOptions {
+    /// Photon-mapping options (index, direct light, batch size).
+    pub ppm: PpmOptions,
+    /// Photons in the first pass of every epoch, doubling pass by pass up to the photons per
+    /// pass (`None`: full passes from the start). A viewer uses it to show a new epoch's first
+    /// image sooner; PPM weighs every photon alike, so only the pass boundaries move.
+    pub first_pass_photons: Option<u64>,
+    /// Start paused: nothing is rendered until [`Command::Resume`].
+    pub start_paused: bool,
 }
 
 /// A render running on its own thread.
 pub struct RenderSession {
     commands: Sender<Command>,
     frames: Receiver<Frame>,
+    failure: Arc<Mutex<Option<String>>>,
     thread: Option<JoinHandle<()>>,
 }
 
@@ -90,19 +118,51 @@ pub type Waker = Box<dyn Fn() + Send>;
 
 impl RenderSession {
     /// Starts rendering `scene` on a new thread (named `caustic-render`), in the global rayon
-    /// pool.
+    /// pool, with full photon passes from the start.
     pub fn start(scene: Scene, options: PpmOptions, waker: Option<Waker>) -> Self {
+        Self::start_with(
+            scene,
+            SessionOptions {
+                ppm: options,
+                ..Default::default()
+            },
+            waker,
+        )
+    }
+
+    /// Starts rendering `scene` with session options (see [`SessionOptions`]).
+    pub fn start_with(scene: Scene, options: SessionOptions, waker: Option<Waker>) -> Self {
         let (commands, command_rx) = unbounded();
         let (frame_tx, frames) = bounded(1);
         // The render thread holds a receiver too, to replace a frame nobody has taken.
         let stale = frames.clone();
+        let failure = Arc::new(Mutex::new(None));
+        let failed = failure.clone();
         let thread = std::thread::Builder::new()
             .name("caustic-render".into())
-            .spawn(move || run(scene, options, command_rx, (frame_tx, stale), waker))
+            .spawn(move || {
+                let outcome = std::panic::catch_unwind(AssertUnwindSafe(|| {
+                    run(scene, options, command_rx, (frame_tx, stale), &waker)
+                }));
+                if let Err(payload) = outcome {
+                    let message = payload
+                        .downcast_ref::<&str>()
+                        .map(|s| s.to_string())
+                        .or_else(|| payload.downcast_ref::<String>().cloned())
+                        .unwrap_or_else(|| "unknown panic".to_owned());
+                    if let Ok(mut f) = failed.lock() {
+                        *f = Some(message);
+                    }
+                    if let Some(w) = &waker {
+                        w();
+                    }
+                }
+            })
             .expect("spawn the render thread");
         Self {
             commands,
             frames,
+            failure,
             thread: Some(thread),
         }
     }
@@ -115,6 +175,11 @@ impl RenderSession {
     /// The frames channel: at most one waiting frame, the newest.
     pub fn frames(&self) -> &Receiver<Frame> {
         &self.frames
+    }
+
+    /// The message of the panic that ended the render thread, if it did.
+    pub fn failure(&self) -> Option<String> {
+        self.failure.lock().ok().and_then(|f| f.clone())
     }
 
     /// Asks the thread to stop and waits for it.
@@ -141,10 +206,10 @@ fn restarts(command: &Command, patches: usize) -> Option<bool> {
     match command {
         Command::SetAlpha(a) => (*a > 0.0 && *a <= 1.0).then_some(false),
         Command::SetPhotonsPerPass(n) => (*n > 0).then_some(false),
-        Command::Pause | Command::Resume | Command::Shutdown => Some(false),
+        Command::Pause | Command::Resume | Command::Shutdown | Command::Fail(_) => Some(false),
         Command::SetInitialRadius(r) => r.is_none_or(|r| r.is_finite() && r > 0.0).then_some(true),
         Command::SetMaxDepth(d) => (1..=64).contains(d).then_some(true),
-        Command::SetCamera(_) | Command::Restart => Some(true),
+        Command::SetCamera(_) | Command::Restart | Command::SetRenderer(_) => Some(true),
         Command::SetAperture(a) => (a.is_finite() && *a >= 0.0).then_some(true),
         Command::SetFocalDistance(f) => (f.is_finite() && *f > 0.0).then_some(true),
         Command::MoveControlPoint {
@@ -163,6 +228,7 @@ fn apply_to_scene(scene: &mut Scene, command: Command) {
         Command::SetCamera(c) => scene.camera = c,
         Command::SetAperture(a) => scene.camera.aperture = a,
         Command::SetFocalDistance(f) => scene.camera.focal_distance = f,
+        Command::SetRenderer(r) => scene.settings.renderer = r,
         Command::MoveControlPoint {
             patch,
             index,
@@ -174,38 +240,53 @@ fn apply_to_scene(scene: &mut Scene, command: Command) {
     }
 }
 
-/// The per-pixel search radius (largest of the pixel's slots).
-fn radius_image(ppm: &Ppm) -> Arc<[f32]> {
+/// Per-pixel search radius (largest of the pixel's slots) and photon count (sum of them).
+fn pixel_statistics(ppm: &Ppm) -> (Arc<[f32]>, Arc<[f32]>) {
     let (w, h) = ppm.size();
-    let mut r = vec![0.0f32; w as usize * h as usize];
+    let mut radius = vec![0.0f32; w as usize * h as usize];
+    let mut gathered = vec![0.0f32; w as usize * h as usize];
     for s in ppm.slots() {
-        let px = &mut r[s.pixel as usize];
+        let px = &mut radius[s.pixel as usize];
         *px = px.max(s.radius2.sqrt() as f32);
+        gathered[s.pixel as usize] += s.n as f32;
     }
-    r.into()
+    (radius.into(), gathered.into())
+}
+
+/// Offers a frame without waiting: a frame the viewer has not taken yet is replaced.
+fn offer(frame: Frame, (frames, stale): &(Sender<Frame>, Receiver<Frame>), waker: &Option<Waker>) {
+    if let Err(crossbeam_channel::TrySendError::Full(frame)) = frames.try_send(frame) {
+        let _ = stale.try_recv();
+        let _ = frames.try_send(frame);
+    }
+    if let Some(w) = waker {
+        w();
+    }
 }
 
 fn run(
     scene: Scene,
-    options: PpmOptions,
+    options: SessionOptions,
     commands: Receiver<Command>,
-    (frames, stale): (Sender<Frame>, Receiver<Frame>),
-    waker: Option<Waker>,
+    channel: (Sender<Frame>, Receiver<Frame>),
+    waker: &Option<Waker>,
 ) {
     let mut scene = scene;
-    let mut ppm = Ppm::new(&scene, options);
+    let mut ppm = Ppm::new(&scene, options.ppm);
     let mut epoch = 0u64;
     let mut epoch_start = Instant::now();
-    let mut paused = false;
+    let mut paused = options.start_paused;
+    // The ray tracer makes one frame per epoch, then waits for commands.
+    let mut traced = false;
     let photons_per_pass = std::cell::Cell::new(scene.settings.photons_per_pass);
     loop {
         let patches = scene.geometry.patches().len();
         let mut pending: Vec<Command> = Vec::new();
         let mut shutdown = false;
-        // Between batches (and passes): apply commands; while paused, wait for them.
+        // Between batches (and passes): apply commands; while paused or done, wait for them.
         let mut control = |alpha: &mut f64| -> Control {
             loop {
-                let next = if paused && pending.is_empty() {
+                let next = if (paused || traced) && pending.is_empty() {
                     commands.recv().map_err(|_| TryRecvError::Disconnected)
                 } else {
                     commands.try_recv()
@@ -225,6 +306,7 @@ fn run(
                     (Some(false), Command::SetPhotonsPerPass(n)) => photons_per_pass.set(n),
                     (Some(false), Command::Pause) => paused = true,
                     (Some(false), Command::Resume) => paused = false,
+                    (Some(false), Command::Fail(message)) => panic!("{message}"),
                     (Some(false), _) => {
                         shutdown = true;
                         return Control::Abort;
@@ -238,13 +320,48 @@ fn run(
             }
         };
         let mut alpha = ppm.alpha;
-        let outcome = if control(&mut alpha) == Control::Continue {
-            ppm.alpha = alpha;
-            ppm.photons_per_pass = photons_per_pass.get();
-            Some(ppm.run_pass(&scene, &mut control))
-        } else {
-            ppm.alpha = alpha;
-            None
+        let go_on = control(&mut alpha) == Control::Continue;
+        ppm.alpha = alpha;
+        let outcome = match (go_on, scene.settings.renderer) {
+            (false, _) => None,
+            (true, RendererKind::Whitted) if traced => None,
+            (true, RendererKind::Ppm) => {
+                let target = photons_per_pass.get();
+                ppm.photons_per_pass = match options.first_pass_photons {
+                    Some(first) => target.min(first.saturating_mul(1 << ppm.stats().passes.min(40))),
+                    None => target,
+                };
+                Some(ppm.run_pass(&scene, &mut control))
+            }
+            (true, RendererKind::Whitted) => {
+                // Give up the frame as soon as a command waits: it may change the picture.
+                match render_whitted_until(&scene, &|_| {}, &|| !commands.is_empty()) {
+                    Some((image, stats)) => {
+                        traced = true;
+                        let pixels = image.pixels.len();
+                        let frame = Frame {
+                            epoch,
+                            renderer: RendererKind::Whitted,
+                            pass: 1,
+                            photons: 0,
+                            elapsed_secs: epoch_start.elapsed().as_secs_f64(),
+                            stats: PpmStats {
+                                passes: 1,
+                                elapsed_secs: stats.elapsed_secs,
+                                ..Default::default()
+                            },
+                            width: image.width,
+                            height: image.height,
+                            radiance: image.pixels.into(),
+                            radius: vec![0.0; pixels].into(),
+                            gathered: vec![0.0; pixels].into(),
+                        };
+                        offer(frame, &channel, waker);
+                    }
+                    None => continue,
+                }
+                None
+            }
         };
         if shutdown {
             return;
@@ -257,14 +374,17 @@ fn run(
             scene.settings.photons_per_pass = photons_per_pass.get();
             epoch += 1;
             epoch_start = Instant::now();
-            ppm = Ppm::new(&scene, options);
+            traced = false;
+            ppm = Ppm::new(&scene, options.ppm);
             continue;
         }
         if outcome == Some(PassOutcome::Completed) {
             let (width, height) = ppm.size();
             let stats = ppm.stats().clone();
+            let (radius, gathered) = pixel_statistics(&ppm);
             let frame = Frame {
                 epoch,
+                renderer: RendererKind::Ppm,
                 pass: stats.passes,
                 photons: stats.photons,
                 elapsed_secs: epoch_start.elapsed().as_secs_f64(),
@@ -272,16 +392,10 @@ fn run(
                 width,
                 height,
                 radiance: ppm.radiance().into(),
-                radius: radius_image(&ppm),
+                radius,
+                gathered,
             };
-            // Never wait for the viewer: a frame it has not taken yet is replaced.
-            if let Err(crossbeam_channel::TrySendError::Full(frame)) = frames.try_send(frame) {
-                let _ = stale.try_recv();
-                let _ = frames.try_send(frame);
-            }
-            if let Some(w) = &waker {
-                w();
-            }
+            offer(frame, &channel, waker);
         }
     }
 }

@@ -141,6 +141,17 @@ impl Tracer<'_> {
 /// Renders `scene` with the ray tracer. `progress(rows)` is called as rows finish (from any
 /// thread). Deterministic: the same scene and seed give the same image for any thread count.
 pub fn render_whitted(scene: &Scene, progress: &(dyn Fn(usize) + Sync)) -> (Image, WhittedStats) {
+    render_whitted_until(scene, progress, &|| false).expect("a render nobody cancels completes")
+}
+
+/// [`render_whitted`] that gives up (returning `None`) soon after `cancelled()` turns true:
+/// it is asked before every row and every pixel of the anti-aliasing pass. The viewer uses it
+/// so that a slider moved during a ray-traced frame restarts the frame at once.
+pub fn render_whitted_until(
+    scene: &Scene,
+    progress: &(dyn Fn(usize) + Sync),
+    cancelled: &(dyn Fn() -> bool + Sync),
+) -> Option<(Image, WhittedStats)> {
     let start = Instant::now();
     let camera = &scene.camera;
     let (w, h) = (camera.width, camera.height);
@@ -153,6 +164,9 @@ pub fn render_whitted(scene: &Scene, progress: &(dyn Fn(usize) + Sync)) -> (Imag
     let first: Vec<(DVec3, u64)> = (0..h)
         .into_par_iter()
         .flat_map_iter(|y| {
+            if cancelled() {
+                return vec![(DVec3::ZERO, 0); w as usize];
+            }
             let row: Vec<(DVec3, u64)> = (0..w)
                 .map(|x| {
                     let index = (y as u64) * w as u64 + x as u64;
@@ -186,6 +200,9 @@ pub fn render_whitted(scene: &Scene, progress: &(dyn Fn(usize) + Sync)) -> (Imag
             row
         })
         .collect();
+    if cancelled() {
+        return None;
+    }
 
     // Pass 2: re-sample pixels on an edge of object ids or shadow states with a 4×4 grid.
     let antialias = scene.settings.antialias && !dof;
@@ -201,7 +218,7 @@ pub fn render_whitted(scene: &Scene, progress: &(dyn Fn(usize) + Sync)) -> (Imag
                     let (nx, ny) = (x + dx, y + dy);
                     nx >= 0 && ny >= 0 && nx < w as i64 && ny < h as i64 && id(nx, ny) != own
                 });
-            let c = if on_edge {
+            let c = if on_edge && !cancelled() {
                 edge_pixels.fetch_add(1, Ordering::Relaxed);
                 let mut rng = stream_rng(seed, streams::WHITTED_EDGE, i as u64);
                 let mut sum = DVec3::ZERO;
@@ -223,18 +240,21 @@ pub fn render_whitted(scene: &Scene, progress: &(dyn Fn(usize) + Sync)) -> (Imag
             [c.x as f32, c.y as f32, c.z as f32]
         })
         .collect();
+    if cancelled() {
+        return None;
+    }
 
     let stats = WhittedStats {
         camera_rays: rays.load(Ordering::Relaxed) as u64,
         edge_pixels: edge_pixels.load(Ordering::Relaxed) as u64,
         elapsed_secs: start.elapsed().as_secs_f64(),
     };
-    (
+    Some((
         Image {
             width: w,
             height: h,
             pixels,
         },
         stats,
-    )
+    ))
 }

@@ -46,8 +46,9 @@ mod streams {
 
 /// Photons per chunk: the unit of parallel work and of deterministic reduction.
 const CHUNK: u64 = 4096;
-/// Chunks per batch: commands are looked at between batches.
-const CHUNKS_PER_BATCH: u64 = 16;
+/// Photons per batch unless [`PpmOptions::batch_photons`] says otherwise: the caller's
+/// control callback is asked between batches.
+pub const DEFAULT_BATCH_PHOTONS: u64 = 16 * CHUNK;
 
 /// Deposits one chunk may hold before they are merged per slot: bounds memory when radii are
 /// large (every photon then reaches thousands of points).
@@ -84,7 +85,7 @@ pub enum IndexKind {
 }
 
 /// Photon-mapping options beyond the scene's `[render]` settings.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PpmOptions {
     /// The spatial index.
     pub index: IndexKind,
@@ -93,6 +94,21 @@ pub struct PpmOptions {
     pub direct_light: bool,
     /// Force stochastic PPM (a new eye pass every pass) even for a pinhole camera.
     pub force_stochastic: bool,
+    /// Photons traced between two calls of the control callback (rounded up to whole
+    /// 4096-photon chunks). Smaller batches let a viewer react sooner; the image does not
+    /// depend on it.
+    pub batch_photons: u64,
+}
+
+impl Default for PpmOptions {
+    fn default() -> Self {
+        Self {
+            index: IndexKind::default(),
+            direct_light: false,
+            force_stochastic: false,
+            batch_photons: DEFAULT_BATCH_PHOTONS,
+        }
+    }
 }
 
 /// A built spatial index.
@@ -377,12 +393,13 @@ impl Ppm {
         let chunks = photons.div_ceil(CHUNK);
         let mut counts = PhotonCounts::default();
         let photon_start = Instant::now();
+        let chunks_per_batch = self.options.batch_photons.div_ceil(CHUNK).max(1);
         let mut chunk = 0;
         while chunk < chunks {
             if control(&mut self.alpha) == Control::Abort {
                 return PassOutcome::Aborted;
             }
-            let end = (chunk + CHUNKS_PER_BATCH).min(chunks);
+            let end = (chunk + chunks_per_batch).min(chunks);
             let results: Vec<(Vec<Deposit>, PhotonCounts)> = (chunk..end)
                 .into_par_iter()
                 .map(|c| {

@@ -1,0 +1,300 @@
+//! Scripted runs of the real window: `caustic view --screenshot FILE` saves a picture of the
+//! window (egui's own screenshot) once the render has reached some passes, and
+//! `caustic view --bench` measures launch-to-first-image, UI frame rate while rendering and
+//! slider-to-new-epoch-image latency, prints them and exits.
+
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use super::viewer::Viewer;
+
+/// What to do besides showing the window.
+#[derive(Clone, Debug)]
+pub struct LaunchOptions {
+    /// Save a screenshot of the window here, then close it.
+    pub screenshot: Option<PathBuf>,
+    /// Passes to wait for before the screenshot.
+    pub screenshot_after_passes: u32,
+    /// Replace an existing screenshot file.
+    pub force: bool,
+    /// Measure and print the viewer's responsiveness, then close.
+    pub bench: bool,
+    /// When the process started (for launch-to-first-image).
+    pub launched: Instant,
+}
+
+impl Default for LaunchOptions {
+    fn default() -> Self {
+        Self {
+            screenshot: None,
+            screenshot_after_passes: 4,
+            force: false,
+            bench: false,
+            launched: Instant::now(),
+        }
+    }
+}
+
+/// Longest a scripted run waits for the renderer before giving up.
+const TIMEOUT: Duration = Duration::from_secs(300);
+/// How long the frame rate is measured.
+const FPS_WINDOW: Duration = Duration::from_secs(5);
+/// Restarts measured.
+const LATENCY_ROUNDS: usize = 6;
+
+enum Stage {
+    WaitFirstImage,
+    FrameRate {
+        start: Instant,
+        frames: u32,
+        worst: Duration,
+        last: Instant,
+        ui_secs: f64,
+        paused: bool,
+    },
+    Latency {
+        round: usize,
+        sent: Option<Instant>,
+    },
+    Screenshot {
+        requested: bool,
+    },
+    Done,
+}
+
+/// The state of a scripted run.
+pub struct Automation {
+    options: LaunchOptions,
+    stage: Stage,
+    screenshot_result: Arc<Mutex<Option<Result<PathBuf, String>>>>,
+    first_image_secs: Option<f64>,
+    /// Frames per second, slowest frame and mean time in the viewer's own UI code (seconds).
+    fps: Option<(f64, f64, f64)>,
+    /// The same with the renderer paused.
+    fps_paused: Option<(f64, f64, f64)>,
+    latencies: Vec<f64>,
+    /// Exit status for the process (non-zero when the run failed).
+    pub failed: Option<String>,
+}
+
+impl Automation {
+    /// A scripted run, or `None` when the options ask for none.
+    pub fn new(options: LaunchOptions) -> Option<Self> {
+        (options.screenshot.is_some() || options.bench).then(|| Self {
+            options,
+            stage: Stage::WaitFirstImage,
+            screenshot_result: Arc::new(Mutex::new(None)),
+            first_image_secs: None,
+            fps: None,
+            fps_paused: None,
+            latencies: Vec::new(),
+            failed: None,
+        })
+    }
+
+    fn finish(&mut self, ctx: &egui::Context, failure: Option<String>) {
+        if let Some(f) = &failure {
+            eprintln!("caustic view: {f}");
+        }
+        self.failed = failure;
+        self.stage = Stage::Done;
+        ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+    }
+
+    /// Advances the script; called once per UI frame after the viewer's own UI.
+    pub fn step(&mut self, viewer: &mut Viewer, ctx: &egui::Context, ui_secs: f64) {
+        ctx.request_repaint();
+        if let Some(f) = viewer.render_failure() {
+            let f = f.to_owned();
+            self.finish(ctx, Some(format!("the renderer failed: {f}")));
+            return;
+        }
+        if self.options.launched.elapsed() > TIMEOUT && !matches!(self.stage, Stage::Done) {
+            self.finish(ctx, Some(format!("gave up after {} s", TIMEOUT.as_secs())));
+            return;
+        }
+        let now = Instant::now();
+        match &mut self.stage {
+            Stage::WaitFirstImage => {
+                if viewer.frame().is_some() {
+                    self.first_image_secs = Some(self.options.launched.elapsed().as_secs_f64());
+                    self.stage = if self.options.bench {
+                        Stage::FrameRate {
+                            start: now,
+                            frames: 0,
+                            worst: Duration::ZERO,
+                            last: now,
+                            ui_secs: 0.0,
+                            paused: false,
+                        }
+                    } else {
+                        Stage::Screenshot { requested: false }
+                    };
+                }
+            }
+            Stage::FrameRate {
+                start,
+                frames,
+                worst,
+                last,
+                ui_secs: total_ui,
+                paused,
+            } => {
+                *frames += 1;
+                *total_ui += ui_secs;
+                *worst = (*worst).max(now - *last);
+                *last = now;
+                if now - *start >= FPS_WINDOW {
+                    let secs = (now - *start).as_secs_f64();
+                    let figures = (
+                        *frames as f64 / secs,
+                        worst.as_secs_f64(),
+                        *total_ui / *frames as f64,
+                    );
+                    // Then the same with the renderer paused: what the UI costs by itself here.
+                    let mut p = viewer.params.clone();
+                    if *paused {
+                        self.fps_paused = Some(figures);
+                        p.paused = false;
+                        self.stage = Stage::Latency { round: 0, sent: None };
+                    } else {
+                        self.fps = Some(figures);
+                        p.paused = true;
+                        self.stage = Stage::FrameRate {
+                            start: now,
+                            frames: 0,
+                            worst: Duration::ZERO,
+                            last: now,
+                            ui_secs: 0.0,
+                            paused: true,
+                        };
+                    }
+                    viewer.set_params(p);
+                }
+            }
+            Stage::Latency { round, sent } => match sent {
+                None => {
+                    // Move the aperture slider's value, exactly as a drag would.
+                    let mut p = viewer.params.clone();
+                    let open = viewer.ranges.aperture_max * 0.02;
+                    p.aperture = if *round % 2 == 0 { open } else { 0.0 };
+                    viewer.set_params(p);
+                    *sent = Some(now);
+                }
+                Some(at) => {
+                    let shown = viewer.restart_latency_secs().is_some() && !viewer.restart_pending();
+                    if shown {
+                        self.latencies.push(viewer.restart_latency_secs().unwrap_or(0.0));
+                        *round += 1;
+                        *sent = None;
+                        if *round == LATENCY_ROUNDS {
+                            self.stage = Stage::Screenshot { requested: false };
+                        }
+                    } else if now - *at > Duration::from_secs(60) {
+                        self.finish(ctx, Some("no image 60 s after a restart".into()));
+                    }
+                }
+            },
+            Stage::Screenshot { requested } => {
+                let Some(path) = self.options.screenshot.clone() else {
+                    self.report(viewer);
+                    self.finish(ctx, None);
+                    return;
+                };
+                let passes = viewer.frame().map_or(0, |f| f.pass);
+                let whitted = viewer
+                    .frame()
+                    .is_some_and(|f| f.renderer == crate::scene::RendererKind::Whitted);
+                if !*requested && (passes >= self.options.screenshot_after_passes || whitted) {
+                    *requested = true;
+                    let result = self.screenshot_result.clone();
+                    let force = self.options.force;
+                    let waker = ctx.clone();
+                    ctx.request_screenshot(move |image| {
+                        let outcome = save_screenshot(&image, &path, force);
+                        if let Ok(mut r) = result.lock() {
+                            *r = Some(outcome);
+                        }
+                        waker.request_repaint();
+                    });
+                }
+                let done = self.screenshot_result.lock().ok().and_then(|mut r| r.take());
+                if let Some(outcome) = done {
+                    if self.options.bench {
+                        self.report(viewer);
+                    }
+                    match outcome {
+                        Ok(p) => {
+                            println!("caustic view: screenshot saved to {}", p.display());
+                            self.finish(ctx, None);
+                        }
+                        Err(e) => self.finish(ctx, Some(e)),
+                    }
+                }
+            }
+            Stage::Done => {}
+        }
+    }
+
+    fn report(&self, viewer: &Viewer) {
+        if !self.options.bench {
+            return;
+        }
+        println!("caustic view --bench ({})", viewer.scene().source.display());
+        if let Some(t) = self.first_image_secs {
+            println!("  launch to first image:        {:.0} ms", t * 1e3);
+        }
+        if let Some((fps, worst, ui)) = self.fps {
+            println!(
+                "  UI frame rate while rendering: {fps:.1} fps (slowest frame {:.0} ms; the viewer's own UI code {:.1} ms per frame)",
+                worst * 1e3,
+                ui * 1e3
+            );
+        }
+        if let Some((fps, worst, ui)) = self.fps_paused {
+            println!(
+                "  UI frame rate, renderer paused:  {fps:.1} fps (slowest frame {:.0} ms; own UI code {:.1} ms per frame)",
+                worst * 1e3,
+                ui * 1e3
+            );
+        }
+        if !self.latencies.is_empty() {
+            let mut l = self.latencies.clone();
+            l.sort_by(f64::total_cmp);
+            let ms: Vec<String> = self.latencies.iter().map(|s| format!("{:.0}", s * 1e3)).collect();
+            println!(
+                "  aperture change to new-epoch image: median {:.0} ms, max {:.0} ms  (each: {} ms)",
+                l[l.len() / 2] * 1e3,
+                l[l.len() - 1] * 1e3,
+                ms.join(", ")
+            );
+        }
+        if let Some(f) = viewer.frame() {
+            println!(
+                "  last frame: epoch {}, pass {}, {} photons in {:.2} s",
+                f.epoch, f.pass, f.photons, f.elapsed_secs
+            );
+        }
+    }
+}
+
+/// Writes a window screenshot as PNG (temp name + rename; refuses to replace unless `force`).
+fn save_screenshot(image: &egui::ColorImage, path: &std::path::Path, force: bool) -> Result<PathBuf, String> {
+    if path.exists() && !force {
+        return Err(format!("{} exists (pass --force to replace it)", path.display()));
+    }
+    let [w, h] = image.size;
+    let bytes: Vec<u8> = image
+        .pixels
+        .iter()
+        .flat_map(|c| c.to_srgba_unmultiplied())
+        .collect();
+    let rgba = image::RgbaImage::from_raw(w as u32, h as u32, bytes)
+        .ok_or_else(|| "screenshot has an inconsistent size".to_owned())?;
+    let tmp = path.with_extension("png.partial");
+    rgba.save_with_format(&tmp, image::ImageFormat::Png)
+        .map_err(|e| format!("{}: {e}", path.display()))?;
+    std::fs::rename(&tmp, path).map_err(|e| format!("{}: {e}", path.display()))?;
+    Ok(path.to_path_buf())
+}

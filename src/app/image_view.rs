@@ -1,0 +1,214 @@
+//! The central image: the render's texture placed by fit / 1:1 / wheel zoom / drag pan, and
+//! the pixel under the cursor for the probe.
+
+use egui::{Color32, ColorImage, Pos2, Rect, Sense, TextureHandle, TextureOptions, Vec2};
+
+use super::settings::{DisplayMode, Zoom};
+use crate::render::session::Frame;
+use crate::render::Image;
+
+/// Zoom limits (image pixels per screen pixel).
+const MIN_SCALE: f32 = 1.0 / 32.0;
+const MAX_SCALE: f32 = 64.0;
+
+/// Texture and placement of the displayed image.
+pub struct ImageView {
+    texture: Option<TextureHandle>,
+    /// Offset of the image centre from the view centre, in points (used with [`Zoom::Scale`]).
+    pan: Vec2,
+    /// Set when the texture must be rebuilt (new frame, exposure or display mode changed).
+    dirty: bool,
+}
+
+/// Where the cursor is over the image.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Probe {
+    /// Pixel column.
+    pub x: u32,
+    /// Pixel row (from the top).
+    pub y: u32,
+}
+
+impl Default for ImageView {
+    fn default() -> Self {
+        Self {
+            texture: None,
+            pan: Vec2::ZERO,
+            dirty: true,
+        }
+    }
+}
+
+/// A false-colour ramp (dark blue → cyan → yellow → white) for `t` in `[0, 1]`.
+fn false_colour(t: f32) -> [u8; 3] {
+    let t = if t.is_finite() { t.clamp(0.0, 1.0) } else { 0.0 };
+    const STOPS: [[f32; 3]; 5] = [
+        [0.05, 0.03, 0.25],
+        [0.10, 0.35, 0.75],
+        [0.20, 0.80, 0.70],
+        [0.95, 0.85, 0.25],
+        [1.00, 1.00, 0.95],
+    ];
+    let x = t * (STOPS.len() - 1) as f32;
+    let i = (x.floor() as usize).min(STOPS.len() - 2);
+    let f = x - i as f32;
+    let c = |k: usize| ((STOPS[i][k] * (1.0 - f) + STOPS[i + 1][k] * f) * 255.0 + 0.5) as u8;
+    [c(0), c(1), c(2)]
+}
+
+/// Log-scaled false colour of positive values (zero/non-finite values are black).
+fn false_colour_image(values: &[f32]) -> Vec<u8> {
+    let logs: Vec<f32> = values
+        .iter()
+        .filter(|v| v.is_finite() && **v > 0.0)
+        .map(|v| v.ln())
+        .collect();
+    let lo = logs.iter().copied().fold(f32::INFINITY, f32::min);
+    let hi = logs.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+    let span = (hi - lo).max(1e-6);
+    values
+        .iter()
+        .flat_map(|&v| {
+            if v.is_finite() && v > 0.0 {
+                false_colour((v.ln() - lo) / span)
+            } else {
+                [0, 0, 0]
+            }
+        })
+        .collect()
+}
+
+/// The 8-bit RGB picture of a frame in a display mode.
+pub fn display_bytes(frame: &Frame, mode: DisplayMode, exposure_stops: f32) -> Vec<u8> {
+    match mode {
+        DisplayMode::Radiance => frame_image(frame).to_srgb8(exposure_stops),
+        DisplayMode::Radius => false_colour_image(&frame.radius),
+        DisplayMode::PhotonCount => false_colour_image(&frame.gathered),
+    }
+}
+
+/// The frame's radiance as an [`Image`] (for display and saving).
+pub fn frame_image(frame: &Frame) -> Image {
+    Image {
+        width: frame.width,
+        height: frame.height,
+        pixels: frame.radiance.to_vec(),
+    }
+}
+
+impl ImageView {
+    /// Marks the texture stale (a new frame, another exposure or display mode).
+    pub fn invalidate(&mut self) {
+        self.dirty = true;
+    }
+
+    /// Rebuilds the texture from `frame` if it is stale.
+    pub fn update_texture(&mut self, ctx: &egui::Context, frame: &Frame, mode: DisplayMode, exposure: f32) {
+        if !self.dirty && self.texture.is_some() {
+            return;
+        }
+        let bytes = display_bytes(frame, mode, exposure);
+        let image = ColorImage::from_rgb([frame.width as usize, frame.height as usize], &bytes);
+        // Nearest when magnified, so zoomed-in pixels stay crisp for the probe.
+        let options = TextureOptions {
+            magnification: egui::TextureFilter::Nearest,
+            ..TextureOptions::LINEAR
+        };
+        match &mut self.texture {
+            Some(t) => t.set(image, options),
+            None => self.texture = Some(ctx.load_texture("caustic-render", image, options)),
+        }
+        self.dirty = false;
+    }
+
+    /// Image pixels per point for `zoom` in a view of `view` points.
+    fn scale(zoom: Zoom, view: Vec2, size: Vec2, pixels_per_point: f32) -> f32 {
+        match zoom {
+            Zoom::Fit => (view.x / size.x).min(view.y / size.y).max(1e-3),
+            // `Scale(s)`: s screen pixels per image pixel.
+            Zoom::Scale(s) => s / pixels_per_point,
+        }
+    }
+
+    /// Shows the image, handles zoom and pan, and returns the pixel under the cursor.
+    pub fn ui(&mut self, ui: &mut egui::Ui, zoom: &mut Zoom, size: [u32; 2]) -> Option<Probe> {
+        let (rect, response) = ui.allocate_exact_size(ui.available_size(), Sense::click_and_drag());
+        ui.painter().rect_filled(rect, 0.0, Color32::from_gray(24));
+        let size_px = Vec2::new(size[0] as f32, size[1] as f32);
+        let ppp = ui.ctx().pixels_per_point();
+        let mut scale = Self::scale(*zoom, rect.size(), size_px, ppp);
+
+        // Wheel (or pinch) zooms about the cursor; dragging pans.
+        if let Some(pointer) = response.hover_pos() {
+            let (scroll, pinch) = ui.input(|i| (i.smooth_scroll_delta.y, i.zoom_delta()));
+            let factor = pinch * (scroll / 200.0).exp();
+            if (factor - 1.0).abs() > 1e-4 {
+                let new_scale = (scale * ppp * factor).clamp(MIN_SCALE, MAX_SCALE) / ppp;
+                let centre = rect.center() + self.pan_for(*zoom);
+                let to_pointer = pointer - centre;
+                self.pan = (centre + to_pointer * (1.0 - new_scale / scale)) - rect.center();
+                *zoom = Zoom::Scale(new_scale * ppp);
+                scale = new_scale;
+            }
+        }
+        if response.dragged() {
+            if *zoom == Zoom::Fit {
+                *zoom = Zoom::Scale(scale * ppp);
+                self.pan = Vec2::ZERO;
+            }
+            self.pan += response.drag_delta();
+        }
+        if response.double_clicked() {
+            *zoom = Zoom::Fit;
+        }
+
+        let centre = rect.center() + self.pan_for(*zoom);
+        let image_rect = Rect::from_center_size(centre, size_px * scale);
+        if let Some(texture) = &self.texture {
+            let uv = Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0));
+            ui.painter_at(rect)
+                .image(texture.id(), image_rect, uv, Color32::WHITE);
+        }
+        let pointer = response.hover_pos()?;
+        if !image_rect.contains(pointer) {
+            return None;
+        }
+        let local = (pointer - image_rect.min) / scale;
+        Some(Probe {
+            x: (local.x as u32).min(size[0].saturating_sub(1)),
+            y: (local.y as u32).min(size[1].saturating_sub(1)),
+        })
+    }
+
+    fn pan_for(&self, zoom: Zoom) -> Vec2 {
+        match zoom {
+            Zoom::Fit => Vec2::ZERO,
+            Zoom::Scale(_) => self.pan,
+        }
+    }
+
+    /// Centres the image (used by "Fit" and "1:1").
+    pub fn recentre(&mut self) {
+        self.pan = Vec2::ZERO;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn false_colour_is_monotone_in_brightness_and_handles_bad_values() {
+        let sum = |c: [u8; 3]| c.iter().map(|&v| v as u32).sum::<u32>();
+        let mut last = 0;
+        for i in 0..=20 {
+            let s = sum(false_colour(i as f32 / 20.0));
+            assert!(s >= last, "ramp not monotone at {i}");
+            last = s;
+        }
+        assert_eq!(false_colour(f32::NAN), false_colour(0.0));
+        let bytes = false_colour_image(&[0.0, f32::NAN, 1.0, 10.0]);
+        assert_eq!(&bytes[..6], &[0; 6]);
+        assert_eq!(bytes.len(), 12);
+    }
+}

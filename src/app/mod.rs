@@ -1,0 +1,117 @@
+//! The desktop viewer (DESIGN.md §4): eframe with the wgpu renderer, the render session on its
+//! own thread, the image with exposure, zoom and a pixel probe, a side panel of parameters
+//! and statistics, open and save dialogs, persisted preferences.
+//!
+//! Built with the `viewer` feature (on by default); the render core never depends on it.
+//!
+//! - [`viewer`]: state and layout ([`Viewer::ui`] is what eframe and the tests run).
+//! - [`controls`]: menu, side panel, status bar, dialog windows.
+//! - [`image_view`]: texture, fit / 1:1 / zoom / pan, probe.
+//! - [`params`]: parameters and the session commands their changes send.
+//! - [`convergence`]: the error estimate plotted against time.
+//! - [`save`], [`job`]: dialogs and file writes off the UI thread.
+//! - [`keys`], [`settings`], [`automation`]: shortcuts, stored preferences, scripted runs.
+
+pub mod automation;
+pub mod controls;
+pub mod convergence;
+pub mod image_view;
+pub mod job;
+pub mod keys;
+pub mod params;
+pub mod save;
+pub mod settings;
+pub mod viewer;
+
+use std::path::PathBuf;
+
+pub use automation::LaunchOptions;
+pub use settings::ViewerSettings;
+pub use viewer::Viewer;
+
+use crate::scene::Scene;
+use automation::Automation;
+
+/// The eframe application: the viewer plus an optional scripted run.
+pub struct CausticApp {
+    /// The viewer.
+    pub viewer: Viewer,
+    automation: Option<Automation>,
+    /// Set when a scripted run failed (read after the window closed).
+    failure: std::sync::Arc<std::sync::Mutex<Option<String>>>,
+}
+
+impl eframe::App for CausticApp {
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        let start = std::time::Instant::now();
+        self.viewer.ui(ui);
+        let ui_secs = start.elapsed().as_secs_f64();
+        if let Some(a) = &mut self.automation {
+            a.step(&mut self.viewer, ui.ctx(), ui_secs);
+            if let (Some(f), Ok(mut slot)) = (&a.failed, self.failure.lock()) {
+                *slot = Some(f.clone());
+            }
+        }
+    }
+
+    fn save(&mut self, storage: &mut dyn eframe::Storage) {
+        eframe::set_value(storage, settings::STORAGE_KEY, &self.viewer.settings);
+    }
+}
+
+/// Opens the viewer window on `scene_path` (the built-in scene when `None`) and runs until it
+/// closes. A scene that fails to load is reported in the window over the built-in scene.
+pub fn run(scene_path: Option<PathBuf>, launch: LaunchOptions) -> anyhow::Result<()> {
+    let (scene, error) = match &scene_path {
+        None => (Scene::builtin(), None),
+        Some(p) => match Scene::load(p) {
+            Ok(s) => (s, None),
+            Err(e) => {
+                eprintln!("caustic view: {e}");
+                (Scene::builtin(), Some(e.to_string()))
+            }
+        },
+    };
+    let scripted = launch.screenshot.is_some() || launch.bench;
+    let native = eframe::NativeOptions {
+        viewport: egui::ViewportBuilder::default()
+            .with_title("caustic")
+            .with_inner_size([1180.0, 760.0])
+            .with_min_inner_size([480.0, 320.0])
+            .with_drag_and_drop(true),
+        renderer: eframe::Renderer::Wgpu,
+        // A scripted run must not depend on (or change) what a person's last session stored.
+        persistence_path: scripted.then(|| std::env::temp_dir().join("caustic-scripted-run")),
+        ..Default::default()
+    };
+    let failure = std::sync::Arc::new(std::sync::Mutex::new(None));
+    let app_failure = failure.clone();
+    eframe::run_native(
+        "caustic",
+        native,
+        Box::new(move |cc| {
+            let settings = if scripted {
+                ViewerSettings::default()
+            } else {
+                cc.storage
+                    .and_then(|s| eframe::get_value::<ViewerSettings>(s, settings::STORAGE_KEY))
+                    .unwrap_or_default()
+            };
+            let mut viewer = Viewer::new(&cc.egui_ctx, scene, settings);
+            if let Some(e) = error {
+                viewer.scene_error = Some(e);
+            }
+            Ok(Box::new(CausticApp {
+                viewer,
+                automation: Automation::new(launch),
+                failure: app_failure,
+            }))
+        }),
+    )
+    .map_err(|e| anyhow::anyhow!("could not open the viewer window: {e}"))?;
+    let failed = failure.lock().ok().and_then(|f| f.clone());
+    match failed {
+        Some(f) => Err(anyhow::anyhow!(f)),
+        None => Ok(()),
+    }
+}

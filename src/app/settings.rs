@@ -1,0 +1,106 @@
+//! What the viewer remembers between runs (eframe storage): view preferences, not the scene's
+//! own parameters, which start from the scene file each time it is opened.
+
+use std::path::PathBuf;
+
+use serde::{Deserialize, Serialize};
+
+/// Key under which [`ViewerSettings`] is stored.
+pub const STORAGE_KEY: &str = "caustic.viewer";
+
+/// How the image is placed in the view.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Zoom {
+    /// Scaled to fit the view, centred.
+    Fit,
+    /// Image pixels per screen pixel (1.0 = 1:1), panned freely.
+    Scale(f32),
+}
+
+/// What the image view shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum DisplayMode {
+    /// Radiance, exposure-scaled and sRGB-encoded.
+    Radiance,
+    /// The PPM search radius per pixel in false colour (log scale).
+    Radius,
+    /// The accumulated photon count per pixel in false colour (log scale).
+    PhotonCount,
+}
+
+impl DisplayMode {
+    /// Every mode, in menu order.
+    pub const ALL: [DisplayMode; 3] = [
+        DisplayMode::Radiance,
+        DisplayMode::Radius,
+        DisplayMode::PhotonCount,
+    ];
+
+    /// Name shown in menus.
+    pub fn label(self) -> &'static str {
+        match self {
+            DisplayMode::Radiance => "Radiance (sRGB)",
+            DisplayMode::Radius => "Search radius (false colour)",
+            DisplayMode::PhotonCount => "Photon count (false colour)",
+        }
+    }
+}
+
+/// Spatial index choice as stored.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum IndexChoice {
+    /// Hashed grid.
+    HashGrid,
+    /// kd-tree.
+    KdTree,
+}
+
+/// Viewer preferences persisted with eframe storage.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct ViewerSettings {
+    /// Exposure in stops (the displayed and PNG-saved image is radiance × 2^stops).
+    pub exposure_stops: f32,
+    /// Image placement.
+    pub zoom: Zoom,
+    /// What the image view shows.
+    pub display: DisplayMode,
+    /// Side panel shown.
+    pub show_side_panel: bool,
+    /// Direct light from point/spot lights by shadow rays.
+    pub direct_light: bool,
+    /// Spatial index over visible points.
+    pub index: IndexChoice,
+    /// Folder the last scene was opened from or frame saved to (file dialogs start there).
+    pub last_directory: Option<PathBuf>,
+}
+
+impl Default for ViewerSettings {
+    fn default() -> Self {
+        Self {
+            exposure_stops: 0.0,
+            zoom: Zoom::Fit,
+            display: DisplayMode::Radiance,
+            show_side_panel: true,
+            direct_light: false,
+            index: IndexChoice::HashGrid,
+            last_directory: None,
+        }
+    }
+}
+
+impl ViewerSettings {
+    /// Repairs values a hand-edited or old storage file may hold (NaN exposure, zero zoom).
+    pub fn sanitized(mut self) -> Self {
+        if !self.exposure_stops.is_finite() {
+            self.exposure_stops = 0.0;
+        }
+        self.exposure_stops = self.exposure_stops.clamp(-20.0, 20.0);
+        if let Zoom::Scale(s) = self.zoom {
+            if !(s.is_finite() && s > 0.0) {
+                self.zoom = Zoom::Fit;
+            }
+        }
+        self
+    }
+}

@@ -1,0 +1,495 @@
+//! The viewer's state and its frame: render session, newest frame, parameters, open/save
+//! flows, messages. The eframe app ([`super::CausticApp`]) and the kittest tests both drive
+//! [`Viewer::ui`].
+
+use std::collections::VecDeque;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use super::controls;
+use super::convergence::Convergence;
+use super::image_view::{frame_image, ImageView, Probe};
+use super::job::{Job, Poll};
+use super::keys;
+use super::params::{Ranges, RenderParams};
+use super::save::{default_file_name, SaveEvent, SaveFlow, Snapshot};
+use super::settings::{IndexChoice, ViewerSettings, Zoom};
+use crate::render::image_metadata;
+use crate::render::ppm::{IndexKind, PpmOptions};
+use crate::render::session::{Command, Frame, RenderSession, SessionOptions};
+use crate::scene::{RendererKind, Scene};
+
+/// Photons between two looks at the command channel: 4 chunks, about 30–60 ms on 2 cores,
+/// so a slider reacts well within the 250 ms target.
+pub const VIEWER_BATCH_PHOTONS: u64 = 16_384;
+/// Photons in the first pass of an epoch (doubling up to photons per pass): the first image of
+/// a new setting appears after one small pass.
+pub const VIEWER_FIRST_PASS_PHOTONS: u64 = 16_384;
+/// Commands kept in [`Viewer::recent_commands`].
+const COMMAND_LOG: usize = 256;
+
+/// A line in the status bar.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Status {
+    /// Something worked.
+    Info(String),
+    /// Something did not.
+    Error(String),
+}
+
+/// The viewer.
+pub struct Viewer {
+    pub(super) ctx: egui::Context,
+    /// Persisted preferences.
+    pub settings: ViewerSettings,
+    /// The scene as loaded (parameters as in its file).
+    pub(super) scene: Scene,
+    /// Slider ranges for the scene.
+    pub(super) ranges: Ranges,
+    /// Current parameter values.
+    pub params: RenderParams,
+    session: RenderSession,
+    /// Newest frame of the newest epoch seen.
+    pub(super) frame: Option<Frame>,
+    pub(super) image_view: ImageView,
+    pub(super) probe: Option<Probe>,
+    pub(super) convergence: Convergence,
+    /// A restart sent at this time, from this epoch, not shown yet.
+    pending_restart: Option<(Instant, u64)>,
+    /// Seconds from the last restart-type change to its first image.
+    pub(super) restart_latency_secs: Option<f64>,
+    pub(super) save: SaveFlow,
+    picking: Option<Job<Option<PathBuf>>>,
+    loading: Option<(Job<Result<Scene, String>>, PathBuf)>,
+    /// A scene that failed to open, with its error (shown in a window).
+    pub(super) scene_error: Option<String>,
+    /// The render thread's panic message.
+    pub(super) render_failure: Option<String>,
+    pub(super) status: Option<Status>,
+    pub(super) show_help: bool,
+    recent_commands: VecDeque<Command>,
+    /// Seconds from [`Viewer::new`] to the first image shown.
+    pub(super) first_image_secs: Option<f64>,
+    created: Instant,
+}
+
+fn session_options(settings: &ViewerSettings, start_paused: bool) -> SessionOptions {
+    SessionOptions {
+        ppm: PpmOptions {
+            index: match settings.index {
+                IndexChoice::HashGrid => IndexKind::HashGrid,
+                IndexChoice::KdTree => IndexKind::KdTree,
+            },
+            direct_light: settings.direct_light,
+            batch_photons: VIEWER_BATCH_PHOTONS,
+            ..Default::default()
+        },
+        first_pass_photons: Some(VIEWER_FIRST_PASS_PHOTONS),
+        start_paused,
+    }
+}
+
+/// The viewer always opens a scene with photon mapping (the image converges from the first
+/// second); the ray tracer a scene file may ask for is one click away.
+fn photon_mapped(mut scene: Scene) -> Scene {
+    scene.settings.renderer = RendererKind::Ppm;
+    scene
+}
+
+fn start_session(
+    ctx: &egui::Context,
+    scene: Scene,
+    settings: &ViewerSettings,
+    paused: bool,
+) -> RenderSession {
+    let waker_ctx = ctx.clone();
+    RenderSession::start_with(
+        scene,
+        session_options(settings, paused),
+        Some(Box::new(move || waker_ctx.request_repaint())),
+    )
+}
+
+impl Viewer {
+    /// A viewer rendering `scene`, with `settings` from storage.
+    pub fn new(ctx: &egui::Context, scene: Scene, settings: ViewerSettings) -> Self {
+        Self::with_pause(ctx, scene, settings, false)
+    }
+
+    /// A viewer whose renderer starts paused when `paused` (Resume, or Space, starts it).
+    pub fn with_pause(ctx: &egui::Context, scene: Scene, settings: ViewerSettings, paused: bool) -> Self {
+        let scene = photon_mapped(scene);
+        let settings = settings.sanitized();
+        let mut params = RenderParams::from_scene(&scene);
+        params.paused = paused;
+        let ranges = Ranges::for_scene(&scene);
+        let session = start_session(ctx, scene.clone(), &settings, paused);
+        Self {
+            ctx: ctx.clone(),
+            settings,
+            scene,
+            ranges,
+            params,
+            session,
+            frame: None,
+            image_view: ImageView::default(),
+            probe: None,
+            convergence: Convergence::default(),
+            pending_restart: None,
+            restart_latency_secs: None,
+            save: SaveFlow::default(),
+            picking: None,
+            loading: None,
+            scene_error: None,
+            render_failure: None,
+            status: None,
+            show_help: false,
+            recent_commands: VecDeque::new(),
+            first_image_secs: None,
+            created: Instant::now(),
+        }
+    }
+
+    /// The scene being rendered (as loaded).
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    /// The newest frame shown.
+    pub fn frame(&self) -> Option<&Frame> {
+        self.frame.as_ref()
+    }
+
+    /// Commands sent to the render session, oldest first (the last 256).
+    pub fn recent_commands(&self) -> impl Iterator<Item = &Command> {
+        self.recent_commands.iter()
+    }
+
+    /// The error of the last scene that failed to open, if it is still shown.
+    pub fn scene_error(&self) -> Option<&str> {
+        self.scene_error.as_deref()
+    }
+
+    /// The render thread's failure, if it failed.
+    pub fn render_failure(&self) -> Option<&str> {
+        self.render_failure.as_deref()
+    }
+
+    /// The status line.
+    pub fn status(&self) -> Option<&Status> {
+        self.status.as_ref()
+    }
+
+    /// Whether a scene is being opened or a frame saved.
+    pub fn busy(&self) -> bool {
+        self.loading.is_some() || self.picking.is_some() || self.save.busy()
+    }
+
+    /// Seconds from creation to the first image shown, once there is one.
+    pub fn first_image_secs(&self) -> Option<f64> {
+        self.first_image_secs
+    }
+
+    /// Seconds from the last restarting change to the first image of its epoch.
+    pub fn restart_latency_secs(&self) -> Option<f64> {
+        self.restart_latency_secs
+    }
+
+    /// Whether a restarting change waits for its first image.
+    pub fn restart_pending(&self) -> bool {
+        self.pending_restart.is_some()
+    }
+
+    /// Sends a command to the render session, remembering it (and when a restart was asked).
+    pub fn send(&mut self, command: Command) {
+        let restarts = !matches!(
+            command,
+            Command::SetAlpha(_)
+                | Command::SetPhotonsPerPass(_)
+                | Command::Pause
+                | Command::Resume
+                | Command::Shutdown
+                | Command::Fail(_)
+        );
+        if restarts {
+            let epoch = self.frame.as_ref().map_or(0, |f| f.epoch);
+            self.pending_restart = Some((Instant::now(), epoch));
+        }
+        if self.recent_commands.len() == COMMAND_LOG {
+            self.recent_commands.pop_front();
+        }
+        self.recent_commands.push_back(command.clone());
+        self.session.send(command);
+    }
+
+    /// Sets parameters, sending the commands their changes need.
+    pub fn set_params(&mut self, params: RenderParams) {
+        for command in params.commands_from(&self.params) {
+            self.send(command);
+        }
+        self.params = params;
+    }
+
+    /// Starts a new render session for the current scene and parameters (after a renderer
+    /// failure, or when index/direct-light options change).
+    pub fn restart_renderer(&mut self) {
+        let mut scene = self.scene.clone();
+        self.params.apply_to(&mut scene);
+        self.session = start_session(&self.ctx, scene, &self.settings, self.params.paused);
+        self.render_failure = None;
+        self.frame = None;
+        self.convergence.reset();
+        self.image_view.invalidate();
+        self.pending_restart = Some((Instant::now(), 0));
+    }
+
+    /// Replaces the scene (a successful open).
+    fn replace_scene(&mut self, scene: Scene) {
+        let scene = photon_mapped(scene);
+        self.params = RenderParams::from_scene(&scene);
+        self.ranges = Ranges::for_scene(&scene);
+        self.scene = scene;
+        self.restart_renderer();
+        self.settings.zoom = Zoom::Fit;
+        self.image_view.recentre();
+    }
+
+    /// Opens a scene file on a background thread; on failure the error is shown and the
+    /// current scene keeps rendering.
+    pub fn open_scene(&mut self, path: PathBuf) {
+        let p = path.clone();
+        let job = Job::spawn("caustic-load", &self.ctx, move || {
+            Scene::load(&p).map_err(|e| e.to_string())
+        });
+        self.loading = Some((job, path));
+    }
+
+    /// Shows the open dialog (on a thread).
+    pub fn pick_scene(&mut self) {
+        if self.picking.is_some() {
+            return;
+        }
+        let dir = self.settings.last_directory.clone();
+        self.picking = Some(Job::spawn("caustic-open-dialog", &self.ctx, move || {
+            let mut dialog = rfd::FileDialog::new()
+                .set_title("Open scene")
+                .add_filter("caustic scene", &["toml"]);
+            if let Some(d) = dir {
+                dialog = dialog.set_directory(d);
+            }
+            dialog.pick_file()
+        }));
+    }
+
+    /// The current frame as something to save, with its metadata.
+    fn snapshot(&self) -> Option<Snapshot> {
+        let frame = self.frame.as_ref()?;
+        let renderer = match frame.renderer {
+            RendererKind::Ppm => "ppm",
+            RendererKind::Whitted => "whitted",
+        };
+        let mut scene = self.scene.clone();
+        self.params.apply_to(&mut scene);
+        let mut metadata = image_metadata(&scene, renderer);
+        metadata.push(("caustic:passes".into(), frame.pass.to_string()));
+        metadata.push(("caustic:photons".into(), frame.photons.to_string()));
+        metadata.push(("caustic:alpha".into(), self.params.alpha.to_string()));
+        metadata.push(("caustic:aperture".into(), self.params.aperture.to_string()));
+        metadata.push((
+            "caustic:focal_distance".into(),
+            self.params.focal_distance.to_string(),
+        ));
+        metadata.push((
+            "caustic:exposure_stops".into(),
+            self.settings.exposure_stops.to_string(),
+        ));
+        Some(Snapshot {
+            image: frame_image(frame),
+            exposure_stops: self.settings.exposure_stops,
+            metadata,
+            pass: frame.pass,
+        })
+    }
+
+    /// Ctrl+S: the save dialog for the current frame.
+    pub fn save_with_dialog(&mut self) {
+        let Some(snapshot) = self.snapshot() else {
+            self.status = Some(Status::Error("nothing to save yet: no frame has arrived".into()));
+            return;
+        };
+        let name = default_file_name(&self.scene.source, snapshot.pass);
+        let dir = self.settings.last_directory.clone();
+        self.save.open_dialog(&self.ctx, snapshot, dir, name);
+    }
+
+    /// Saves the current frame to `path` (.png as displayed, .exr linear), asking before
+    /// replacing a file; the write runs on a background thread.
+    pub fn save_to(&mut self, path: PathBuf) {
+        let Some(snapshot) = self.snapshot() else {
+            self.status = Some(Status::Error("nothing to save yet: no frame has arrived".into()));
+            return;
+        };
+        if let Some(event) = self.save.save_to(&self.ctx, path, snapshot) {
+            self.on_save_event(event);
+        }
+    }
+
+    /// Whether an overwrite question is open.
+    pub fn confirming_overwrite(&self) -> Option<&Path> {
+        self.save.confirm.as_ref().map(|(p, _)| p.as_path())
+    }
+
+    /// Answers the overwrite question.
+    pub fn confirm_overwrite(&mut self, replace: bool) {
+        if let Some(event) = self.save.confirm_overwrite(&self.ctx, replace) {
+            self.on_save_event(event);
+        }
+    }
+
+    fn on_save_event(&mut self, event: SaveEvent) {
+        self.status = Some(match event {
+            SaveEvent::Saved { path, pass } => {
+                if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+                    self.settings.last_directory = Some(dir.to_path_buf());
+                }
+                Status::Info(format!("Saved pass {pass} to {}", path.display()))
+            }
+            SaveEvent::Failed(e) => Status::Error(format!("Not saved: {e}")),
+            SaveEvent::Cancelled => Status::Info("Save cancelled".into()),
+        });
+    }
+
+    /// Takes new frames, failures and finished jobs; call once per UI frame.
+    pub fn poll(&mut self) {
+        // Newest frame of the newest epoch.
+        while let Ok(frame) = self.session.frames().try_recv() {
+            self.show_frame(frame);
+        }
+        if self.render_failure.is_none() {
+            self.render_failure = self.session.failure();
+        }
+        if let Some(job) = &self.picking {
+            match job.poll() {
+                Poll::Pending => {}
+                Poll::Ready(choice) => {
+                    self.picking = None;
+                    if let Some(path) = choice {
+                        self.open_scene(path);
+                    }
+                }
+                Poll::Lost => {
+                    self.picking = None;
+                    self.status = Some(Status::Error("the file dialog failed".into()));
+                }
+            }
+        }
+        if let Some((job, path)) = &self.loading {
+            let path = path.clone();
+            let loaded = match job.poll() {
+                Poll::Pending => None,
+                Poll::Ready(r) => Some(r),
+                Poll::Lost => Some(Err(format!("{}: loading failed unexpectedly", path.display()))),
+            };
+            if let Some(result) = loaded {
+                self.loading = None;
+                match result {
+                    Ok(scene) => {
+                        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+                            self.settings.last_directory = Some(dir.to_path_buf());
+                        }
+                        self.replace_scene(scene);
+                        self.scene_error = None;
+                        self.status = Some(Status::Info(format!("Opened {}", path.display())));
+                    }
+                    Err(e) => {
+                        self.status = Some(Status::Error(format!("Could not open {}", path.display())));
+                        self.scene_error = Some(e);
+                    }
+                }
+            }
+        }
+        if let Some(event) = self.save.poll(&self.ctx) {
+            self.on_save_event(event);
+        }
+    }
+
+    /// Shows `frame` as the newest image if it is newer (a later epoch, or a later pass of
+    /// this one) than the one shown; older frames are dropped. Frames from the session arrive
+    /// here; tests hand in fixed frames.
+    pub fn show_frame(&mut self, frame: Frame) {
+        let current = self.frame.as_ref().map(|f| (f.epoch, f.pass));
+        if current.is_some_and(|(e, p)| frame.epoch < e || (frame.epoch == e && frame.pass <= p)) {
+            return;
+        }
+        if current.is_none_or(|(e, _)| frame.epoch > e) {
+            self.convergence.reset();
+        }
+        if let Some((sent, epoch)) = self.pending_restart {
+            if frame.epoch > epoch || self.frame.is_none() {
+                self.restart_latency_secs = Some(sent.elapsed().as_secs_f64());
+                self.pending_restart = None;
+            }
+        }
+        if frame.renderer == RendererKind::Ppm {
+            self.convergence
+                .add(frame.pass, frame.elapsed_secs, &frame.radiance);
+        }
+        self.first_image_secs
+            .get_or_insert_with(|| self.created.elapsed().as_secs_f64());
+        self.frame = Some(frame);
+        self.image_view.invalidate();
+    }
+
+    /// The whole window: menu, side panel, status bar, image, dialogs.
+    pub fn ui(&mut self, ui: &mut egui::Ui) {
+        self.poll();
+        keys::handle(self, ui.ctx());
+        // Files dropped on the window open as scenes (the first one).
+        let dropped: Vec<PathBuf> = ui.input(|i| {
+            i.raw
+                .dropped_files
+                .iter()
+                .map(|f| f.path().to_path_buf())
+                .filter(|p| !p.as_os_str().is_empty())
+                .collect()
+        });
+        if let Some(path) = dropped.into_iter().next() {
+            self.open_scene(path);
+        }
+        if let Some(frame) = &self.frame {
+            self.image_view.update_texture(
+                ui.ctx(),
+                frame,
+                self.settings.display,
+                self.settings.exposure_stops,
+            );
+        }
+
+        egui::Panel::top("caustic-menu").show(ui, |ui| controls::menu_ui(self, ui));
+        egui::Panel::bottom("caustic-status").show(ui, |ui| controls::status_ui(self, ui));
+        if self.settings.show_side_panel {
+            egui::Panel::right("caustic-controls")
+                .resizable(true)
+                .default_size(290.0)
+                .show(ui, |ui| {
+                    egui::ScrollArea::vertical().show(ui, |ui| controls::side_panel_ui(self, ui));
+                });
+        }
+        egui::CentralPanel::no_frame().show(ui, |ui| match &self.frame {
+            Some(frame) => {
+                let size = [frame.width, frame.height];
+                self.probe = self.image_view.ui(ui, &mut self.settings.zoom, size);
+            }
+            None => {
+                self.probe = None;
+                let text = if self.params.paused {
+                    "Paused before the first pass: press Space or Resume"
+                } else {
+                    "Rendering the first pass..."
+                };
+                ui.centered_and_justified(|ui| ui.label(text));
+            }
+        });
+        controls::dialogs_ui(self, ui.ctx());
+    }
+}

@@ -1,0 +1,379 @@
+//! The viewer driven as a person would, through egui_kittest: sliders send the right session
+//! commands, α keeps the epoch and the aperture starts a new one, frames save as readable PNG
+//! and EXR without silent overwrites, a bad scene and a render-thread panic are shown in the
+//! window, and a snapshot of the whole window with a fixed frame (rendered with wgpu).
+#![cfg(feature = "viewer")]
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use caustic::app::settings::ViewerSettings;
+use caustic::app::viewer::Status;
+use caustic::app::Viewer;
+use caustic::render::ppm::{Control, Ppm, PpmOptions};
+use caustic::render::session::{Command, Frame};
+use caustic::scene::{RendererKind, Scene};
+use egui::accesskit::Role;
+use egui_kittest::kittest::Queryable;
+use egui_kittest::Harness;
+
+/// A glass ball on a floor under a point light: caustic, quick at 96×72.
+const BALL: &str = r#"
+[camera]
+position = [0.0, 2.2, 4.5]
+look_at = [0, 0.6, 0]
+up = [0, 1, 0]
+fov = 40
+width = 96
+height = 72
+
+[render]
+renderer = "ppm"
+photons_per_pass = 20000
+alpha = 0.7
+antialias = false
+
+[materials.floor]
+type = "diffuse"
+color = [0.75, 0.7, 0.6]
+
+[materials.glass]
+type = "glass"
+color = [1, 1, 1]
+ior = 1.5
+
+[[lights]]
+type = "point"
+position = [1.0, 4.0, 1.0]
+power = 900
+
+[[objects]]
+type = "plane"
+point = [0, 0, 0]
+normal = [0, 1, 0]
+material = "floor"
+
+[[objects]]
+type = "sphere"
+center = [0, 0.7, 0]
+radius = 0.7
+material = "glass"
+"#;
+
+/// A file dropped on the window, as the windowing layer reports it.
+#[derive(Debug)]
+struct DroppedPath(PathBuf);
+
+impl egui::DroppedFile for DroppedPath {
+    fn path(&self) -> &Path {
+        &self.0
+    }
+
+    fn bytes(&self) -> Result<Vec<u8>, String> {
+        std::fs::read(&self.0).map_err(|e| e.to_string())
+    }
+}
+
+fn ball() -> Scene {
+    Scene::from_str(BALL, Path::new("ball.toml"), None).expect("test scene loads")
+}
+
+type App<'a> = Harness<'a, Option<Viewer>>;
+
+fn harness<'a>(scene: Scene, paused: bool) -> App<'a> {
+    let mut h = Harness::builder()
+        .with_size(egui::Vec2::new(1100.0, 720.0))
+        .build_ui_state(
+            |ui, viewer: &mut Option<Viewer>| {
+                if let Some(v) = viewer {
+                    v.ui(ui);
+                }
+            },
+            None,
+        );
+    let viewer = Viewer::with_pause(&h.ctx, scene, ViewerSettings::default(), paused);
+    *h.state_mut() = Some(viewer);
+    h.step();
+    h
+}
+
+fn viewer<'h>(h: &'h App<'_>) -> &'h Viewer {
+    h.state().as_ref().expect("viewer")
+}
+
+fn viewer_mut<'h>(h: &'h mut App<'_>) -> &'h mut Viewer {
+    h.state_mut().as_mut().expect("viewer")
+}
+
+/// Steps the UI until `done` holds (the render thread works meanwhile); panics after 60 s.
+fn step_until(h: &mut App<'_>, what: &str, done: impl Fn(&Viewer) -> bool) {
+    let start = Instant::now();
+    while !done(viewer(h)) {
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "timed out waiting for {what}"
+        );
+        std::thread::sleep(Duration::from_millis(5));
+        h.step();
+    }
+}
+
+fn sent(h: &App<'_>) -> Vec<Command> {
+    viewer(h).recent_commands().cloned().collect()
+}
+
+fn set_slider(h: &mut App<'_>, label: &str, value: f64) {
+    h.get_by_role_and_label(Role::Slider, label)
+        .set_value_accesskit(value);
+    h.step();
+    h.step();
+}
+
+#[test]
+fn each_slider_sends_its_command() {
+    let mut h = harness(ball(), true);
+    let cases: Vec<(&str, f64, Command)> = vec![
+        ("Alpha", 0.5, Command::SetAlpha(0.5)),
+        ("Photons per pass", 50_000.0, Command::SetPhotonsPerPass(50_000)),
+        ("Aperture", 0.05, Command::SetAperture(0.05)),
+        ("Focal distance", 3.0, Command::SetFocalDistance(3.0)),
+        ("Max depth", 3.0, Command::SetMaxDepth(3)),
+    ];
+    for (label, value, expected) in cases {
+        set_slider(&mut h, label, value);
+        assert_eq!(sent(&h).last(), Some(&expected), "slider {label}");
+    }
+    // The initial radius slider is enabled by unticking "automatic".
+    h.get_by_role_and_label(Role::CheckBox, "Automatic initial radius")
+        .click();
+    h.step();
+    h.step();
+    let radius = viewer(&h).params.initial_radius;
+    assert_eq!(sent(&h).last(), Some(&Command::SetInitialRadius(Some(radius))));
+    set_slider(&mut h, "Initial radius", 0.01);
+    assert_eq!(sent(&h).last(), Some(&Command::SetInitialRadius(Some(0.01))));
+    // Exposure is the viewer's own: no command.
+    let before = sent(&h).len();
+    set_slider(&mut h, "Exposure", 1.5);
+    assert_eq!(viewer(&h).settings.exposure_stops, 1.5);
+    assert_eq!(sent(&h).len(), before, "exposure sent a command");
+    // The renderer buttons, pause and restart.
+    h.get_by_label("Ray tracer").click();
+    h.step();
+    assert_eq!(
+        sent(&h).last(),
+        Some(&Command::SetRenderer(RendererKind::Whitted))
+    );
+    h.get_by_label("Resume").click();
+    h.step();
+    assert_eq!(sent(&h).last(), Some(&Command::Resume));
+    h.key_press(egui::Key::Space);
+    h.step();
+    assert_eq!(sent(&h).last(), Some(&Command::Pause));
+    h.get_by_label("Restart").click();
+    h.step();
+    assert_eq!(sent(&h).last(), Some(&Command::Restart));
+}
+
+#[test]
+fn alpha_keeps_the_epoch_and_aperture_starts_a_new_one() {
+    let mut h = harness(ball(), false);
+    step_until(&mut h, "the first frame", |v| v.frame().is_some());
+    assert_eq!(viewer(&h).frame().map(|f| f.epoch), Some(0));
+    set_slider(&mut h, "Alpha", 0.6);
+    let pass = viewer(&h).frame().map_or(0, |f| f.pass);
+    step_until(&mut h, "two more passes", |v| {
+        v.frame().is_some_and(|f| f.pass >= pass + 2)
+    });
+    assert_eq!(
+        viewer(&h).frame().map(|f| f.epoch),
+        Some(0),
+        "alpha restarted the render"
+    );
+    set_slider(&mut h, "Aperture", 0.05);
+    step_until(&mut h, "a new epoch", |v| v.frame().is_some_and(|f| f.epoch >= 1));
+    let f = viewer(&h).frame().expect("frame");
+    assert_eq!(f.epoch, 1);
+    assert!(f.pass <= 3, "the new epoch starts from scratch (pass {})", f.pass);
+    assert!(viewer(&h).restart_latency_secs().is_some());
+}
+
+fn wait_saved(h: &mut App<'_>) -> Status {
+    step_until(h, "the save", |v| !v.busy());
+    viewer(h).status().cloned().expect("a status line")
+}
+
+#[test]
+fn save_writes_readable_png_and_exr_and_asks_before_replacing() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = harness(ball(), false);
+    step_until(&mut h, "two passes", |v| v.frame().is_some_and(|f| f.pass >= 2));
+    let mut paused = viewer(&h).params.clone();
+    paused.paused = true;
+    viewer_mut(&mut h).set_params(paused);
+    let png = dir.path().join("frame.png");
+    viewer_mut(&mut h).save_to(png.clone());
+    match wait_saved(&mut h) {
+        Status::Info(s) => assert!(s.contains("frame.png"), "{s}"),
+        Status::Error(e) => panic!("{e}"),
+    }
+    let img = image::open(&png).expect("PNG reads back");
+    assert_eq!((img.width(), img.height()), (96, 72));
+
+    let exr = dir.path().join("frame.exr");
+    viewer_mut(&mut h).save_to(exr.clone());
+    wait_saved(&mut h);
+    let linear = image::open(&exr).expect("EXR reads back").into_rgb32f();
+    let frame = viewer(&h).frame().expect("frame").clone();
+    let mean_exr: f64 = linear.pixels().map(|p| p.0[1] as f64).sum::<f64>() / (96.0 * 72.0);
+    let mean_frame: f64 = frame.radiance.iter().map(|p| p[1] as f64).sum::<f64>() / (96.0 * 72.0);
+    assert!(
+        (mean_exr / mean_frame - 1.0).abs() < 1e-5,
+        "EXR {mean_exr} vs frame {mean_frame}"
+    );
+
+    // Saving over an existing file asks first; "Cancel" leaves it alone.
+    let before = std::fs::read(&png).expect("read");
+    std::fs::write(&png, b"precious").expect("write");
+    viewer_mut(&mut h).save_to(png.clone());
+    h.run_steps(3);
+    assert_eq!(viewer(&h).confirming_overwrite(), Some(png.as_path()));
+    assert!(
+        h.query_by_label("Replace file?").is_some(),
+        "no overwrite question shown"
+    );
+    h.get_by_label("Cancel").click();
+    h.step();
+    h.step();
+    assert_eq!(std::fs::read(&png).expect("read"), b"precious");
+    // "Replace" writes it.
+    viewer_mut(&mut h).save_to(png.clone());
+    h.run_steps(3);
+    h.get_by_label("Replace").click();
+    h.step();
+    wait_saved(&mut h);
+    assert_eq!(
+        std::fs::read(&png).expect("read"),
+        before,
+        "the same frame gives the same PNG"
+    );
+
+    // A name the viewer cannot write is refused with a clear message.
+    viewer_mut(&mut h).save_to(dir.path().join("frame.bmp"));
+    match viewer(&h).status() {
+        Some(Status::Error(e)) => assert!(e.contains(".png") && e.contains("frame.bmp"), "{e}"),
+        other => panic!("expected an error, got {other:?}"),
+    }
+}
+
+#[test]
+fn bad_scene_shows_its_error_and_the_old_scene_keeps_rendering() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(&bad, BALL.replace("radius = 0.7", "radius = -2")).expect("write");
+    let mut h = harness(ball(), false);
+    step_until(&mut h, "the first frame", |v| v.frame().is_some());
+    viewer_mut(&mut h).open_scene(bad.clone());
+    step_until(&mut h, "the load", |v| !v.busy());
+    let error = viewer(&h).scene_error().expect("an error").to_owned();
+    assert!(error.contains("bad.toml") && error.contains("radius"), "{error}");
+    h.step();
+    assert!(
+        h.query_by_label("Could not open scene").is_some(),
+        "no error window"
+    );
+    assert_eq!(viewer(&h).scene().source, PathBuf::from("ball.toml"));
+    let pass = viewer(&h).frame().map_or(0, |f| f.pass);
+    step_until(&mut h, "more passes of the old scene", |v| {
+        v.frame().is_some_and(|f| f.pass > pass)
+    });
+    h.get_by_label("OK").click();
+    h.step();
+    assert!(viewer(&h).scene_error().is_none());
+
+    // A good file dropped on the window replaces the scene.
+    let good = dir.path().join("good.toml");
+    std::fs::write(&good, BALL).expect("write");
+    h.input_mut()
+        .dropped_files
+        .push(Arc::new(DroppedPath(good.clone())));
+    h.step();
+    step_until(&mut h, "the dropped scene", |v| {
+        !v.busy() && v.scene().source == good
+    });
+}
+
+#[test]
+fn a_render_thread_panic_is_shown_and_the_renderer_can_restart() {
+    let mut h = harness(ball(), false);
+    step_until(&mut h, "the first frame", |v| v.frame().is_some());
+    viewer_mut(&mut h).send(Command::Fail("injected failure".into()));
+    step_until(&mut h, "the failure", |v| v.render_failure().is_some());
+    h.step();
+    assert!(
+        h.query_by_label_contains("injected failure").is_some(),
+        "failure not shown"
+    );
+    h.get_by_label("Restart renderer").click();
+    h.step();
+    assert!(viewer(&h).render_failure().is_none());
+    step_until(&mut h, "frames after the restart", |v| v.frame().is_some());
+}
+
+/// Four deterministic passes of the test scene as frames with fixed timings.
+fn fixed_frames() -> Vec<Frame> {
+    let scene = ball();
+    let mut ppm = Ppm::new(&scene, PpmOptions::default());
+    let mut frames = Vec::new();
+    for pass in 1..=4u32 {
+        ppm.run_pass(&scene, &mut |_| Control::Continue);
+        let mut stats = ppm.stats().clone();
+        stats.elapsed_secs = pass as f64 * 0.25;
+        stats.photon_secs = pass as f64 * 0.2;
+        let (w, h) = ppm.size();
+        let mut radius = vec![0.0f32; (w * h) as usize];
+        let mut gathered = vec![0.0f32; (w * h) as usize];
+        for s in ppm.slots() {
+            radius[s.pixel as usize] = radius[s.pixel as usize].max(s.radius2.sqrt() as f32);
+            gathered[s.pixel as usize] += s.n as f32;
+        }
+        frames.push(Frame {
+            epoch: 0,
+            renderer: RendererKind::Ppm,
+            pass,
+            photons: stats.photons,
+            elapsed_secs: pass as f64 * 0.25,
+            stats,
+            width: w,
+            height: h,
+            radiance: ppm.radiance().into(),
+            radius: Arc::from(radius),
+            gathered: Arc::from(gathered),
+        });
+    }
+    frames
+}
+
+#[test]
+fn window_snapshot_with_a_fixed_frame() {
+    let mut h = Harness::builder()
+        .with_size(egui::Vec2::new(1100.0, 880.0))
+        .wgpu()
+        .build_ui_state(
+            |ui, viewer: &mut Option<Viewer>| {
+                if let Some(v) = viewer {
+                    v.ui(ui);
+                }
+            },
+            None,
+        );
+    let mut v = Viewer::with_pause(&h.ctx, ball(), ViewerSettings::default(), true);
+    for f in fixed_frames() {
+        v.show_frame(f);
+    }
+    v.settings.exposure_stops = -1.0;
+    *h.state_mut() = Some(v);
+    h.run_steps(4);
+    h.snapshot("viewer_window");
+}
