@@ -519,6 +519,10 @@ fn render_ppm(mut scene: Scene, out: &Path, exposure: f32, force: bool, args: &P
         s.mean_radius,
         s.visible_points
     );
+    println!(
+        "  time: eye passes {:.3} s ({} of them), index builds {:.3} s, photons {:.3} s",
+        s.eye_secs, s.eye_passes, s.index_secs, s.photon_secs
+    );
     for skipped in &s.skipped {
         println!("  skipped: {skipped}");
     }

@@ -6,9 +6,9 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use caustic::render::ppm::photon::{PhotonCounts, PhotonSource};
-use caustic::render::ppm::{Control, IndexKind, Ppm, PpmOptions};
+use caustic::render::ppm::{Control, IndexKind, PassOutcome, Ppm, PpmOptions};
 use caustic::render::rng::stream_rng;
-use caustic::render::session::{Command, Frame, RenderSession};
+use caustic::render::session::{Command, Frame, RenderSession, SessionOptions};
 use caustic::scene::Scene;
 use glam::{DVec2, DVec3};
 
@@ -338,6 +338,76 @@ fn session_switches_to_the_ray_tracer_and_reports_a_panic() {
         std::thread::sleep(Duration::from_millis(5));
     }
     assert_eq!(session.failure().as_deref(), Some("boom"));
+    session.shutdown();
+}
+
+/// A pass abandoned part-way (twice in the middle of a stochastic eye pass, once between photon
+/// batches after its eye pass) leaves no trace: the render equals one never interrupted.
+#[test]
+fn an_interrupted_pass_leaves_no_trace() {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    use std::sync::Arc;
+    let scene = cornell_small(0.1);
+    let reference = render_passes(&scene, PpmOptions::default(), 3);
+    let mut ppm = Ppm::new(&scene, PpmOptions::default());
+    assert!(ppm.is_stochastic());
+    // The 500th question (mid eye pass of pass 2) and the 1700th answer "interrupt".
+    let calls = Arc::new(AtomicUsize::new(0));
+    let counter = calls.clone();
+    ppm.set_interrupt(Some(Arc::new(move || {
+        let n = counter.fetch_add(1, Ordering::Relaxed);
+        n == 500 + 1200 || n == 500 + 1200 * 2
+    })));
+    let mut outcomes = Vec::new();
+    // And the caller drops pass 3 once at its first photon batch, after its eye pass.
+    let mut dropped = false;
+    while ppm.stats().passes < 3 {
+        let at_pass_3 = ppm.stats().passes == 2;
+        outcomes.push(ppm.run_pass(&scene, &mut |_| {
+            if at_pass_3 && !dropped {
+                dropped = true;
+                Control::Abort
+            } else {
+                Control::Continue
+            }
+        }));
+    }
+    assert_eq!(
+        outcomes.iter().filter(|o| **o == PassOutcome::Aborted).count(),
+        3,
+        "{outcomes:?}"
+    );
+    assert_eq!(ppm.radiance(), reference);
+}
+
+#[test]
+fn a_new_epoch_starts_with_a_full_size_preview() {
+    let mut scene = cornell_small(0.0);
+    scene.camera.width = 160;
+    scene.camera.height = 120;
+    // Full passes much longer than the preview's 16,384 photons, so the preview is seen.
+    scene.settings.photons_per_pass = 4_000_000;
+    let options = SessionOptions {
+        preview_divisor: Some(4),
+        ..Default::default()
+    };
+    let session = RenderSession::start_with(scene, options, None);
+    let f = next_frame(&session, Duration::from_secs(60));
+    assert!(f.preview, "first frame is not a preview (pass {})", f.pass);
+    assert_eq!((f.epoch, f.pass, f.width, f.height), (0, 0, 160, 120));
+    assert_eq!(f.radiance.len(), 160 * 120);
+    assert!(f.radiance.iter().any(|p| p[0] > 0.0), "black preview");
+    // 4×4 blocks repeat one low-resolution pixel.
+    assert_eq!(f.radiance[0], f.radiance[3 + 3 * 160]);
+    // A restart interrupts the long pass at once and previews the new epoch.
+    session.send(Command::SetAperture(0.1));
+    let f = next_frame(&session, Duration::from_secs(60));
+    assert!(
+        f.preview && f.epoch == 1,
+        "epoch {} preview {}",
+        f.epoch,
+        f.preview
+    );
     session.shutdown();
 }
 

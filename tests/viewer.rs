@@ -350,6 +350,7 @@ fn fixed_frames() -> Vec<Frame> {
             radiance: ppm.radiance().into(),
             radius: Arc::from(radius),
             gathered: Arc::from(gathered),
+            preview: false,
         });
     }
     frames

@@ -265,7 +265,16 @@ fn statistics_ui(viewer: &mut Viewer, ui: &mut egui::Ui) {
                 frame.epoch.to_string(),
                 "Restarts so far: each change that discards the accumulation starts a new epoch",
             );
-            row("Pass", frame.pass.to_string(), "Completed passes in this epoch");
+            let pass = if frame.preview {
+                "preview (1/4 resolution)".to_owned()
+            } else {
+                frame.pass.to_string()
+            };
+            row(
+                "Pass",
+                pass,
+                "Completed passes in this epoch; a new epoch first shows a quick low-resolution preview",
+            );
             if frame.renderer == RendererKind::Ppm {
                 row("Photons", count(frame.photons), "Photons emitted in this epoch");
                 let rate = frame.photons as f64 / frame.stats.elapsed_secs.max(1e-9);

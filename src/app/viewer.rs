@@ -25,6 +25,8 @@ pub const VIEWER_BATCH_PHOTONS: u64 = 16_384;
 /// Photons in the first pass of an epoch (doubling up to photons per pass): the first image of
 /// a new setting appears after one small pass.
 pub const VIEWER_FIRST_PASS_PHOTONS: u64 = 16_384;
+/// A new epoch first shows a preview at this fraction of the resolution.
+pub const VIEWER_PREVIEW_DIVISOR: u32 = 4;
 /// Commands kept in [`Viewer::recent_commands`].
 const COMMAND_LOG: usize = 256;
 
@@ -86,6 +88,7 @@ fn session_options(settings: &ViewerSettings, start_paused: bool) -> SessionOpti
         },
         first_pass_photons: Some(VIEWER_FIRST_PASS_PHOTONS),
         start_paused,
+        preview_divisor: Some(VIEWER_PREVIEW_DIVISOR),
     }
 }
 
@@ -202,16 +205,7 @@ impl Viewer {
 
     /// Sends a command to the render session, remembering it (and when a restart was asked).
     pub fn send(&mut self, command: Command) {
-        let restarts = !matches!(
-            command,
-            Command::SetAlpha(_)
-                | Command::SetPhotonsPerPass(_)
-                | Command::Pause
-                | Command::Resume
-                | Command::Shutdown
-                | Command::Fail(_)
-        );
-        if restarts {
+        if command.restarts() {
             let epoch = self.frame.as_ref().map_or(0, |f| f.epoch);
             self.pending_restart = Some((Instant::now(), epoch));
         }
@@ -430,7 +424,7 @@ impl Viewer {
                 self.pending_restart = None;
             }
         }
-        if frame.renderer == RendererKind::Ppm {
+        if frame.renderer == RendererKind::Ppm && !frame.preview {
             self.convergence
                 .add(frame.pass, frame.elapsed_secs, &frame.radiance);
         }

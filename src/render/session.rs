@@ -13,6 +13,7 @@
 //! can show it and stay up.
 
 use std::panic::AssertUnwindSafe;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::Instant;
@@ -20,7 +21,7 @@ use std::time::Instant;
 use crossbeam_channel::{bounded, unbounded, Receiver, Sender, TryRecvError};
 use glam::DVec3;
 
-use super::ppm::{Control, PassOutcome, Ppm, PpmOptions, PpmStats};
+use super::ppm::{Control, Interrupt, PassOutcome, Ppm, PpmOptions, PpmStats};
 use super::whitted::render_whitted_until;
 use crate::scene::{Camera, RendererKind, Scene};
 
@@ -65,6 +66,27 @@ pub enum Command {
     Fail(String),
 }
 
+impl Command {
+    /// Whether the command discards the accumulation (starts a new epoch) when valid.
+    pub fn restarts(&self) -> bool {
+        !matches!(
+            self,
+            Command::SetAlpha(_)
+                | Command::SetPhotonsPerPass(_)
+                | Command::Pause
+                | Command::Resume
+                | Command::Shutdown
+                | Command::Fail(_)
+        )
+    }
+
+    /// Whether the render thread should drop the pass in progress at once for it: restarts,
+    /// shutdown and failure do; α, photons and pause wait for the next batch.
+    fn interrupts(&self) -> bool {
+        self.restarts() || matches!(self, Command::Shutdown | Command::Fail(_))
+    }
+}
+
 /// One finished pass, as the viewer needs it.
 #[derive(Clone, Debug)]
 pub struct Frame {
@@ -90,6 +112,8 @@ pub struct Frame {
     pub radius: Arc<[f32]>,
     /// Accumulated photon count `N` per pixel (summed over the pixel's slots).
     pub gathered: Arc<[f32]>,
+    /// A quick low-resolution preview of a new epoch (pass 0), enlarged to full size.
+    pub preview: bool,
 }
 
 /// How a session renders, beyond the scene's own settings.
@@ -103,11 +127,17 @@ pub struct SessionOptions {
     pub first_pass_photons: Option<u64>,
     /// Start paused: nothing is rendered until [`Command::Resume`].
     pub start_paused: bool,
+    /// When set, every epoch of photon mapping begins with a preview frame rendered at
+    /// 1/`n` of the resolution (one pass of [`SessionOptions::first_pass_photons`] or 16,384
+    /// photons), so a changed setting shows within a fraction of a full pass.
+    pub preview_divisor: Option<u32>,
 }
 
 /// A render running on its own thread.
 pub struct RenderSession {
     commands: Sender<Command>,
+    /// Set by [`RenderSession::send`] for commands that interrupt the pass in progress.
+    interrupt: Arc<AtomicBool>,
     frames: Receiver<Frame>,
     failure: Arc<Mutex<Option<String>>>,
     thread: Option<JoinHandle<()>>,
@@ -138,11 +168,20 @@ impl RenderSession {
         let stale = frames.clone();
         let failure = Arc::new(Mutex::new(None));
         let failed = failure.clone();
+        let interrupt = Arc::new(AtomicBool::new(false));
+        let interrupt_flag = interrupt.clone();
         let thread = std::thread::Builder::new()
             .name("caustic-render".into())
             .spawn(move || {
                 let outcome = std::panic::catch_unwind(AssertUnwindSafe(|| {
-                    run(scene, options, command_rx, (frame_tx, stale), &waker)
+                    run(
+                        scene,
+                        options,
+                        command_rx,
+                        (frame_tx, stale),
+                        &waker,
+                        interrupt_flag,
+                    )
                 }));
                 if let Err(payload) = outcome {
                     let message = payload
@@ -161,15 +200,21 @@ impl RenderSession {
             .expect("spawn the render thread");
         Self {
             commands,
+            interrupt,
             frames,
             failure,
             thread: Some(thread),
         }
     }
 
-    /// Sends a command (ignored once the thread has ended).
+    /// Sends a command (ignored once the thread has ended). Restarts, shutdown and failure
+    /// also abandon the pass in progress, even mid-way through an eye pass.
     pub fn send(&self, command: Command) {
+        let interrupts = command.interrupts();
         let _ = self.commands.send(command);
+        if interrupts {
+            self.interrupt.store(true, Ordering::Release);
+        }
     }
 
     /// The frames channel: at most one waiting frame, the newest.
@@ -264,15 +309,74 @@ fn offer(frame: Frame, (frames, stale): &(Sender<Frame>, Receiver<Frame>), waker
     }
 }
 
+/// Nearest-neighbour enlargement of a `(sw, sh)` image to `(w, h)`.
+fn enlarge<T: Copy>(src: &[T], (sw, sh): (u32, u32), (w, h): (u32, u32)) -> Arc<[T]> {
+    (0..h)
+        .flat_map(|y| {
+            let sy = (y as u64 * sh as u64 / h as u64) as usize;
+            (0..w).map(move |x| src[sy * sw as usize + (x as u64 * sw as u64 / w as u64) as usize])
+        })
+        .collect()
+}
+
+/// One photon-mapping pass at 1/`divisor` of the resolution, enlarged: the first picture of a
+/// new epoch. `None` when interrupted.
+fn preview(
+    scene: &mut Scene,
+    options: &SessionOptions,
+    divisor: u32,
+    interrupted: &Interrupt,
+    epoch: u64,
+    epoch_start: Instant,
+) -> Option<Frame> {
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    let small = ((w / divisor.max(1)).max(1), (h / divisor.max(1)).max(1));
+    (scene.camera.width, scene.camera.height) = small;
+    let mut ppm = Ppm::new(scene, options.ppm);
+    ppm.photons_per_pass = options
+        .first_pass_photons
+        .unwrap_or(16_384)
+        .min(scene.settings.photons_per_pass);
+    ppm.set_interrupt(Some(interrupted.clone()));
+    let outcome = ppm.run_pass(scene, &mut |_| Control::Continue);
+    (scene.camera.width, scene.camera.height) = (w, h);
+    if outcome != PassOutcome::Completed {
+        return None;
+    }
+    let (radius, gathered) = pixel_statistics(&ppm);
+    let stats = ppm.stats().clone();
+    Some(Frame {
+        epoch,
+        renderer: RendererKind::Ppm,
+        pass: 0,
+        photons: 0,
+        elapsed_secs: epoch_start.elapsed().as_secs_f64(),
+        stats,
+        width: w,
+        height: h,
+        radiance: enlarge(&ppm.radiance(), small, (w, h)),
+        radius: enlarge(&radius, small, (w, h)),
+        gathered: enlarge(&gathered, small, (w, h)),
+        preview: true,
+    })
+}
+
 fn run(
     scene: Scene,
     options: SessionOptions,
     commands: Receiver<Command>,
     channel: (Sender<Frame>, Receiver<Frame>),
     waker: &Option<Waker>,
+    interrupt: Arc<AtomicBool>,
 ) {
+    let interrupted: Interrupt = {
+        let flag = interrupt.clone();
+        Arc::new(move || flag.load(Ordering::Acquire))
+    };
     let mut scene = scene;
     let mut ppm = Ppm::new(&scene, options.ppm);
+    ppm.set_interrupt(Some(interrupted.clone()));
+    let mut preview_due = options.preview_divisor.is_some();
     let mut epoch = 0u64;
     let mut epoch_start = Instant::now();
     let mut paused = options.start_paused;
@@ -285,6 +389,8 @@ fn run(
         let mut shutdown = false;
         // Between batches (and passes): apply commands; while paused or done, wait for them.
         let mut control = |alpha: &mut f64| -> Control {
+            // Whatever interrupted the pass is among the commands drained below.
+            interrupt.store(false, Ordering::Release);
             loop {
                 let next = if (paused || traced) && pending.is_empty() {
                     commands.recv().map_err(|_| TryRecvError::Disconnected)
@@ -325,6 +431,15 @@ fn run(
         let outcome = match (go_on, scene.settings.renderer) {
             (false, _) => None,
             (true, RendererKind::Whitted) if traced => None,
+            (true, RendererKind::Ppm) if preview_due => {
+                preview_due = false;
+                let divisor = options.preview_divisor.unwrap_or(4);
+                if let Some(frame) = preview(&mut scene, &options, divisor, &interrupted, epoch, epoch_start)
+                {
+                    offer(frame, &channel, waker);
+                }
+                None
+            }
             (true, RendererKind::Ppm) => {
                 let target = photons_per_pass.get();
                 ppm.photons_per_pass = match options.first_pass_photons {
@@ -335,7 +450,7 @@ fn run(
             }
             (true, RendererKind::Whitted) => {
                 // Give up the frame as soon as a command waits: it may change the picture.
-                match render_whitted_until(&scene, &|_| {}, &|| !commands.is_empty()) {
+                match render_whitted_until(&scene, &|_| {}, &|| interrupted()) {
                     Some((image, stats)) => {
                         traced = true;
                         let pixels = image.pixels.len();
@@ -355,6 +470,7 @@ fn run(
                             radiance: image.pixels.into(),
                             radius: vec![0.0; pixels].into(),
                             gathered: vec![0.0; pixels].into(),
+                            preview: false,
                         };
                         offer(frame, &channel, waker);
                     }
@@ -376,6 +492,8 @@ fn run(
             epoch_start = Instant::now();
             traced = false;
             ppm = Ppm::new(&scene, options.ppm);
+            ppm.set_interrupt(Some(interrupted.clone()));
+            preview_due = options.preview_divisor.is_some();
             continue;
         }
         if outcome == Some(PassOutcome::Completed) {
@@ -394,6 +512,7 @@ fn run(
                 radiance: ppm.radiance().into(),
                 radius,
                 gathered,
+                preview: false,
             };
             offer(frame, &channel, waker);
         }

@@ -42,7 +42,7 @@ impl HashGrid {
             - DVec3::splat(max_r);
         let inv_cell = 1.0 / cell;
         let cell_of = |p: DVec3| ((p - origin) * inv_cell).floor().as_ivec3();
-        // Each point's cell range (a sphere of radius ≤ cell/2 spans at most 2 cells per axis).
+        // Each point's cell range.
         let ranges: Vec<(IVec3, IVec3)> = points
             .iter()
             .map(|p| {
@@ -51,43 +51,45 @@ impl HashGrid {
             })
             .collect();
         // The distinct buckets of each point's cells: two of its cells may hash to the same
-        // bucket, and a point listed twice there would be handed a photon twice.
-        let buckets_guess = (2 * points.len() * 4).next_power_of_two().max(2);
-        let mask = buckets_guess as u64 - 1;
-        let point_buckets: Vec<Vec<u64>> = ranges
+        // bucket, and a point listed twice there would be handed a photon twice. A sphere spans
+        // 2 cells per axis, 3 when rounding puts its edge a hair past a cell boundary (seen in
+        // the Cornell box), so at most 27.
+        // About two buckets per point keeps the table small enough to stay in cache.
+        let buckets = (2 * points.len()).next_power_of_two().max(2);
+        let mask = buckets as u64 - 1;
+        let pairs: Vec<(u32, u32)> = ranges
             .par_iter()
-            .map(|(lo, hi)| {
-                let mut b = Vec::with_capacity(8);
+            .enumerate()
+            .flat_map_iter(|(k, (lo, hi))| {
+                let mut b = [0u32; 27];
+                let mut n = 0;
                 for z in lo.z..=hi.z {
                     for y in lo.y..=hi.y {
                         for x in lo.x..=hi.x {
-                            b.push(hash(IVec3::new(x, y, z)) & mask);
+                            let h = (hash(IVec3::new(x, y, z)) & mask) as u32;
+                            if !b[..n].contains(&h) {
+                                b[n] = h;
+                                n += 1;
+                            }
                         }
                     }
                 }
-                b.sort_unstable();
-                b.dedup();
-                b
+                (0..n).map(move |i| (b[i], k as u32))
             })
             .collect();
-        let count: usize = point_buckets.iter().map(Vec::len).sum();
-        let buckets = buckets_guess;
+        // Counting sort by bucket; within a bucket points stay in index order.
         let mut starts = vec![0u32; buckets + 1];
-        for bs in &point_buckets {
-            for &b in bs {
-                starts[b as usize + 1] += 1;
-            }
+        for &(b, _) in &pairs {
+            starts[b as usize + 1] += 1;
         }
         for b in 0..buckets {
             starts[b + 1] += starts[b];
         }
         let mut fill = starts.clone();
-        let mut entries = vec![0u32; count];
-        for (k, bs) in point_buckets.iter().enumerate() {
-            for &b in bs {
-                entries[fill[b as usize] as usize] = k as u32;
-                fill[b as usize] += 1;
-            }
+        let mut entries = vec![0u32; pairs.len()];
+        for &(b, k) in &pairs {
+            entries[fill[b as usize] as usize] = k;
+            fill[b as usize] += 1;
         }
         Self {
             origin,
@@ -116,6 +118,53 @@ mod tests {
     use super::*;
     use crate::render::ppm::kd_tree::KdTree;
 
+    /// Rounding can make a sphere whose radius is the largest touch 3 cells along an axis (seen
+    /// in the Cornell box, where many eye-pass points share one wall coordinate and radius):
+    /// all its cells must be entered, or photons in some of them miss it.
+    #[test]
+    fn a_sphere_touching_three_cells_on_an_axis_is_found_everywhere() {
+        let r = 0.8695652173913044;
+        let point = |slot, position| VisiblePoint {
+            slot,
+            position,
+            normal: DVec3::Z,
+            weight: DVec3::ONE,
+            radius2: r * r,
+        };
+        // Find a height where the rounding happens (the build computes the same expression).
+        let inv_cell = 1.0 / (2.0 * r);
+        let span = |y: f64| (((y + r) + r) * inv_cell).floor() - (((y - r) + r) * inv_cell).floor();
+        let y = (1..20)
+            .flat_map(|k| (-8i64..=8).map(move |ulps| (k, ulps)))
+            .map(|(k, ulps)| f64::from_bits((k as f64 * 2.0 * r).to_bits().wrapping_add_signed(ulps)))
+            .find(|&y| span(y) >= 2.0)
+            .expect("a height near a cell boundary touches three cells");
+        let centre = DVec3::new(10.0, y, 4.916823166961748);
+        let mut points = vec![point(0, DVec3::ZERO), point(1, centre)];
+        // Small points elsewhere make the table large enough that cells rarely share buckets.
+        for k in 0..5000u32 {
+            let mut p = point(
+                2 + k,
+                DVec3::new(
+                    20.0 + (k % 10) as f64,
+                    (k / 10 % 10) as f64,
+                    (k / 100) as f64 * 0.2,
+                ),
+            );
+            p.radius2 = 1e-4;
+            points.push(p);
+        }
+        let grid = HashGrid::build(&points);
+        for i in 0..=40 {
+            for j in 0..=40 {
+                let (theta, phi) = (i as f64 / 40.0 * std::f64::consts::PI, j as f64 / 40.0 * 6.3);
+                let d = DVec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
+                let p = centre + d * r * 0.999;
+                assert!(grid.candidates(p).contains(&1), "missed at {p}");
+            }
+        }
+    }
+
     #[test]
     fn grid_and_kd_tree_return_each_point_in_reach_exactly_once() {
         let mut x = 0x1234_5678_9abc_def1u64;
@@ -125,7 +174,11 @@ mod tests {
             x ^= x << 17;
             (x >> 11) as f64 / (1u64 << 53) as f64
         };
-        let points: Vec<VisiblePoint> = (0..3000)
+        // Random radii in a volume, then points on the walls of a box with the largest radius
+        // (a classic PPM eye pass: every point starts with the same radius). Many points then
+        // share the same rounding, and a sphere can touch 3 cells along an axis.
+        const WALL_RADIUS: f64 = 0.35;
+        let mut points: Vec<VisiblePoint> = (0..3000)
             .map(|k| VisiblePoint {
                 slot: k,
                 position: DVec3::new(next(), next(), next()) * 10.0,
@@ -134,10 +187,24 @@ mod tests {
                 radius2: (0.05 + 0.3 * next()).powi(2),
             })
             .collect();
+        for k in 0..3000u32 {
+            let mut position = DVec3::new(next(), next(), next()) * 10.0;
+            position[(k % 3) as usize] = if k % 2 == 0 { 0.0 } else { 10.0 };
+            points.push(VisiblePoint {
+                slot: 3000 + k,
+                position,
+                normal: DVec3::Z,
+                weight: DVec3::ONE,
+                radius2: WALL_RADIUS.powi(2),
+            });
+        }
         let grid = HashGrid::build(&points);
         let kd = KdTree::build(&points);
-        for _ in 0..2000 {
-            let p = DVec3::new(next(), next(), next()) * 10.0;
+        for q in 0..6000 {
+            let mut p = DVec3::new(next(), next(), next()) * 10.0;
+            if q % 2 == 0 {
+                p[q % 3] = if q % 4 == 0 { 0.0 } else { 10.0 };
+            }
             let inside =
                 |k: &u32| (points[*k as usize].position - p).length_squared() <= points[*k as usize].radius2;
             let mut brute: Vec<u32> = (0..points.len() as u32).filter(inside).collect();

@@ -23,6 +23,7 @@ pub mod photon;
 pub mod visible;
 
 use std::f64::consts::PI;
+use std::sync::Arc;
 use std::time::Instant;
 
 use glam::{DVec2, DVec3};
@@ -162,6 +163,10 @@ pub struct PpmStats {
     pub elapsed_secs: f64,
     /// Seconds spent tracing photons.
     pub photon_secs: f64,
+    /// Seconds spent in eye passes (tracing and setting up visible points).
+    pub eye_secs: f64,
+    /// Seconds spent building the spatial index over visible points.
+    pub index_secs: f64,
     /// Eye passes run.
     pub eye_passes: u32,
     /// Work the scene did not need, in words.
@@ -199,11 +204,18 @@ pub struct Ppm {
     slots: Vec<Slot>,
     points: Vec<VisiblePoint>,
     direct: Vec<DVec3>,
+    /// This stochastic pass's directly seen light, added to `direct` when the pass completes.
+    pass_direct: Vec<DVec3>,
     stats: PpmStats,
     width: u32,
     height: u32,
     seed: u64,
+    interrupt: Option<Interrupt>,
 }
+
+/// Asked often during a pass (from any thread); returning true abandons the pass. The render
+/// session sets one that turns true when a restart is waiting.
+pub type Interrupt = Arc<dyn Fn() -> bool + Send + Sync>;
 
 impl Ppm {
     /// A new render of `scene` (its `[render]` settings give α, photons per pass, radius, seed).
@@ -243,6 +255,7 @@ impl Ppm {
             slots: Vec::new(),
             points: Vec::new(),
             direct: vec![DVec3::ZERO; pixels],
+            pass_direct: Vec::new(),
             stats: PpmStats {
                 skipped,
                 ..Default::default()
@@ -250,7 +263,19 @@ impl Ppm {
             width: cam.width,
             height: cam.height,
             seed: scene.settings.seed,
+            interrupt: None,
         }
+    }
+
+    /// Lets `interrupt` abandon a pass mid-way (also during the eye pass, which the control
+    /// callback does not reach). An abandoned pass leaves no trace: running it again gives the
+    /// same result.
+    pub fn set_interrupt(&mut self, interrupt: Option<Interrupt>) {
+        self.interrupt = interrupt;
+    }
+
+    fn interrupted(&self) -> bool {
+        self.interrupt.as_ref().is_some_and(|f| f())
     }
 
     /// Statistics so far.
@@ -268,15 +293,22 @@ impl Ppm {
         (self.width, self.height)
     }
 
-    fn eye_pass(&mut self, scene: &Scene) {
+    /// Traces the eye pass; `false` when interrupted (nothing changed then).
+    fn eye_pass(&mut self, scene: &Scene) -> bool {
         let (w, h) = (self.width as u64, self.height as u64);
         let pass = self.stats.passes as u64;
         let stochastic = self.stochastic;
         let direct_light = self.options.direct_light;
         let seed = self.seed;
+        let interrupt = self.interrupt.as_deref();
+        let skipped = std::sync::atomic::AtomicBool::new(false);
         let results: Vec<visible::EyeResult> = (0..w * h)
             .into_par_iter()
             .map(|i| {
+                if interrupt.is_some_and(|f| f()) {
+                    skipped.store(true, std::sync::atomic::Ordering::Relaxed);
+                    return visible::EyeResult::default();
+                }
                 let (x, y) = (i % w, i / w);
                 let mut rng = stream_rng(seed, streams::EYE, pass * w * h + i);
                 if stochastic {
@@ -305,10 +337,22 @@ impl Ppm {
                 }
             })
             .collect();
-        self.stats.eye_passes += 1;
+        if skipped.into_inner() {
+            return false;
+        }
+        // Classic PPM keeps its one eye pass at once; a stochastic pass's directly seen light
+        // counts only when the pass completes (an abandoned pass is traced again).
+        if !stochastic {
+            self.stats.eye_passes += 1;
+        }
+        self.pass_direct.clear();
         self.points.clear();
         for (pixel, r) in results.into_iter().enumerate() {
-            self.direct[pixel] += r.direct;
+            if stochastic {
+                self.pass_direct.push(r.direct);
+            } else {
+                self.direct[pixel] += r.direct;
+            }
             for mut vp in r.points {
                 if !stochastic {
                     vp.slot = self.slots.len() as u32;
@@ -361,23 +405,35 @@ impl Ppm {
         for vp in &mut self.points {
             vp.radius2 = self.slots[vp.slot as usize].radius2;
         }
+        true
     }
 
     /// Runs one pass: eye pass if needed, photons in batches (calling `control(&mut α)`
     /// between batches; `Abort` drops the pass), then the radius/flux update.
     pub fn run_pass(&mut self, scene: &Scene, control: &mut dyn FnMut(&mut f64) -> Control) -> PassOutcome {
         let start = Instant::now();
+        if self.interrupted() {
+            return PassOutcome::Aborted;
+        }
         if self.stochastic || self.stats.eye_passes == 0 {
-            self.eye_pass(scene);
+            if !self.eye_pass(scene) {
+                return PassOutcome::Aborted;
+            }
         } else {
             for vp in &mut self.points {
                 vp.radius2 = self.slots[vp.slot as usize].radius2;
             }
         }
+        let index_start = Instant::now();
+        self.stats.eye_secs += (index_start - start).as_secs_f64();
         let index = match self.options.index {
             IndexKind::HashGrid => SpatialIndex::Grid(HashGrid::build(&self.points)),
             IndexKind::KdTree => SpatialIndex::Kd(KdTree::build(&self.points)),
         };
+        self.stats.index_secs += index_start.elapsed().as_secs_f64();
+        if self.interrupted() {
+            return PassOutcome::Aborted;
+        }
         let source = PhotonSource::new(scene, self.options.direct_light);
         // Positions and radii packed tightly: the candidate test reads nothing else.
         let reach: Vec<[f64; 4]> = self
@@ -454,6 +510,12 @@ impl Ppm {
                 s.tau = (s.tau + phi[k]) * g;
                 s.n += alpha * mk;
             }
+        }
+        if self.stochastic {
+            for (d, p) in self.direct.iter_mut().zip(self.pass_direct.drain(..)) {
+                *d += p;
+            }
+            self.stats.eye_passes += 1;
         }
         self.stats.passes += 1;
         self.stats.photons += photons;

@@ -41,6 +41,7 @@ pub enum Branching {
 }
 
 /// One eye path's outputs: visible points and light seen directly.
+#[derive(Default)]
 pub struct EyeResult {
     /// Visible points (0, 1, or several with [`Branching::Split`]).
     pub points: Vec<VisiblePoint>,
