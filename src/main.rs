@@ -231,10 +231,7 @@ fn main() -> Result<()> {
             after_passes,
             force,
             bench,
-        } => view(
-            scene,
-            caustic_launch(screenshot, after_passes, force, bench, launched),
-        ),
+        } => view(scene, screenshot, after_passes, force, bench, launched),
         Command::Render {
             scene,
             out,
@@ -313,43 +310,44 @@ fn progress_bar(len: u64, template: &str, message: String) -> Result<indicatif::
     Ok(bar)
 }
 
-/// Options of a viewer launch (only with the `viewer` feature).
+/// Opens the viewer (only with the `viewer` feature).
 #[cfg(feature = "viewer")]
-fn caustic_launch(
+fn view(
+    scene: Option<PathBuf>,
     screenshot: Option<PathBuf>,
     after_passes: u32,
     force: bool,
     bench: bool,
     launched: std::time::Instant,
-) -> caustic::app::LaunchOptions {
+) -> Result<()> {
     if let Some(p) = &screenshot {
         if p.extension().is_none_or(|e| !e.eq_ignore_ascii_case("png")) {
-            eprintln!(
-                "caustic view: --screenshot {}: the screenshot is written as PNG; name it .png",
+            bail!(
+                "--screenshot {}: the screenshot is written as PNG; name it .png",
                 p.display()
             );
-            std::process::exit(2);
         }
     }
-    caustic::app::LaunchOptions {
+    let launch = caustic::app::LaunchOptions {
         screenshot,
         screenshot_after_passes: after_passes.max(1),
         force,
         bench,
         launched,
-    }
-}
-
-#[cfg(feature = "viewer")]
-fn view(scene: Option<PathBuf>, launch: caustic::app::LaunchOptions) -> Result<()> {
+    };
     caustic::app::run(scene, launch)
 }
 
+/// Without the `viewer` feature there is no window to open.
 #[cfg(not(feature = "viewer"))]
-fn caustic_launch(_: Option<PathBuf>, _: u32, _: bool, _: bool, _: std::time::Instant) {}
-
-#[cfg(not(feature = "viewer"))]
-fn view(_: Option<PathBuf>, _: ()) -> Result<()> {
+fn view(
+    _: Option<PathBuf>,
+    _: Option<PathBuf>,
+    _: u32,
+    _: bool,
+    _: bool,
+    _: std::time::Instant,
+) -> Result<()> {
     bail!("this caustic was built without the viewer (the `viewer` feature); use `caustic render`")
 }
 

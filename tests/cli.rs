@@ -222,3 +222,15 @@ fn bad_input_gives_clear_errors() {
     }
     assert!(!Path::new(out_s).exists(), "a failed render left a file");
 }
+
+#[test]
+fn view_flags_are_checked_before_a_window_opens() {
+    let out = caustic(&["view", "--screenshot", "shot.jpg"]);
+    assert!(!out.status.success());
+    let msg = text(&out);
+    assert!(msg.contains("shot.jpg") && msg.contains(".png"), "{msg}");
+    let help = text(&caustic(&["view", "--help"]));
+    for flag in ["--screenshot", "--after-passes", "--bench", "--force"] {
+        assert!(help.contains(flag), "view --help lacks {flag}: {help}");
+    }
+}
