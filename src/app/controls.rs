@@ -50,23 +50,43 @@ fn count(n: u64) -> String {
 pub fn menu_ui(viewer: &mut Viewer, ui: &mut egui::Ui) {
     egui::MenuBar::new().ui(ui, |ui| {
         ui.menu_button("File", |ui| {
-            if ui.button("Open scene...  (Ctrl+O)").clicked() {
+            if ui
+                .button("Open scene...  (Ctrl+O)")
+                .on_hover_text("Open a scene file (.toml); you can also drop one on the window")
+                .clicked()
+            {
                 viewer.pick_scene();
             }
-            if ui.button("Save frame...  (Ctrl+S)").clicked() {
+            if ui
+                .button("Save frame...  (Ctrl+S)")
+                .on_hover_text("Save the current frame: PNG as displayed, or EXR with linear radiance")
+                .clicked()
+            {
                 viewer.save_with_dialog();
             }
             ui.separator();
-            if ui.button("Quit").clicked() {
+            if ui
+                .button("Quit")
+                .on_hover_text("Close the viewer (settings are kept)")
+                .clicked()
+            {
                 ui.ctx().send_viewport_cmd(egui::ViewportCommand::Close);
             }
         });
         ui.menu_button("View", |ui| {
-            if ui.button("Fit  (F)").clicked() {
+            if ui
+                .button("Fit  (F)")
+                .on_hover_text("Scale the image to fit the view")
+                .clicked()
+            {
                 viewer.settings.zoom = Zoom::Fit;
                 viewer.image_view.recentre();
             }
-            if ui.button("1:1  (1)").clicked() {
+            if ui
+                .button("1:1  (1)")
+                .on_hover_text("One image pixel per screen pixel")
+                .clicked()
+            {
                 viewer.settings.zoom = Zoom::Scale(1.0);
                 viewer.image_view.recentre();
             }
@@ -74,16 +94,22 @@ pub fn menu_ui(viewer: &mut Viewer, ui: &mut egui::Ui) {
             for mode in DisplayMode::ALL {
                 if ui
                     .radio_value(&mut viewer.settings.display, mode, mode.label())
+                    .on_hover_text("What the image shows; the probe always reports all three (D cycles)")
                     .changed()
                 {
                     viewer.image_view.invalidate();
                 }
             }
             ui.separator();
-            ui.checkbox(&mut viewer.settings.show_side_panel, "Side panel  (P)");
+            ui.checkbox(&mut viewer.settings.show_side_panel, "Side panel  (P)")
+                .on_hover_text("Show or hide the parameters and statistics");
         });
         ui.menu_button("Help", |ui| {
-            if ui.button("Keys and mouse  (F1)").clicked() {
+            if ui
+                .button("Keys and mouse  (F1)")
+                .on_hover_text("List the shortcuts")
+                .clicked()
+            {
                 viewer.show_help = true;
             }
         });
@@ -154,6 +180,13 @@ pub fn side_panel_ui(viewer: &mut Viewer, ui: &mut egui::Ui) {
             .clicked()
         {
             viewer.send(Command::Restart);
+        }
+        if ui
+            .button("Save frame...")
+            .on_hover_text("Save the current frame: PNG as displayed, or EXR with linear radiance (Ctrl+S)")
+            .clicked()
+        {
+            viewer.save_with_dialog();
         }
     });
 
