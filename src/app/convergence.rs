@@ -1,22 +1,23 @@
 //! A running error estimate for the convergence plot, from successive frames alone (no
 //! reference image).
 //!
-//! If the image after `k` passes were the mean of `k` independent pass estimates with
-//! per-pixel variance σ², then between frames at passes `a < b`
-//! `Var(L_b − L_a) = σ²(1/a − 1/b)` and the error of `L_b` is `σ/√b`, so
+//! If the image after `n` photons were the photon-weighted mean of independent estimates with
+//! per-pixel variance σ² per photon, then between frames at `n_a < n_b` photons
+//! `Var(L_b − L_a) = σ²(1/n_a − 1/n_b)` and the error of `L_b` is `σ/√n_b`, so
 //!
-//! `error(L_b) ≈ RMS(L_b − L_a) / √(b/a − 1)`,
+//! `error(L_b) ≈ RMS(L_b − L_a) / √(n_b/n_a − 1)`,
 //!
-//! reported relative to `RMS(L_b)`. PPM's shrinking radii make later passes count a little
-//! more than a plain mean, so this is an estimate of the noise, not of the bias; it falls as
-//! the render converges and is comparable between settings of the same scene.
+//! reported relative to `RMS(L_b)`. Counting photons rather than passes keeps the estimate
+//! right while the viewer's first passes grow (16,384 photons, doubling). PPM's shrinking radii
+//! make later photons count a little more than a plain mean, so this estimates the noise, not
+//! the bias; it falls as the render converges and is comparable between settings of a scene.
 
 use std::sync::Arc;
 
 /// One frame as the estimator needs it.
 #[derive(Clone)]
 struct Sample {
-    pass: u32,
+    count: u64,
     radiance: Arc<[[f32; 3]]>,
 }
 
@@ -28,10 +29,11 @@ pub struct Convergence {
     pub points: Vec<[f64; 2]>,
 }
 
-/// `RMS(b − a) / √(pass_b/pass_a − 1) / RMS(b)`, or `None` when it is undefined (same pass,
-/// black image, mismatched sizes).
-pub fn relative_error_estimate(pass_a: u32, a: &[[f32; 3]], pass_b: u32, b: &[[f32; 3]]) -> Option<f64> {
-    if pass_a == 0 || pass_b <= pass_a || a.len() != b.len() || a.is_empty() {
+/// `RMS(b − a) / √(n_b/n_a − 1) / RMS(b)` for images after `n_a < n_b` samples (photons, or
+/// passes of equal size), or `None` when it is undefined (no growth, black image, mismatched
+/// sizes).
+pub fn relative_error_estimate(n_a: u64, a: &[[f32; 3]], n_b: u64, b: &[[f32; 3]]) -> Option<f64> {
+    if n_a == 0 || n_b <= n_a || a.len() != b.len() || a.is_empty() {
         return None;
     }
     let (mut diff2, mut norm2) = (0.0f64, 0.0f64);
@@ -45,7 +47,7 @@ pub fn relative_error_estimate(pass_a: u32, a: &[[f32; 3]], pass_b: u32, b: &[[f
     if norm2 <= 0.0 || !diff2.is_finite() || !norm2.is_finite() {
         return None;
     }
-    let ratio = pass_b as f64 / pass_a as f64 - 1.0;
+    let ratio = n_b as f64 / n_a as f64 - 1.0;
     Some((diff2 / ratio).sqrt() / norm2.sqrt())
 }
 
@@ -55,18 +57,18 @@ impl Convergence {
         *self = Self::default();
     }
 
-    /// Takes a frame of the current epoch.
-    pub fn add(&mut self, pass: u32, elapsed_secs: f64, radiance: &Arc<[[f32; 3]]>) {
+    /// Takes a frame of the current epoch made from `photons` photons.
+    pub fn add(&mut self, photons: u64, elapsed_secs: f64, radiance: &Arc<[[f32; 3]]>) {
         if let Some(prev) = &self.previous {
-            if pass <= prev.pass {
+            if photons <= prev.count {
                 return;
             }
-            if let Some(e) = relative_error_estimate(prev.pass, &prev.radiance, pass, radiance) {
+            if let Some(e) = relative_error_estimate(prev.count, &prev.radiance, photons, radiance) {
                 self.points.push([elapsed_secs, e]);
             }
         }
         self.previous = Some(Sample {
-            pass,
+            count: photons,
             radiance: radiance.clone(),
         });
     }
@@ -89,8 +91,8 @@ mod tests {
         let truth = 2.0f32;
         let pixels = 20_000;
         let mut sum = vec![0.0f64; pixels];
-        let mut frames: Vec<(u32, Vec<[f32; 3]>)> = Vec::new();
-        for pass in 1..=32u32 {
+        let mut frames: Vec<(u64, Vec<[f32; 3]>)> = Vec::new();
+        for pass in 1..=32u64 {
             for s in sum.iter_mut() {
                 *s += truth as f64 + (rng.random::<f64>() - 0.5) * 2.0;
             }
@@ -117,6 +119,40 @@ mod tests {
                 b.0
             );
         }
+    }
+
+    /// Passes that grow (the viewer's 16,384-photon start, doubling) are weighed by their
+    /// sample counts: the estimate still matches the true error.
+    #[test]
+    fn estimate_follows_growing_passes() {
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(11);
+        let truth = 1.0f64;
+        let pixels = 20_000;
+        let mut sum = vec![0.0f64; pixels];
+        let mut count = 0u64;
+        let mut frames: Vec<(u64, Vec<[f32; 3]>)> = Vec::new();
+        for pass in 0..6 {
+            let samples = 1u64 << pass; // 1, 2, 4, 8, 16, 32 samples per pixel
+            for s in sum.iter_mut() {
+                for _ in 0..samples {
+                    *s += truth + (rng.random::<f64>() - 0.5) * 2.0;
+                }
+            }
+            count += samples;
+            if pass >= 4 {
+                frames.push((
+                    count,
+                    sum.iter().map(|s| [(s / count as f64) as f32; 3]).collect(),
+                ));
+            }
+        }
+        let ((a, la), (b, lb)) = (&frames[0], &frames[1]);
+        let estimate = relative_error_estimate(*a, la, *b, lb).expect("defined");
+        let actual = (lb.iter().map(|p| (p[0] as f64 - truth).powi(2)).sum::<f64>() / pixels as f64).sqrt();
+        assert!(
+            (estimate / actual - 1.0).abs() < 0.1,
+            "estimate {estimate} vs actual {actual}"
+        );
     }
 
     #[test]

@@ -426,7 +426,7 @@ impl Viewer {
         }
         if frame.renderer == RendererKind::Ppm && !frame.preview {
             self.convergence
-                .add(frame.pass, frame.elapsed_secs, &frame.radiance);
+                .add(frame.photons, frame.elapsed_secs, &frame.radiance);
         }
         self.first_image_secs
             .get_or_insert_with(|| self.created.elapsed().as_secs_f64());
