@@ -24,27 +24,31 @@ struct Cli {
     command: Option<Command>,
 }
 
+/// `caustic view` (also what `caustic` alone runs, with these defaults).
+#[derive(Parser)]
+struct ViewArgs {
+    /// Scene file (TOML).
+    scene: Option<PathBuf>,
+    /// Save a screenshot of the window (PNG) once the render has reached
+    /// --after-passes passes, then close.
+    #[arg(long, value_name = "FILE.png")]
+    screenshot: Option<PathBuf>,
+    /// Passes to wait for before --screenshot.
+    #[arg(long, default_value_t = 4, value_name = "N")]
+    after_passes: u32,
+    /// Replace an existing --screenshot file.
+    #[arg(long)]
+    force: bool,
+    /// Measure launch-to-first-image, UI frame rate while rendering and the latency from
+    /// an aperture change to the new image; print them and close.
+    #[arg(long)]
+    bench: bool,
+}
+
 #[derive(Subcommand)]
 enum Command {
     /// Open the viewer window on a scene (the built-in teapot scene when omitted).
-    View {
-        /// Scene file (TOML).
-        scene: Option<PathBuf>,
-        /// Save a screenshot of the window (PNG) once the render has reached
-        /// --after-passes passes, then close.
-        #[arg(long, value_name = "FILE.png")]
-        screenshot: Option<PathBuf>,
-        /// Passes to wait for before --screenshot.
-        #[arg(long, default_value_t = 4, value_name = "N")]
-        after_passes: u32,
-        /// Replace an existing --screenshot file.
-        #[arg(long)]
-        force: bool,
-        /// Measure launch-to-first-image, UI frame rate while rendering and the latency from
-        /// an aperture change to the new image; print them and close.
-        #[arg(long)]
-        bench: bool,
-    },
+    View(ViewArgs),
     /// Render a scene to an image (PNG: tonemapped sRGB; EXR: linear float).
     Render {
         /// Scene file (TOML); the built-in teapot scene when omitted.
@@ -217,21 +221,12 @@ enum MethodChoice {
 
 fn main() -> Result<()> {
     let launched = std::time::Instant::now();
-    let command = Cli::parse().command.unwrap_or(Command::View {
-        scene: None,
-        screenshot: None,
-        after_passes: 4,
-        force: false,
-        bench: false,
-    });
+    // No subcommand: the viewer with `view`'s own defaults.
+    let command = Cli::parse()
+        .command
+        .unwrap_or_else(|| Command::View(ViewArgs::parse_from(["caustic view"])));
     match command {
-        Command::View {
-            scene,
-            screenshot,
-            after_passes,
-            force,
-            bench,
-        } => view(scene, screenshot, after_passes, force, bench, launched),
+        Command::View(args) => view(args, launched),
         Command::Render {
             scene,
             out,
@@ -312,14 +307,14 @@ fn progress_bar(len: u64, template: &str, message: String) -> Result<indicatif::
 
 /// Opens the viewer (only with the `viewer` feature).
 #[cfg(feature = "viewer")]
-fn view(
-    scene: Option<PathBuf>,
-    screenshot: Option<PathBuf>,
-    after_passes: u32,
-    force: bool,
-    bench: bool,
-    launched: std::time::Instant,
-) -> Result<()> {
+fn view(args: ViewArgs, launched: std::time::Instant) -> Result<()> {
+    let ViewArgs {
+        scene,
+        screenshot,
+        after_passes,
+        force,
+        bench,
+    } = args;
     if let Some(p) = &screenshot {
         if p.extension().is_none_or(|e| !e.eq_ignore_ascii_case("png")) {
             bail!(
@@ -340,14 +335,7 @@ fn view(
 
 /// Without the `viewer` feature there is no window to open.
 #[cfg(not(feature = "viewer"))]
-fn view(
-    _: Option<PathBuf>,
-    _: Option<PathBuf>,
-    _: u32,
-    _: bool,
-    _: bool,
-    _: std::time::Instant,
-) -> Result<()> {
+fn view(_: ViewArgs, _: std::time::Instant) -> Result<()> {
     bail!("this caustic was built without the viewer (the `viewer` feature); use `caustic render`")
 }
 

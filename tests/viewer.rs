@@ -328,30 +328,10 @@ fn fixed_frames() -> Vec<Frame> {
     let mut frames = Vec::new();
     for pass in 1..=4u32 {
         ppm.run_pass(&scene, &mut |_| Control::Continue);
-        let mut stats = ppm.stats().clone();
-        stats.elapsed_secs = pass as f64 * 0.25;
-        stats.photon_secs = pass as f64 * 0.2;
-        let (w, h) = ppm.size();
-        let mut radius = vec![0.0f32; (w * h) as usize];
-        let mut gathered = vec![0.0f32; (w * h) as usize];
-        for s in ppm.slots() {
-            radius[s.pixel as usize] = radius[s.pixel as usize].max(s.radius2.sqrt() as f32);
-            gathered[s.pixel as usize] += s.n as f32;
-        }
-        frames.push(Frame {
-            epoch: 0,
-            renderer: RendererKind::Ppm,
-            pass,
-            photons: stats.photons,
-            elapsed_secs: pass as f64 * 0.25,
-            stats,
-            width: w,
-            height: h,
-            radiance: ppm.radiance().into(),
-            radius: Arc::from(radius),
-            gathered: Arc::from(gathered),
-            preview: false,
-        });
+        let mut frame = Frame::from_ppm(&ppm, 0, pass as f64 * 0.25);
+        frame.stats.elapsed_secs = pass as f64 * 0.25;
+        frame.stats.photon_secs = pass as f64 * 0.2;
+        frames.push(frame);
     }
     frames
 }

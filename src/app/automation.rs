@@ -63,6 +63,20 @@ enum Stage {
     Done,
 }
 
+impl Stage {
+    /// A fresh frame-rate measurement starting `now`, with the renderer running or paused.
+    fn frame_rate(now: Instant, paused: bool) -> Stage {
+        Stage::FrameRate {
+            start: now,
+            frames: 0,
+            worst: Duration::ZERO,
+            last: now,
+            ui_secs: 0.0,
+            paused,
+        }
+    }
+}
+
 /// The state of a scripted run.
 pub struct Automation {
     options: LaunchOptions,
@@ -120,14 +134,7 @@ impl Automation {
                 if viewer.frame().is_some() {
                     self.first_image_secs = Some(self.options.launched.elapsed().as_secs_f64());
                     self.stage = if self.options.bench {
-                        Stage::FrameRate {
-                            start: now,
-                            frames: 0,
-                            worst: Duration::ZERO,
-                            last: now,
-                            ui_secs: 0.0,
-                            paused: false,
-                        }
+                        Stage::frame_rate(now, false)
                     } else {
                         Stage::Screenshot { requested: false }
                     };
@@ -161,14 +168,7 @@ impl Automation {
                     } else {
                         self.fps = Some(figures);
                         p.paused = true;
-                        self.stage = Stage::FrameRate {
-                            start: now,
-                            frames: 0,
-                            worst: Duration::ZERO,
-                            last: now,
-                            ui_secs: 0.0,
-                            paused: true,
-                        };
+                        self.stage = Stage::frame_rate(now, true);
                     }
                     viewer.set_params(p);
                 }

@@ -4,12 +4,14 @@
 use egui::{Color32, ColorImage, Pos2, Rect, Sense, TextureHandle, TextureOptions, Vec2};
 
 use super::settings::{DisplayMode, Zoom};
+use crate::render::film::srgb8;
 use crate::render::session::Frame;
 use crate::render::Image;
 
-/// Zoom limits (image pixels per screen pixel).
-const MIN_SCALE: f32 = 1.0 / 32.0;
-const MAX_SCALE: f32 = 64.0;
+/// Zoom limits (screen pixels per image pixel).
+pub const MIN_SCALE: f32 = 1.0 / 32.0;
+/// See [`MIN_SCALE`].
+pub const MAX_SCALE: f32 = 64.0;
 
 /// Texture and placement of the displayed image.
 pub struct ImageView {
@@ -81,7 +83,7 @@ fn false_colour_image(values: &[f32]) -> Vec<u8> {
 /// The 8-bit RGB picture of a frame in a display mode.
 pub fn display_bytes(frame: &Frame, mode: DisplayMode, exposure_stops: f32) -> Vec<u8> {
     match mode {
-        DisplayMode::Radiance => frame_image(frame).to_srgb8(exposure_stops),
+        DisplayMode::Radiance => srgb8(&frame.radiance, exposure_stops),
         DisplayMode::Radius => false_colour_image(&frame.radius),
         DisplayMode::PhotonCount => false_colour_image(&frame.gathered),
     }

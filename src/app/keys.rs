@@ -2,7 +2,8 @@
 
 use egui::{Key, KeyboardShortcut, Modifiers};
 
-use super::settings::{DisplayMode, Zoom};
+use super::image_view::{MAX_SCALE, MIN_SCALE};
+use super::settings::{DisplayMode, Zoom, EXPOSURE_LIMIT};
 use super::viewer::Viewer;
 
 /// Shortcuts as shown in the help window: (keys, what they do).
@@ -60,16 +61,16 @@ pub fn handle(viewer: &mut Viewer, ctx: &egui::Context) {
     if zoom_in || zoom_out {
         let factor = if zoom_in { 1.25 } else { 0.8 };
         viewer.settings.zoom = match viewer.settings.zoom {
-            Zoom::Scale(s) => Zoom::Scale((s * factor).clamp(1.0 / 32.0, 64.0)),
+            Zoom::Scale(s) => Zoom::Scale((s * factor).clamp(MIN_SCALE, MAX_SCALE)),
             Zoom::Fit => Zoom::Scale(factor),
         };
     }
     if pressed(Key::OpenBracket) {
-        viewer.settings.exposure_stops = (viewer.settings.exposure_stops - 0.5).max(-20.0);
+        viewer.settings.exposure_stops = (viewer.settings.exposure_stops - 0.5).max(-EXPOSURE_LIMIT);
         viewer.image_view.invalidate();
     }
     if pressed(Key::CloseBracket) {
-        viewer.settings.exposure_stops = (viewer.settings.exposure_stops + 0.5).min(20.0);
+        viewer.settings.exposure_stops = (viewer.settings.exposure_stops + 0.5).min(EXPOSURE_LIMIT);
         viewer.image_view.invalidate();
     }
     if pressed(Key::D) {

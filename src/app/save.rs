@@ -20,8 +20,8 @@ pub struct Snapshot {
     pub pass: u32,
 }
 
-/// A write under way: the job, its path and what it writes.
-type Write = (Job<Result<(), String>>, PathBuf, Snapshot);
+/// A write under way: the job, its path and the pass it writes.
+type Write = (Job<Result<(), String>>, PathBuf, u32);
 
 /// Where a save stands.
 #[derive(Default)]
@@ -117,13 +117,14 @@ impl SaveFlow {
     }
 
     fn write(&mut self, ctx: &egui::Context, path: PathBuf, snapshot: Snapshot, overwrite: bool) {
-        let (p, s) = (path.clone(), snapshot.clone());
+        let (p, pass) = (path.clone(), snapshot.pass);
         let job = Job::spawn("caustic-save", ctx, move || {
-            s.image
-                .save(&p, s.exposure_stops, &s.metadata, overwrite)
+            snapshot
+                .image
+                .save(&p, snapshot.exposure_stops, &snapshot.metadata, overwrite)
                 .map_err(|e| e.to_string())
         });
-        self.writing = Some((job, path, snapshot));
+        self.writing = Some((job, path, pass));
     }
 
     /// Advances the flow; returns what finished this frame.
@@ -144,12 +145,12 @@ impl SaveFlow {
                 }
             }
         }
-        if let Some((job, path, snapshot)) = &self.writing {
+        if let Some((job, path, pass)) = &self.writing {
             let event = match job.poll() {
                 Poll::Pending => return None,
                 Poll::Ready(Ok(())) => SaveEvent::Saved {
                     path: path.clone(),
-                    pass: snapshot.pass,
+                    pass: *pass,
                 },
                 Poll::Ready(Err(e)) => SaveEvent::Failed(e),
                 Poll::Lost => SaveEvent::Failed(format!("writing {} failed", path.display())),

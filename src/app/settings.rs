@@ -5,6 +5,9 @@ use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 
+/// Largest exposure, in stops either way, the viewer keeps.
+pub const EXPOSURE_LIMIT: f32 = 20.0;
+
 /// Key under which [`ViewerSettings`] is stored.
 pub const STORAGE_KEY: &str = "caustic.viewer";
 
@@ -95,7 +98,7 @@ impl ViewerSettings {
         if !self.exposure_stops.is_finite() {
             self.exposure_stops = 0.0;
         }
-        self.exposure_stops = self.exposure_stops.clamp(-20.0, 20.0);
+        self.exposure_stops = self.exposure_stops.clamp(-EXPOSURE_LIMIT, EXPOSURE_LIMIT);
         if let Zoom::Scale(s) = self.zoom {
             if !(s.is_finite() && s > 0.0) {
                 self.zoom = Zoom::Fit;

@@ -282,9 +282,9 @@ impl Viewer {
             RendererKind::Ppm => "ppm",
             RendererKind::Whitted => "whitted",
         };
-        let mut scene = self.scene.clone();
-        self.params.apply_to(&mut scene);
-        let mut metadata = image_metadata(&scene, renderer);
+        // The parameters the panel changes are added below; the base pairs (scene file, seed,
+        // size) do not depend on them.
+        let mut metadata = image_metadata(&self.scene, renderer);
         metadata.push(("caustic:passes".into(), frame.pass.to_string()));
         metadata.push(("caustic:photons".into(), frame.photons.to_string()));
         metadata.push(("caustic:alpha".into(), self.params.alpha.to_string()));
@@ -340,12 +340,17 @@ impl Viewer {
         }
     }
 
+    /// File dialogs start in the folder of the last file opened or saved.
+    fn remember_folder_of(&mut self, path: &Path) {
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            self.settings.last_directory = Some(dir.to_path_buf());
+        }
+    }
+
     fn on_save_event(&mut self, event: SaveEvent) {
         self.status = Some(match event {
             SaveEvent::Saved { path, pass } => {
-                if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-                    self.settings.last_directory = Some(dir.to_path_buf());
-                }
+                self.remember_folder_of(&path);
                 Status::Info(format!("Saved pass {pass} to {}", path.display()))
             }
             SaveEvent::Failed(e) => Status::Error(format!("Not saved: {e}")),
@@ -388,9 +393,7 @@ impl Viewer {
                 self.loading = None;
                 match result {
                     Ok(scene) => {
-                        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-                            self.settings.last_directory = Some(dir.to_path_buf());
-                        }
+                        self.remember_folder_of(&path);
                         self.replace_scene(scene);
                         self.scene_error = None;
                         self.status = Some(Status::Info(format!("Opened {}", path.display())));

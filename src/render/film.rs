@@ -67,6 +67,16 @@ impl Format {
     }
 }
 
+/// Tonemapped 8-bit sRGB bytes of linear RGB pixels: linear × 2^stops, clamped,
+/// sRGB-encoded (the viewer tonemaps frames with it without copying them into an [`Image`]).
+pub fn srgb8(pixels: &[[f32; 3]], exposure_stops: f32) -> Vec<u8> {
+    let scale = exposure_stops.exp2();
+    pixels
+        .iter()
+        .flat_map(|p| p.map(|c| (linear_to_srgb((c * scale).clamp(0.0, 1.0)) * 255.0 + 0.5) as u8))
+        .collect()
+}
+
 impl Image {
     /// A black image.
     pub fn new(width: u32, height: u32) -> Self {
@@ -82,14 +92,9 @@ impl Image {
         self.pixels[(y * self.width + x) as usize]
     }
 
-    /// Tonemapped 8-bit sRGB bytes (RGB, rows from the top): linear × 2^stops, clamped,
-    /// sRGB-encoded.
+    /// Tonemapped 8-bit sRGB bytes (RGB, rows from the top): see [`srgb8`].
     pub fn to_srgb8(&self, exposure_stops: f32) -> Vec<u8> {
-        let scale = exposure_stops.exp2();
-        self.pixels
-            .iter()
-            .flat_map(|p| p.map(|c| (linear_to_srgb((c * scale).clamp(0.0, 1.0)) * 255.0 + 0.5) as u8))
-            .collect()
+        srgb8(&self.pixels, exposure_stops)
     }
 
     /// Mean of all pixels' channels (a quick brightness figure for summaries and tests).

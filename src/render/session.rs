@@ -246,22 +246,22 @@ impl Drop for RenderSession {
     }
 }
 
-/// Whether a command discards the accumulation, and is valid for a scene with `patches`.
-fn restarts(command: &Command, patches: usize) -> Option<bool> {
+/// Whether a command's values are valid for a scene with `patches` patches.
+fn valid(command: &Command, patches: usize) -> bool {
     match command {
-        Command::SetAlpha(a) => (*a > 0.0 && *a <= 1.0).then_some(false),
-        Command::SetPhotonsPerPass(n) => (*n > 0).then_some(false),
-        Command::Pause | Command::Resume | Command::Shutdown | Command::Fail(_) => Some(false),
-        Command::SetInitialRadius(r) => r.is_none_or(|r| r.is_finite() && r > 0.0).then_some(true),
-        Command::SetMaxDepth(d) => (1..=64).contains(d).then_some(true),
-        Command::SetCamera(_) | Command::Restart | Command::SetRenderer(_) => Some(true),
-        Command::SetAperture(a) => (a.is_finite() && *a >= 0.0).then_some(true),
-        Command::SetFocalDistance(f) => (f.is_finite() && *f > 0.0).then_some(true),
+        Command::SetAlpha(a) => *a > 0.0 && *a <= 1.0,
+        Command::SetPhotonsPerPass(n) => *n > 0,
+        Command::Pause | Command::Resume | Command::Shutdown | Command::Fail(_) => true,
+        Command::SetInitialRadius(r) => r.is_none_or(|r| r.is_finite() && r > 0.0),
+        Command::SetMaxDepth(d) => (1..=64).contains(d),
+        Command::SetCamera(_) | Command::Restart | Command::SetRenderer(_) => true,
+        Command::SetAperture(a) => a.is_finite() && *a >= 0.0,
+        Command::SetFocalDistance(f) => f.is_finite() && *f > 0.0,
         Command::MoveControlPoint {
             patch,
             index,
             position,
-        } => (*patch < patches && *index < 16 && position.is_finite()).then_some(true),
+        } => *patch < patches && *index < 16 && position.is_finite(),
     }
 }
 
@@ -282,6 +282,29 @@ fn apply_to_scene(scene: &mut Scene, command: Command) {
             scene.geometry.set_control_point(patch, index, position);
         }
         _ => {}
+    }
+}
+
+impl Frame {
+    /// The state of a photon-mapping render as a frame of `epoch`, `elapsed_secs` into it.
+    pub fn from_ppm(ppm: &Ppm, epoch: u64, elapsed_secs: f64) -> Frame {
+        let (width, height) = ppm.size();
+        let stats = ppm.stats().clone();
+        let (radius, gathered) = pixel_statistics(ppm);
+        Frame {
+            epoch,
+            renderer: RendererKind::Ppm,
+            pass: stats.passes,
+            photons: stats.photons,
+            elapsed_secs,
+            stats,
+            width,
+            height,
+            radiance: ppm.radiance().into(),
+            radius,
+            gathered,
+            preview: false,
+        }
     }
 }
 
@@ -343,21 +366,17 @@ fn preview(
     if outcome != PassOutcome::Completed {
         return None;
     }
-    let (radius, gathered) = pixel_statistics(&ppm);
-    let stats = ppm.stats().clone();
+    let frame = Frame::from_ppm(&ppm, epoch, epoch_start.elapsed().as_secs_f64());
     Some(Frame {
-        epoch,
-        renderer: RendererKind::Ppm,
         pass: 0,
         photons: 0,
-        elapsed_secs: epoch_start.elapsed().as_secs_f64(),
-        stats,
         width: w,
         height: h,
-        radiance: enlarge(&ppm.radiance(), small, (w, h)),
-        radius: enlarge(&radius, small, (w, h)),
-        gathered: enlarge(&gathered, small, (w, h)),
+        radiance: enlarge(&frame.radiance, small, (w, h)),
+        radius: enlarge(&frame.radius, small, (w, h)),
+        gathered: enlarge(&frame.gathered, small, (w, h)),
         preview: true,
+        ..frame
     })
 }
 
@@ -405,7 +424,8 @@ fn run(
                         return Control::Abort;
                     }
                 };
-                match (restarts(&command, patches), command) {
+                let restarts = valid(&command, patches).then(|| command.restarts());
+                match (restarts, command) {
                     (None, _) => {} // out of range: ignored (the UI validates before sending)
                     (Some(true), c) => pending.push(c),
                     (Some(false), Command::SetAlpha(a)) => *alpha = a,
@@ -497,23 +517,7 @@ fn run(
             continue;
         }
         if outcome == Some(PassOutcome::Completed) {
-            let (width, height) = ppm.size();
-            let stats = ppm.stats().clone();
-            let (radius, gathered) = pixel_statistics(&ppm);
-            let frame = Frame {
-                epoch,
-                renderer: RendererKind::Ppm,
-                pass: stats.passes,
-                photons: stats.photons,
-                elapsed_secs: epoch_start.elapsed().as_secs_f64(),
-                stats,
-                width,
-                height,
-                radiance: ppm.radiance().into(),
-                radius,
-                gathered,
-                preview: false,
-            };
+            let frame = Frame::from_ppm(&ppm, epoch, epoch_start.elapsed().as_secs_f64());
             offer(frame, &channel, waker);
         }
     }
