@@ -322,3 +322,92 @@ fn rays_leaving_a_surface_do_not_hit_it_again_at_zero() {
     }
     assert!(leaving > 4000);
 }
+
+/// Nearest hits of many random rays through the teapot's bounds: `(t, uv, shape)`.
+fn hits_of(geometry: &caustic::geometry::SceneGeometry, rays: &[Ray]) -> Vec<Option<(f64, DVec2, ShapeRef)>> {
+    rays.par_iter()
+        .map(|r| geometry.intersect(r, f64::INFINITY).map(|h| (h.t, h.uv, h.shape)))
+        .collect()
+}
+
+#[test]
+fn re_preparing_edited_patches_intersects_like_a_fresh_build() {
+    let patches = teapot_from_assets();
+    let build = |patches: &[caustic::geometry::BezierPatch]| {
+        let mut b = GeometryBuilder::default();
+        for (k, p) in patches.iter().enumerate() {
+            b.add_patch(*p, k as u32);
+        }
+        b.build()
+    };
+    let mut rng = rng(77);
+    let rays: Vec<Ray> = (0..100_000)
+        .map(|_| {
+            let target = DVec3::new(
+                rng.random::<f64>() * 7.0 - 3.5,
+                rng.random::<f64>() * 5.0 - 2.5,
+                rng.random::<f64>() * 3.5,
+            );
+            let origin = target - unit_vector(&mut rng) * 12.0;
+            Ray::new(origin, target - origin)
+        })
+        .collect();
+    let leaves = |p: &caustic::geometry::BezierPatch| build(std::slice::from_ref(p)).stats().patch_leaves;
+    // A small move (every patch keeps its leaf count: the BVH is refit), a large one that
+    // bends a patch into more leaves (the BVH is rebuilt), then two patches at once.
+    let cases: [&[(usize, usize, DVec3)]; 3] = [
+        &[(5, 5, DVec3::new(0.0, 0.0, 0.01))],
+        &[(5, 5, DVec3::new(0.0, -2.5, 1.5))],
+        &[
+            (0, 6, DVec3::new(0.3, 0.2, 0.1)),
+            (20, 9, DVec3::new(-0.2, 0.0, 0.4)),
+        ],
+    ];
+    let mut paths = Vec::new();
+    for moves in cases {
+        let mut edited = build(&patches);
+        let mut fresh = patches.clone();
+        let mut edits = Vec::new();
+        for &(patch, index, delta) in moves {
+            fresh[patch].points[index] += delta;
+            edits.push((patch, fresh[patch]));
+        }
+        let update = edited.update_patches(&edits).expect("valid edit");
+        let same_counts = edits.iter().all(|(k, p)| leaves(p) == leaves(&patches[*k]));
+        assert_eq!(update.refit, same_counts, "{moves:?}");
+        paths.push(update.refit);
+        let scratch = build(&fresh);
+        assert_eq!(edited.stats().patch_leaves, scratch.stats().patch_leaves);
+        let (a, b) = (hits_of(&edited, &rays), hits_of(&scratch, &rays));
+        let hits = a.iter().filter(|h| h.is_some()).count();
+        assert!(hits > 20_000, "only {hits} rays hit");
+        for (k, (x, y)) in a.iter().zip(&b).enumerate() {
+            match (x, y) {
+                (Some((ta, uva, sa)), Some((tb, uvb, sb))) => {
+                    assert!(
+                        (ta - tb).abs() <= 1e-9 * tb.abs().max(1.0),
+                        "ray {k}: t {ta} vs {tb}"
+                    );
+                    // Where two patches meet, either may report the seam point.
+                    if sa == sb {
+                        assert!((*uva - *uvb).length() < 1e-6, "ray {k}: uv {uva} vs {uvb}");
+                    }
+                }
+                (None, None) => {}
+                _ => panic!("ray {k}: {x:?} vs {y:?}"),
+            }
+        }
+    }
+    assert_eq!(
+        paths[..2],
+        [true, false],
+        "both the refit and the rebuild were tried"
+    );
+    // Bad edits change nothing.
+    let mut g = build(&patches);
+    let mut bad = patches[3];
+    bad.points[2].x = f64::NAN;
+    assert!(g.update_patches(&[(3, bad)]).is_none());
+    assert!(g.update_patches(&[(32, patches[0])]).is_none());
+    assert!(!g.set_control_point(0, 16, DVec3::ZERO));
+}

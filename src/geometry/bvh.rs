@@ -233,6 +233,25 @@ impl Bvh {
         found
     }
 
+    /// Recomputes every node's bounds from new primitive bounds, keeping the tree's shape
+    /// (a "refit": the usual way to follow deforming geometry without a rebuild). Children
+    /// follow their parent in the depth-first array, so one backward sweep suffices.
+    pub fn refit(&mut self, bounds: &[Aabb]) {
+        for i in (0..self.nodes.len()).rev() {
+            let n = self.nodes[i];
+            self.nodes[i].bounds = if n.count > 0 {
+                let first = n.offset as usize;
+                self.order[first..first + n.count as usize]
+                    .iter()
+                    .fold(Aabb::EMPTY, |b, &p| b.union(bounds[p as usize]))
+            } else {
+                self.nodes[i + 1]
+                    .bounds
+                    .union(self.nodes[n.offset as usize].bounds)
+            };
+        }
+    }
+
     /// Depth of the deepest leaf (for statistics and the stack-size guarantee).
     pub fn depth(&self) -> usize {
         fn walk(bvh: &Bvh, node: usize) -> usize {
@@ -293,6 +312,41 @@ mod tests {
             let brute = boxes.iter().filter_map(entry).fold(f64::INFINITY, f64::min);
             let found = bvh.traverse(&ray, f64::INFINITY, |p, _| entry(&boxes[p as usize]));
             assert_eq!(brute, found);
+        }
+    }
+
+    #[test]
+    fn refit_matches_a_rebuild_for_moved_boxes() {
+        let boxes: Vec<Aabb> = (0..300)
+            .map(|i| {
+                let c = DVec3::new((i % 7) as f64, (i % 11) as f64, (i / 11) as f64);
+                Aabb::new(c, c + 0.5)
+            })
+            .collect();
+        let mut bvh = Bvh::build(&boxes);
+        let moved: Vec<Aabb> = boxes
+            .iter()
+            .enumerate()
+            .map(|(i, b)| {
+                if i % 5 == 0 {
+                    Aabb::new(b.min - 3.0, b.max + 1.0)
+                } else {
+                    *b
+                }
+            })
+            .collect();
+        bvh.refit(&moved);
+        assert_eq!(bvh.bounds(), Bvh::build(&moved).bounds());
+        for k in 0..200 {
+            let o = DVec3::new(-5.0, k as f64 * 0.1 - 2.0, (k % 13) as f64);
+            let ray = Ray::new(o, DVec3::new(1.0, 0.05, 0.02));
+            let inv = safe_inverse(ray.dir);
+            let entry = |b: &Aabb| b.hit_interval(ray.origin, inv, f64::INFINITY).map(|(t0, _)| t0);
+            let brute = moved.iter().filter_map(entry).fold(f64::INFINITY, f64::min);
+            assert_eq!(
+                brute,
+                bvh.traverse(&ray, f64::INFINITY, |p, _| entry(&moved[p as usize]))
+            );
         }
     }
 }

@@ -23,6 +23,6 @@ pub use patch::{PatchHit, PatchLeaf, SubdivisionParams, Window};
 pub use quad::{Plane, Quad};
 pub use ray::{spawn_ray, Ray};
 pub use scene_geometry::{
-    GeometryBuilder, GeometryStats, Hit, PatchMethod, Primitive, SceneGeometry, ShapeRef,
+    GeometryBuilder, GeometryStats, Hit, PatchMethod, PatchUpdate, Primitive, SceneGeometry, ShapeRef,
 };
 pub use sphere::Sphere;

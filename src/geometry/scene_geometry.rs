@@ -201,6 +201,7 @@ impl GeometryBuilder {
         }
         let bvh = Bvh::build(&bounds);
         SceneGeometry {
+            primitive_bounds: bounds,
             spheres: self.spheres,
             quads: self.quads,
             planes: self.planes,
@@ -225,8 +226,11 @@ pub struct SceneGeometry {
     patches: Vec<(BezierPatch, u32)>,
     patch_scales: Vec<f64>,
     leaves: Vec<PatchLeaf>,
-    /// Everything in the BVH; its leaves index this list.
+    /// Everything in the BVH; its leaves index this list. Patch leaves (or whole patches,
+    /// per-ray method) come last, in patch order.
     primitives: Vec<Primitive>,
+    /// Bounds of `primitives[k]`, kept for refitting the BVH after an edit.
+    primitive_bounds: Vec<Aabb>,
     bvh: Bvh,
     patch_method: PatchMethod,
 }
@@ -260,23 +264,106 @@ impl SceneGeometry {
     }
 
     /// Moves control point `index` (0–15, `4i + j`) of patch `patch` to `position` and
-    /// rebuilds the patch's leaves and the BVH. Returns `false` (changing nothing) for an index
-    /// out of range or a non-finite position.
+    /// re-prepares that patch ([`SceneGeometry::update_patches`]). Returns `false` (changing
+    /// nothing) for an index out of range or a non-finite position.
     pub fn set_control_point(&mut self, patch: usize, index: usize, position: DVec3) -> bool {
-        if patch >= self.patches.len() || index >= 16 || !position.is_finite() {
+        let Some((p, _)) = self.patches.get(patch) else {
+            return false;
+        };
+        if index >= 16 {
             return false;
         }
-        self.patches[patch].0.points[index] = position;
-        let builder = GeometryBuilder {
-            spheres: std::mem::take(&mut self.spheres),
-            quads: std::mem::take(&mut self.quads),
-            planes: std::mem::take(&mut self.planes),
-            meshes: std::mem::take(&mut self.meshes),
-            patches: std::mem::take(&mut self.patches),
-            patch_method: self.patch_method,
+        let mut edited = *p;
+        edited.points[index] = position;
+        self.update_patches(&[(patch, edited)]).is_some()
+    }
+
+    /// Replaces patches (`(index, new patch)`; a later entry for the same index wins) and
+    /// re-prepares only them: their leaves are subdivided again, and the BVH is refit when
+    /// every edited patch keeps its number of leaves, or rebuilt over the unchanged bounds of
+    /// everything else when one does not (nothing else is subdivided again). The result
+    /// intersects like a scene built from scratch with the edited patches.
+    ///
+    /// Returns `None` (changing nothing) for an index out of range or a non-finite point.
+    pub fn update_patches(&mut self, edits: &[(usize, BezierPatch)]) -> Option<PatchUpdate> {
+        let valid =
+            |(k, p): &(usize, BezierPatch)| *k < self.patches.len() && p.points.iter().all(|q| q.is_finite());
+        if !edits.iter().all(valid) {
+            return None;
+        }
+        // The last edit of each patch, in patch order.
+        let edits: std::collections::BTreeMap<usize, BezierPatch> = edits.iter().copied().collect();
+        for (&k, p) in &edits {
+            self.patches[k].0 = *p;
+            self.patch_scales[k] = p.bounds().diagonal().length();
+        }
+        let first = self.primitives.len()
+            - match self.patch_method {
+                PatchMethod::Prepared(_) => self.leaves.len(),
+                PatchMethod::PerRay { .. } => self.patches.len(),
+            };
+        let refit = match self.patch_method {
+            PatchMethod::Prepared(params) => {
+                let fresh: Vec<(usize, Vec<PatchLeaf>)> = edits
+                    .iter()
+                    .map(|(&k, p)| (k, subdivide(p, k as u32, &params)))
+                    .collect();
+                self.replace_leaves(first, fresh)
+            }
+            PatchMethod::PerRay { .. } => {
+                for &k in edits.keys() {
+                    let padded = self.patches[k].0.bounds().padded(1e-9 * self.patch_scales[k]);
+                    self.primitive_bounds[first + k] = padded;
+                }
+                true
+            }
         };
-        *self = builder.build();
-        true
+        if refit {
+            self.bvh.refit(&self.primitive_bounds);
+        } else {
+            self.bvh = Bvh::build(&self.primitive_bounds);
+        }
+        Some(PatchUpdate {
+            patches: edits.len(),
+            refit,
+        })
+    }
+
+    /// Puts new leaves for some patches in place (leaves start at primitive `first`); returns
+    /// whether every patch kept its leaf count (the BVH can then be refit).
+    fn replace_leaves(&mut self, first: usize, fresh: Vec<(usize, Vec<PatchLeaf>)>) -> bool {
+        let range = |leaves: &[PatchLeaf], k: u32| {
+            leaves.partition_point(|l| l.patch < k)..leaves.partition_point(|l| l.patch <= k)
+        };
+        let same_counts = fresh
+            .iter()
+            .all(|(k, new)| range(&self.leaves, *k as u32).len() == new.len());
+        if same_counts {
+            for (k, new) in fresh {
+                let r = range(&self.leaves, k as u32);
+                for (i, leaf) in r.zip(new) {
+                    self.primitive_bounds[first + i] = leaf.bounds;
+                    self.leaves[i] = leaf;
+                }
+            }
+            return true;
+        }
+        // Splice, keeping leaves in patch order, as a fresh build lays them out.
+        let mut fresh = fresh.into_iter().peekable();
+        let old = std::mem::take(&mut self.leaves);
+        for k in 0..self.patches.len() as u32 {
+            match fresh.next_if(|(e, _)| *e as u32 == k) {
+                Some((_, new)) => self.leaves.extend(new),
+                None => self.leaves.extend_from_slice(&old[range(&old, k)]),
+            }
+        }
+        self.primitives.truncate(first);
+        self.primitive_bounds.truncate(first);
+        for (k, leaf) in self.leaves.iter().enumerate() {
+            self.primitives.push(Primitive::PatchLeaf(k as u32));
+            self.primitive_bounds.push(leaf.bounds);
+        }
+        false
     }
 
     /// The prepared leaves (empty for the per-ray method).
@@ -437,6 +524,15 @@ impl SceneGeometry {
                 .is_some()
         })
     }
+}
+
+/// What [`SceneGeometry::update_patches`] did.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PatchUpdate {
+    /// Patches re-prepared.
+    pub patches: usize,
+    /// Whether the BVH was refit (every patch kept its leaf count) rather than rebuilt.
+    pub refit: bool,
 }
 
 /// Sizes of a built geometry.

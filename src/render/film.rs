@@ -117,30 +117,13 @@ impl Image {
         overwrite: bool,
     ) -> Result<(), FilmError> {
         let format = Format::from_path(path).ok_or_else(|| FilmError::UnknownFormat(path.to_owned()))?;
-        if !overwrite && path.exists() {
-            return Err(FilmError::Exists(path.to_owned()));
-        }
-        let write_err = |message: String| FilmError::Write {
-            path: path.to_owned(),
-            message,
-        };
-        let file_name = path.file_name().ok_or_else(|| write_err("no file name".into()))?;
-        let tmp = path.with_file_name(format!(".{}.partial", file_name.to_string_lossy()));
-        let result = match format {
-            Format::Png => self.write_png(&tmp, exposure_stops, metadata),
-            Format::Exr => self.write_exr(&tmp, metadata),
-        };
-        if let Err(message) = result {
-            let _ = std::fs::remove_file(&tmp);
-            return Err(write_err(message));
-        }
-        if !overwrite && path.exists() {
-            let _ = std::fs::remove_file(&tmp);
-            return Err(FilmError::Exists(path.to_owned()));
-        }
-        std::fs::rename(&tmp, path).map_err(|e| {
-            let _ = std::fs::remove_file(&tmp);
-            write_err(e.to_string())
+        let result = crate::files::write_atomically(path, overwrite, |tmp| match format {
+            Format::Png => self.write_png(tmp, exposure_stops, metadata),
+            Format::Exr => self.write_exr(tmp, metadata),
+        });
+        result.map_err(|e| match e {
+            crate::files::WriteError::Exists(p) => FilmError::Exists(p),
+            crate::files::WriteError::Failed { path, message } => FilmError::Write { path, message },
         })
     }
 

@@ -23,6 +23,7 @@ use glam::DVec3;
 
 use super::ppm::{Control, Interrupt, PassOutcome, Ppm, PpmOptions, PpmStats};
 use super::whitted::render_whitted_until;
+use crate::geometry::BezierPatch;
 use crate::scene::{Camera, RendererKind, Scene};
 
 /// What the UI (or a test) asks of the renderer.
@@ -265,23 +266,33 @@ fn valid(command: &Command, patches: usize) -> bool {
     }
 }
 
-/// Applies a command that restarts the accumulation to the scene.
-fn apply_to_scene(scene: &mut Scene, command: Command) {
-    match command {
-        Command::SetInitialRadius(r) => scene.settings.initial_radius = r,
-        Command::SetMaxDepth(d) => scene.settings.max_depth = d,
-        Command::SetCamera(c) => scene.camera = c,
-        Command::SetAperture(a) => scene.camera.aperture = a,
-        Command::SetFocalDistance(f) => scene.camera.focal_distance = f,
-        Command::SetRenderer(r) => scene.settings.renderer = r,
-        Command::MoveControlPoint {
-            patch,
-            index,
-            position,
-        } => {
-            scene.geometry.set_control_point(patch, index, position);
+/// Applies the commands that restart the accumulation to the scene, in order. Control-point
+/// moves are gathered so that each edited patch is re-prepared once, however many steps of a
+/// drag arrived together (the latest position of each point wins).
+fn apply_to_scene(scene: &mut Scene, commands: Vec<Command>) {
+    let mut edited: std::collections::BTreeMap<usize, BezierPatch> = Default::default();
+    for command in commands {
+        match command {
+            Command::SetInitialRadius(r) => scene.settings.initial_radius = r,
+            Command::SetMaxDepth(d) => scene.settings.max_depth = d,
+            Command::SetCamera(c) => scene.camera = c,
+            Command::SetAperture(a) => scene.camera.aperture = a,
+            Command::SetFocalDistance(f) => scene.camera.focal_distance = f,
+            Command::SetRenderer(r) => scene.settings.renderer = r,
+            Command::MoveControlPoint {
+                patch,
+                index,
+                position,
+            } => {
+                let current = scene.geometry.patches()[patch].0;
+                edited.entry(patch).or_insert(current).points[index] = position;
+            }
+            _ => {}
         }
-        _ => {}
+    }
+    if !edited.is_empty() {
+        let edits: Vec<(usize, BezierPatch)> = edited.into_iter().collect();
+        scene.geometry.update_patches(&edits);
     }
 }
 
@@ -503,9 +514,7 @@ fn run(
             return;
         }
         if !pending.is_empty() {
-            for c in pending {
-                apply_to_scene(&mut scene, c);
-            }
+            apply_to_scene(&mut scene, pending);
             scene.settings.alpha = ppm.alpha;
             scene.settings.photons_per_pass = photons_per_pass.get();
             epoch += 1;

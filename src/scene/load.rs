@@ -258,6 +258,8 @@ pub(super) fn load_str(text: &str, path: &Path, base_dir: Option<&Path>) -> Resu
         objects,
         lights,
         geometry: builder.build(),
+        text: text.into(),
+        base_dir: base_dir.map(Path::to_path_buf),
     })
 }
 

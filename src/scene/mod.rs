@@ -7,6 +7,7 @@ pub mod format;
 pub mod light;
 mod load;
 pub mod material;
+pub mod save;
 pub mod texture;
 
 use std::path::PathBuf;
@@ -104,6 +105,10 @@ pub struct Scene {
     pub lights: Vec<Light>,
     /// Everything intersectable, behind one BVH.
     pub geometry: SceneGeometry,
+    /// The TOML text the scene was read from (what [`save::scene_toml`] edits).
+    pub text: std::sync::Arc<str>,
+    /// The folder relative file names in `text` resolve against (`None`: built-in data only).
+    pub base_dir: Option<PathBuf>,
 }
 
 /// The scene the program shows when started without a file: the Utah teapot on a checkered
