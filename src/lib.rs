@@ -10,6 +10,8 @@
 //! * [`render`]: the Whitted ray tracer, the film and its PNG/EXR output, random streams.
 //! * [`assets`]: the data the binary carries built in (Newell's teapot).
 //! * [`bench`]: measurement harnesses used by `caustic bench`.
+//! * `app` and `gpu` (feature `viewer`, on by default): the eframe viewer and the wgpu
+//!   control-net overlay it draws; the render core does not depend on them.
 //!
 //! The architecture of record is DESIGN.md (kept beside the project); module docs name the
 //! paper or source of every algorithm they implement.
@@ -20,6 +22,9 @@
 pub mod app;
 pub mod assets;
 pub mod bench;
+pub mod files;
 pub mod geometry;
+#[cfg(feature = "viewer")]
+pub mod gpu;
 pub mod render;
 pub mod scene;

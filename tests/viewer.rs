@@ -387,6 +387,7 @@ fn settings_survive_storage_and_bad_stored_values_are_repaired() {
         direct_light: true,
         index: IndexChoice::KdTree,
         last_directory: Some(PathBuf::from("/some/where")),
+        show_wireframe: false,
     };
     let mut storage = MemoryStorage::default();
     eframe::set_value(&mut storage, STORAGE_KEY, &settings);

@@ -1,14 +1,14 @@
-//! The menu bar, side panel, status bar and dialog windows. Every control edits a copy of the
-//! parameters; [`Viewer::set_params`] turns the differences into session commands.
+//! The menu bar, side panel, status bar and dialog windows. They read the viewer and emit
+//! [`Action`]s; a control edits a copy of a value and asks for the new one.
 
 use egui::{Color32, RichText};
 use egui_plot::{Line, Plot, PlotPoints};
 
+use super::action::Action;
 use super::keys::HELP;
 use super::params::{ALPHA_RANGE, DEPTH_RANGE, PHOTONS_RANGE};
 use super::settings::{DisplayMode, IndexChoice, Zoom};
 use super::viewer::{Status, Viewer};
-use crate::render::session::Command;
 use crate::scene::RendererKind;
 
 /// Seconds as `1.23 s` or `4 min 05 s`.
@@ -47,7 +47,7 @@ fn count(n: u64) -> String {
 }
 
 /// File, View and Help menus.
-pub fn menu_ui(viewer: &mut Viewer, ui: &mut egui::Ui) {
+pub fn menu_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) {
     egui::MenuBar::new().ui(ui, |ui| {
         ui.menu_button("File", |ui| {
             if ui
@@ -55,54 +55,87 @@ pub fn menu_ui(viewer: &mut Viewer, ui: &mut egui::Ui) {
                 .on_hover_text("Open a scene file (.toml); you can also drop one on the window")
                 .clicked()
             {
-                viewer.pick_scene();
+                out.push(Action::PickScene);
             }
             if ui
                 .button("Save frame...  (Ctrl+S)")
                 .on_hover_text("Save the current frame: PNG as displayed, or EXR with linear radiance")
                 .clicked()
             {
-                viewer.save_with_dialog();
+                out.push(Action::SaveFrame);
+            }
+            ui.separator();
+            if ui
+                .button("Save scene  (Ctrl+Shift+S)")
+                .on_hover_text("Write the scene as edited (camera, parameters, control points) to its file, after you confirm; the built-in scene asks where")
+                .clicked()
+            {
+                out.push(Action::SaveScene);
+            }
+            if ui
+                .button("Save scene as...")
+                .on_hover_text("Write the scene as edited to a new .toml file that loads back to the same patches")
+                .clicked()
+            {
+                out.push(Action::SaveSceneAs);
             }
             ui.separator();
             if ui
                 .button("Quit")
-                .on_hover_text("Close the viewer (settings are kept)")
+                .on_hover_text("Close the viewer (settings are kept; unsaved edits are asked about)")
                 .clicked()
             {
-                ui.ctx().send_viewport_cmd(egui::ViewportCommand::Close);
+                out.push(Action::Close);
             }
         });
+        super::edit_panel::edit_menu_ui(viewer, ui, out);
         ui.menu_button("View", |ui| {
             if ui
                 .button("Fit  (F)")
                 .on_hover_text("Scale the image to fit the view")
                 .clicked()
             {
-                viewer.settings.zoom = Zoom::Fit;
-                viewer.image_view.recentre();
+                out.push(Action::SetZoom {
+                    zoom: Zoom::Fit,
+                    recentre: true,
+                });
             }
             if ui
                 .button("1:1  (1)")
                 .on_hover_text("One image pixel per screen pixel")
                 .clicked()
             {
-                viewer.settings.zoom = Zoom::Scale(1.0);
-                viewer.image_view.recentre();
+                out.push(Action::SetZoom {
+                    zoom: Zoom::Scale(1.0),
+                    recentre: true,
+                });
             }
             ui.separator();
+            let mut display = viewer.settings.display;
             for mode in DisplayMode::ALL {
-                if ui
-                    .radio_value(&mut viewer.settings.display, mode, mode.label())
-                    .on_hover_text("What the image shows; the probe always reports all three (D cycles)")
-                    .changed()
-                {
-                    viewer.image_view.invalidate();
-                }
+                ui.radio_value(&mut display, mode, mode.label())
+                    .on_hover_text("What the image shows; the probe always reports all three (D cycles)");
+            }
+            if display != viewer.settings.display {
+                out.push(Action::SetDisplay(display));
             }
             ui.separator();
-            ui.checkbox(&mut viewer.settings.show_side_panel, "Side panel  (P)")
-                .on_hover_text("Show or hide the parameters and statistics");
+            let mut nets = viewer.settings.show_wireframe;
+            if ui
+                .checkbox(&mut nets, "Control nets  (W)")
+                .on_hover_text("Draw the patches' control nets and boundary curves over the image, to pick and drag")
+                .changed()
+            {
+                out.push(Action::ShowWireframe(nets));
+            }
+            let mut side = viewer.settings.show_side_panel;
+            if ui
+                .checkbox(&mut side, "Side panel  (P)")
+                .on_hover_text("Show or hide the parameters and statistics")
+                .changed()
+            {
+                out.push(Action::ShowSidePanel(side));
+            }
         });
         ui.menu_button("Help", |ui| {
             if ui
@@ -110,7 +143,7 @@ pub fn menu_ui(viewer: &mut Viewer, ui: &mut egui::Ui) {
                 .on_hover_text("List the shortcuts")
                 .clicked()
             {
-                viewer.show_help = true;
+                out.push(Action::ShowHelp(true));
             }
         });
         ui.separator();
@@ -120,7 +153,7 @@ pub fn menu_ui(viewer: &mut Viewer, ui: &mut egui::Ui) {
 }
 
 /// Pixel probe and the last message.
-pub fn status_ui(viewer: &mut Viewer, ui: &mut egui::Ui) {
+pub fn status_ui(viewer: &Viewer, ui: &mut egui::Ui) {
     ui.horizontal(|ui| {
         match (&viewer.probe, &viewer.frame) {
             (Some(p), Some(f)) => {
@@ -152,7 +185,7 @@ pub fn status_ui(viewer: &mut Viewer, ui: &mut egui::Ui) {
 }
 
 /// Parameters, actions, statistics and the convergence plot.
-pub fn side_panel_ui(viewer: &mut Viewer, ui: &mut egui::Ui) {
+pub fn side_panel_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) {
     let mut p = viewer.params.clone();
     let ranges = viewer.ranges;
     let photon_mapping = p.renderer == RendererKind::Ppm;
@@ -179,26 +212,28 @@ pub fn side_panel_ui(viewer: &mut Viewer, ui: &mut egui::Ui) {
             .on_hover_text("Discard the accumulated image and start again (R)")
             .clicked()
         {
-            viewer.send(Command::Restart);
+            out.push(Action::Restart);
         }
         if ui
             .button("Save frame...")
             .on_hover_text("Save the current frame: PNG as displayed, or EXR with linear radiance (Ctrl+S)")
             .clicked()
         {
-            viewer.save_with_dialog();
+            out.push(Action::SaveFrame);
         }
     });
 
-    let exposure = ui
+    let mut exposure = viewer.settings.exposure_stops;
+    if ui
         .add(
-            egui::Slider::new(&mut viewer.settings.exposure_stops, -10.0..=10.0)
+            egui::Slider::new(&mut exposure, -10.0..=10.0)
                 .step_by(0.1)
                 .text("Exposure"),
         )
-        .on_hover_text("Display brightness in stops: radiance × 2^stops, then sRGB ([ and ])");
-    if exposure.changed() {
-        viewer.image_view.invalidate();
+        .on_hover_text("Display brightness in stops: radiance × 2^stops, then sRGB ([ and ])")
+        .changed()
+    {
+        out.push(Action::SetExposure(exposure));
     }
 
     ui.separator();
@@ -227,8 +262,7 @@ pub fn side_panel_ui(viewer: &mut Viewer, ui: &mut egui::Ui) {
             .on_hover_text("Point and spot lights lit exactly with shadow rays; their photons count only after the first bounce (caustics kept). Restarts.")
             .changed()
         {
-            viewer.settings.direct_light = direct;
-            viewer.restart_renderer();
+            out.push(Action::SetDirectLight(direct));
         }
         let mut index = viewer.settings.index;
         ui.horizontal(|ui| {
@@ -239,8 +273,7 @@ pub fn side_panel_ui(viewer: &mut Viewer, ui: &mut egui::Ui) {
                 .on_hover_text("The seed report's kd-tree");
         });
         if index != viewer.settings.index {
-            viewer.settings.index = index;
-            viewer.restart_renderer();
+            out.push(Action::SetIndex(index));
         }
     });
 
@@ -264,14 +297,18 @@ pub fn side_panel_ui(viewer: &mut Viewer, ui: &mut egui::Ui) {
         .on_hover_text("Most mirror/glass bounces followed by eye rays and photons. Restarts.");
 
     if p != viewer.params {
-        viewer.set_params(p);
+        out.push(Action::SetParams(p));
     }
 
+    if !viewer.patches().is_empty() {
+        ui.separator();
+        super::edit_panel::edit_panel_ui(viewer, ui, out);
+    }
     ui.separator();
     statistics_ui(viewer, ui);
 }
 
-fn statistics_ui(viewer: &mut Viewer, ui: &mut egui::Ui) {
+fn statistics_ui(viewer: &Viewer, ui: &mut egui::Ui) {
     ui.heading("Statistics");
     if viewer.restart_pending() {
         let what = match viewer.params.renderer {
@@ -369,8 +406,8 @@ fn statistics_ui(viewer: &mut Viewer, ui: &mut egui::Ui) {
     }
 }
 
-/// Help, scene error, renderer failure and overwrite windows.
-pub fn dialogs_ui(viewer: &mut Viewer, ctx: &egui::Context) {
+/// Help, scene error, renderer failure, overwrite and unsaved-edits windows.
+pub fn dialogs_ui(viewer: &Viewer, ctx: &egui::Context, out: &mut Vec<Action>) {
     if viewer.show_help {
         let mut open = true;
         egui::Window::new("Keys and mouse")
@@ -387,24 +424,25 @@ pub fn dialogs_ui(viewer: &mut Viewer, ctx: &egui::Context) {
                 ui.separator();
                 ui.label("Hover over any control for what it does.");
             });
-        viewer.show_help = open;
+        if !open {
+            out.push(Action::ShowHelp(false));
+        }
     }
-    if let Some(error) = viewer.scene_error.clone() {
+    if let Some(error) = &viewer.scene_error {
         let mut open = true;
+        let mut ok = false;
         egui::Window::new("Could not open scene")
             .open(&mut open)
             .show(ctx, |ui| {
                 ui.colored_label(Color32::from_rgb(255, 110, 90), error);
                 ui.label("The previous scene is still rendering.");
-                if ui.button("OK").clicked() {
-                    viewer.scene_error = None;
-                }
+                ok = ui.button("OK").clicked();
             });
-        if !open {
-            viewer.scene_error = None;
+        if !open || ok {
+            out.push(Action::DismissSceneError);
         }
     }
-    if let Some(failure) = viewer.render_failure.clone() {
+    if let Some(failure) = &viewer.render_failure {
         egui::Window::new("The renderer stopped").show(ctx, |ui| {
             ui.colored_label(
                 Color32::from_rgb(255, 110, 90),
@@ -412,29 +450,71 @@ pub fn dialogs_ui(viewer: &mut Viewer, ctx: &egui::Context) {
             );
             ui.label("The last image is kept; you can save it or start the renderer again.");
             if ui.button("Restart renderer").clicked() {
-                viewer.restart_renderer();
+                out.push(Action::RestartRenderer);
             }
         });
     }
-    if let Some(path) = viewer.confirming_overwrite().map(|p| p.display().to_string()) {
-        let modal = egui::Modal::new(egui::Id::unique("caustic-overwrite")).show(ctx, |ui| {
-            ui.heading("Replace file?");
-            ui.label(format!(
-                "{path} already exists. Replace it with the current frame?"
-            ));
+    if let Some(path) = viewer.confirming_overwrite() {
+        let text = format!(
+            "{} already exists. Replace it with the current frame?",
+            path.display()
+        );
+        if let Some(replace) = replace_question(ctx, "caustic-overwrite", &text) {
+            out.push(Action::ConfirmFrameOverwrite(replace));
+        }
+    }
+    if let Some(path) = &viewer.confirm_scene_overwrite {
+        let text = format!("Replace {} with the scene as edited?", path.display());
+        if let Some(replace) = replace_question(ctx, "caustic-scene-overwrite", &text) {
+            out.push(Action::ConfirmSceneOverwrite(replace));
+        }
+    }
+    if viewer.unsaved_question.is_some() {
+        let modal = egui::Modal::new(egui::Id::unique("caustic-unsaved")).show(ctx, |ui| {
+            ui.heading("Unsaved edits");
+            ui.label("The scene has edits that are not saved. Save them first?");
             ui.horizontal(|ui| {
-                if ui.button("Replace").clicked() {
-                    Some(true)
+                if ui
+                    .button("Save")
+                    .on_hover_text("Save the scene, then go on")
+                    .clicked()
+                {
+                    Some(Some(false))
+                } else if ui
+                    .button("Discard")
+                    .on_hover_text("Go on without saving")
+                    .clicked()
+                {
+                    Some(Some(true))
                 } else if ui.button("Cancel").clicked() {
-                    Some(false)
+                    Some(None)
                 } else {
                     None
                 }
             })
             .inner
         });
-        if let Some(answer) = modal.inner.or(modal.should_close().then_some(false)) {
-            viewer.confirm_overwrite(answer);
+        if let Some(choice) = modal.inner.or(modal.should_close().then_some(None)) {
+            out.push(Action::ResolveUnsaved(choice));
         }
     }
+}
+
+/// A "Replace file?" modal: `Some(true)` replace, `Some(false)` cancel, `None` not answered.
+fn replace_question(ctx: &egui::Context, id: &str, text: &str) -> Option<bool> {
+    let modal = egui::Modal::new(egui::Id::unique(id)).show(ctx, |ui| {
+        ui.heading("Replace file?");
+        ui.label(text);
+        ui.horizontal(|ui| {
+            if ui.button("Replace").clicked() {
+                Some(true)
+            } else if ui.button("Cancel").clicked() {
+                Some(false)
+            } else {
+                None
+            }
+        })
+        .inner
+    });
+    modal.inner.or(modal.should_close().then_some(false))
 }

@@ -22,6 +22,20 @@ pub struct ImageView {
     dirty: bool,
 }
 
+/// What [`ImageView::ui`] did this frame.
+pub struct ImageResponse {
+    /// The view's response (clicks and drags over it).
+    pub response: egui::Response,
+    /// The view (points).
+    pub view: Rect,
+    /// Where the image was drawn (points).
+    pub image: Rect,
+    /// The pixel under the cursor.
+    pub probe: Option<Probe>,
+    /// The zoom after this frame's wheel, drag and double-click.
+    pub zoom: Zoom,
+}
+
 /// Where the cursor is over the image.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Probe {
@@ -132,13 +146,15 @@ impl ImageView {
         }
     }
 
-    /// Shows the image, handles zoom and pan, and returns the pixel under the cursor.
-    pub fn ui(&mut self, ui: &mut egui::Ui, zoom: &mut Zoom, size: [u32; 2]) -> Option<Probe> {
+    /// Shows the image and handles wheel zoom, double-click fit and (when `pan_enabled`) a
+    /// left drag that pans; returns where everything went and the zoom it leaves.
+    pub fn ui(&mut self, ui: &mut egui::Ui, zoom: Zoom, size: [u32; 2], pan_enabled: bool) -> ImageResponse {
+        let mut zoom = zoom;
         let (rect, response) = ui.allocate_exact_size(ui.available_size(), Sense::click_and_drag());
         ui.painter().rect_filled(rect, 0.0, Color32::from_gray(24));
         let size_px = Vec2::new(size[0] as f32, size[1] as f32);
         let ppp = ui.ctx().pixels_per_point();
-        let mut scale = Self::scale(*zoom, rect.size(), size_px, ppp);
+        let mut scale = Self::scale(zoom, rect.size(), size_px, ppp);
 
         // Wheel (or pinch) zooms about the cursor; dragging pans.
         if let Some(pointer) = response.hover_pos() {
@@ -146,40 +162,49 @@ impl ImageView {
             let factor = pinch * (scroll / 200.0).exp();
             if (factor - 1.0).abs() > 1e-4 {
                 let new_scale = (scale * ppp * factor).clamp(MIN_SCALE, MAX_SCALE) / ppp;
-                let centre = rect.center() + self.pan_for(*zoom);
+                let centre = rect.center() + self.pan_for(zoom);
                 let to_pointer = pointer - centre;
                 self.pan = (centre + to_pointer * (1.0 - new_scale / scale)) - rect.center();
-                *zoom = Zoom::Scale(new_scale * ppp);
+                zoom = Zoom::Scale(new_scale * ppp);
                 scale = new_scale;
             }
         }
-        if response.dragged() {
-            if *zoom == Zoom::Fit {
-                *zoom = Zoom::Scale(scale * ppp);
+        if pan_enabled && response.dragged_by(egui::PointerButton::Primary) {
+            if zoom == Zoom::Fit {
+                zoom = Zoom::Scale(scale * ppp);
                 self.pan = Vec2::ZERO;
             }
             self.pan += response.drag_delta();
         }
         if response.double_clicked() {
-            *zoom = Zoom::Fit;
+            zoom = Zoom::Fit;
         }
 
-        let centre = rect.center() + self.pan_for(*zoom);
-        let image_rect = Rect::from_center_size(centre, size_px * scale);
+        let centre = rect.center() + self.pan_for(zoom);
+        let image_rect =
+            Rect::from_center_size(centre, size_px * Self::scale(zoom, rect.size(), size_px, ppp));
         if let Some(texture) = &self.texture {
             let uv = Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0));
             ui.painter_at(rect)
                 .image(texture.id(), image_rect, uv, Color32::WHITE);
         }
-        let pointer = response.hover_pos()?;
-        if !image_rect.contains(pointer) {
-            return None;
+        let probe = response
+            .hover_pos()
+            .filter(|p| image_rect.contains(*p))
+            .map(|pointer| {
+                let local = (pointer - image_rect.min) / (image_rect.width() / size_px.x);
+                Probe {
+                    x: (local.x as u32).min(size[0].saturating_sub(1)),
+                    y: (local.y as u32).min(size[1].saturating_sub(1)),
+                }
+            });
+        ImageResponse {
+            response,
+            view: rect,
+            image: image_rect,
+            probe,
+            zoom,
         }
-        let local = (pointer - image_rect.min) / scale;
-        Some(Probe {
-            x: (local.x as u32).min(size[0].saturating_sub(1)),
-            y: (local.y as u32).min(size[1].saturating_sub(1)),
-        })
     }
 
     fn pan_for(&self, zoom: Zoom) -> Vec2 {

@@ -1,21 +1,47 @@
-//! Keyboard shortcuts (listed in the help window from the same table).
+//! Keyboard shortcuts (listed in the help window from the same table), as actions.
 
-use egui::{Key, KeyboardShortcut, Modifiers};
+use egui::{Key, KeyboardShortcut, Modifiers, Vec2};
 
+use super::action::Action;
 use super::image_view::{MAX_SCALE, MIN_SCALE};
-use super::settings::{DisplayMode, Zoom, EXPOSURE_LIMIT};
+use super::settings::{DisplayMode, Zoom};
 use super::viewer::Viewer;
 
-/// Shortcuts as shown in the help window: (keys, what they do).
+/// Shortcuts and mouse gestures as shown in the help window: (keys, what they do).
 pub const HELP: &[(&str, &str)] = &[
     ("Ctrl+O", "Open a scene (or drop a .toml file on the window)"),
     ("Ctrl+S", "Save the current frame (PNG as displayed, EXR linear)"),
+    ("Ctrl+Shift+S", "Save the scene as edited (TOML)"),
+    (
+        "Ctrl+Z / Ctrl+Shift+Z",
+        "Undo / redo an edit (control points, camera)",
+    ),
     ("Space", "Pause / resume rendering"),
     ("R", "Restart the render"),
     ("F", "Fit the image to the view (also: double-click)"),
     ("1", "Show the image 1:1"),
     ("+ / -", "Zoom in / out (also: mouse wheel over the image)"),
-    ("Drag", "Pan the image"),
+    (
+        "Left drag",
+        "Pan the image; on a control point: move it (and the selection)",
+    ),
+    (
+        "Ctrl + left drag",
+        "On a control point: move it along the line of sight",
+    ),
+    (
+        "Click / Shift+click",
+        "Select a control point / add it to the selection",
+    ),
+    ("A", "Select the whole patch of the selected point"),
+    ("Esc", "Select nothing"),
+    ("Arrows (Shift: ×10)", "Nudge the selection in the image plane"),
+    (
+        "Right drag",
+        "Orbit the camera (Shift: pan, Ctrl: dolly; middle drag pans)",
+    ),
+    ("C", "Frame the selection (or all patches) with the camera"),
+    ("W", "Show / hide the control nets"),
     ("[ / ]", "Exposure down / up by half a stop"),
     ("D", "Next display mode: radiance, radius, photon count"),
     ("P", "Show / hide the side panel"),
@@ -24,35 +50,54 @@ pub const HELP: &[(&str, &str)] = &[
 
 const OPEN: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::O);
 const SAVE: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::S);
+const SAVE_SCENE: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND.plus(Modifiers::SHIFT), Key::S);
+const UNDO: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::Z);
+const REDO: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND.plus(Modifiers::SHIFT), Key::Z);
+const REDO_Y: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::Y);
 
-/// Applies the shortcuts pressed this frame (plain keys only when no widget has focus).
-pub fn handle(viewer: &mut Viewer, ctx: &egui::Context) {
-    if ctx.input_mut(|i| i.consume_shortcut(&OPEN)) {
-        viewer.pick_scene();
+/// The actions of the shortcuts pressed this frame (plain keys only when no widget has
+/// focus).
+pub fn handle(viewer: &Viewer, ctx: &egui::Context, out: &mut Vec<Action>) {
+    let shortcut = |s: &KeyboardShortcut| ctx.input_mut(|i| i.consume_shortcut(s));
+    // With Shift before without: egui matches Ctrl+Z also when Shift is held.
+    if shortcut(&SAVE_SCENE) {
+        out.push(Action::SaveScene);
+    } else if shortcut(&SAVE) {
+        out.push(Action::SaveFrame);
     }
-    if ctx.input_mut(|i| i.consume_shortcut(&SAVE)) {
-        viewer.save_with_dialog();
+    if shortcut(&OPEN) {
+        out.push(Action::PickScene);
+    }
+    if shortcut(&REDO) || shortcut(&REDO_Y) {
+        out.push(Action::Redo);
+    } else if shortcut(&UNDO) {
+        out.push(Action::Undo);
     }
     // Plain keys belong to a focused widget (Space clicks a focused button, text fields type).
     if ctx.egui_wants_keyboard_input() || ctx.memory(|m| m.focused().is_some()) {
         return;
     }
     let pressed = |key: Key| ctx.input_mut(|i| i.consume_key(Modifiers::NONE, key));
+    let settings = &viewer.settings;
     if pressed(Key::Space) {
         let mut p = viewer.params.clone();
         p.paused = !p.paused;
-        viewer.set_params(p);
+        out.push(Action::SetParams(p));
     }
     if pressed(Key::R) {
-        viewer.send(crate::render::session::Command::Restart);
+        out.push(Action::Restart);
     }
     if pressed(Key::F) {
-        viewer.settings.zoom = Zoom::Fit;
-        viewer.image_view.recentre();
+        out.push(Action::SetZoom {
+            zoom: Zoom::Fit,
+            recentre: true,
+        });
     }
     if pressed(Key::Num1) {
-        viewer.settings.zoom = Zoom::Scale(1.0);
-        viewer.image_view.recentre();
+        out.push(Action::SetZoom {
+            zoom: Zoom::Scale(1.0),
+            recentre: true,
+        });
     }
     let zoom_in = ctx.input_mut(|i| {
         i.consume_key(Modifiers::NONE, Key::Plus) || i.consume_key(Modifiers::NONE, Key::Equals)
@@ -60,32 +105,64 @@ pub fn handle(viewer: &mut Viewer, ctx: &egui::Context) {
     let zoom_out = pressed(Key::Minus);
     if zoom_in || zoom_out {
         let factor = if zoom_in { 1.25 } else { 0.8 };
-        viewer.settings.zoom = match viewer.settings.zoom {
+        let zoom = match settings.zoom {
             Zoom::Scale(s) => Zoom::Scale((s * factor).clamp(MIN_SCALE, MAX_SCALE)),
             Zoom::Fit => Zoom::Scale(factor),
         };
+        out.push(Action::SetZoom {
+            zoom,
+            recentre: false,
+        });
     }
     if pressed(Key::OpenBracket) {
-        viewer.settings.exposure_stops = (viewer.settings.exposure_stops - 0.5).max(-EXPOSURE_LIMIT);
-        viewer.image_view.invalidate();
+        out.push(Action::SetExposure(settings.exposure_stops - 0.5));
     }
     if pressed(Key::CloseBracket) {
-        viewer.settings.exposure_stops = (viewer.settings.exposure_stops + 0.5).min(EXPOSURE_LIMIT);
-        viewer.image_view.invalidate();
+        out.push(Action::SetExposure(settings.exposure_stops + 0.5));
     }
     if pressed(Key::D) {
         let modes = DisplayMode::ALL;
-        let at = modes
-            .iter()
-            .position(|m| *m == viewer.settings.display)
-            .unwrap_or(0);
-        viewer.settings.display = modes[(at + 1) % modes.len()];
-        viewer.image_view.invalidate();
+        let at = modes.iter().position(|m| *m == settings.display).unwrap_or(0);
+        out.push(Action::SetDisplay(modes[(at + 1) % modes.len()]));
     }
     if pressed(Key::P) {
-        viewer.settings.show_side_panel = !viewer.settings.show_side_panel;
+        out.push(Action::ShowSidePanel(!settings.show_side_panel));
     }
     if pressed(Key::F1) {
-        viewer.show_help = !viewer.show_help;
+        out.push(Action::ShowHelp(!viewer.show_help));
+    }
+    editing_keys(viewer, ctx, out);
+}
+
+/// Keys of the control-net editor.
+fn editing_keys(viewer: &Viewer, ctx: &egui::Context, out: &mut Vec<Action>) {
+    let pressed = |key: Key| ctx.input_mut(|i| i.consume_key(Modifiers::NONE, key));
+    if pressed(Key::W) {
+        out.push(Action::ShowWireframe(!viewer.settings.show_wireframe));
+    }
+    if pressed(Key::C) {
+        out.push(Action::FrameSelection);
+    }
+    let selected = viewer.editor.selection.first().copied();
+    if pressed(Key::Escape) && selected.is_some() {
+        out.push(Action::ClearSelection);
+    }
+    if pressed(Key::A) {
+        out.extend(selected.map(|r| Action::SelectPatch(r.patch)));
+    }
+    if selected.is_none() {
+        return;
+    }
+    for (key, step) in [
+        (Key::ArrowLeft, Vec2::new(-1.0, 0.0)),
+        (Key::ArrowRight, Vec2::new(1.0, 0.0)),
+        (Key::ArrowUp, Vec2::new(0.0, -1.0)),
+        (Key::ArrowDown, Vec2::new(0.0, 1.0)),
+    ] {
+        if pressed(key) {
+            out.push(Action::Nudge(step * 2.0));
+        } else if ctx.input_mut(|i| i.consume_key(Modifiers::SHIFT, key)) {
+            out.push(Action::Nudge(step * 20.0));
+        }
     }
 }

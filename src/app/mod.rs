@@ -5,26 +5,38 @@
 //! Built with the `viewer` feature (on by default); the render core never depends on it.
 //!
 //! - [`viewer`]: state and layout ([`Viewer::ui`] is what eframe and the tests run).
-//! - [`controls`]: menu, side panel, status bar, dialog windows.
+//! - [`action`]: every request as an [`action::Action`]; [`Viewer::apply`] carries them out.
+//! - [`controls`], [`edit_panel`]: menu, side panel, status bar, dialog windows.
+//! - [`overlay`], [`editor`], [`view_input`], [`navigate`]: the control-net overlay's
+//!   projection and geometry, the editing state and undo history, the mouse over the image,
+//!   and camera moves (drawn by [`crate::gpu::wireframe`]).
 //! - [`image_view`]: texture, fit / 1:1 / zoom / pan, probe.
 //! - [`params`]: parameters and the session commands their changes send.
 //! - [`convergence`]: the error estimate plotted against time.
 //! - [`save`], [`job`]: dialogs and file writes off the UI thread.
 //! - [`keys`], [`settings`], [`automation`]: shortcuts, stored preferences, scripted runs.
 
+pub mod action;
 pub mod automation;
 pub mod controls;
 pub mod convergence;
+pub mod edit_panel;
+pub mod editor;
 pub mod image_view;
 pub mod job;
 pub mod keys;
+pub mod navigate;
+pub mod overlay;
 pub mod params;
 pub mod save;
+mod scene_file;
 pub mod settings;
+pub mod view_input;
 pub mod viewer;
 
 use std::path::PathBuf;
 
+pub use action::Action;
 pub use automation::LaunchOptions;
 pub use settings::ViewerSettings;
 pub use viewer::Viewer;
@@ -98,6 +110,10 @@ pub fn run(scene_path: Option<PathBuf>, launch: LaunchOptions) -> anyhow::Result
                     .unwrap_or_default()
             };
             let mut viewer = Viewer::new(&cc.egui_ctx, scene, settings);
+            if let Some(render_state) = &cc.wgpu_render_state {
+                // eframe's default `depth_buffer: 0` gives egui's pass no depth attachment.
+                viewer.install_overlay(render_state, None);
+            }
             if let Some(e) = error {
                 viewer.scene_error = Some(e);
             }

@@ -76,6 +76,8 @@ pub struct ViewerSettings {
     pub index: IndexChoice,
     /// Folder the last scene was opened from or frame saved to (file dialogs start there).
     pub last_directory: Option<PathBuf>,
+    /// The control-net overlay is drawn (and can be edited).
+    pub show_wireframe: bool,
 }
 
 impl Default for ViewerSettings {
@@ -88,6 +90,7 @@ impl Default for ViewerSettings {
             direct_light: false,
             index: IndexChoice::HashGrid,
             last_directory: None,
+            show_wireframe: true,
         }
     }
 }

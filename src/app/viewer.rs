@@ -6,14 +6,19 @@ use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use super::action::{Action, AfterDiscard};
 use super::controls;
 use super::convergence::Convergence;
+use super::editor::Editor;
 use super::image_view::{frame_image, ImageView, Probe};
 use super::job::{Job, Poll};
 use super::keys;
+use super::overlay::OverlayProjection;
 use super::params::{Ranges, RenderParams};
 use super::save::{default_file_name, SaveEvent, SaveFlow, Snapshot};
 use super::settings::{IndexChoice, ViewerSettings, Zoom};
+use super::view_input;
+use crate::geometry::BezierPatch;
 use crate::render::image_metadata;
 use crate::render::ppm::{IndexKind, PpmOptions};
 use crate::render::session::{Command, Frame, RenderSession, SessionOptions};
@@ -73,6 +78,22 @@ pub struct Viewer {
     /// Seconds from [`Viewer::new`] to the first image shown.
     pub(super) first_image_secs: Option<f64>,
     created: Instant,
+    /// Control points as edited, selection, gesture and undo history.
+    pub(super) editor: Editor,
+    /// Where the image and its overlay were placed in the last UI frame.
+    pub(super) projection: Option<OverlayProjection>,
+    /// Whether the wgpu overlay was installed in the renderer (else it is not drawn).
+    pub(super) overlay_installed: bool,
+    /// The "save scene as" dialog.
+    pub(super) scene_dialog: Option<Job<Option<PathBuf>>>,
+    /// A scene file waiting for the user to confirm replacing it.
+    pub(super) confirm_scene_overwrite: Option<PathBuf>,
+    /// What waits on the unsaved-edits question.
+    pub(super) unsaved_question: Option<AfterDiscard>,
+    /// What to do once the scene is saved (from "Save" in the unsaved-edits question).
+    pub(super) after_save: Option<AfterDiscard>,
+    /// The window may close even with unsaved edits (the user said so).
+    pub(super) allow_close: bool,
 }
 
 fn session_options(settings: &ViewerSettings, start_paused: bool) -> SessionOptions {
@@ -127,6 +148,7 @@ impl Viewer {
         params.paused = paused;
         let ranges = Ranges::for_scene(&scene);
         let session = start_session(ctx, scene.clone(), &settings, paused);
+        let editor = Editor::new(&scene);
         Self {
             ctx: ctx.clone(),
             settings,
@@ -150,7 +172,26 @@ impl Viewer {
             recent_commands: VecDeque::new(),
             first_image_secs: None,
             created: Instant::now(),
+            editor,
+            projection: None,
+            overlay_installed: false,
+            scene_dialog: None,
+            confirm_scene_overwrite: None,
+            unsaved_question: None,
+            after_save: None,
+            allow_close: false,
         }
+    }
+
+    /// Draws the control-net overlay with wgpu from now on: sets its pipelines up in
+    /// `render_state` (eframe's, or a test's). `depth_format` must match the render pass's.
+    pub fn install_overlay(
+        &mut self,
+        render_state: &eframe::egui_wgpu::RenderState,
+        depth_format: Option<eframe::wgpu::TextureFormat>,
+    ) {
+        crate::gpu::wireframe::install(render_state, depth_format, 1);
+        self.overlay_installed = true;
     }
 
     /// The scene being rendered (as loaded).
@@ -183,9 +224,9 @@ impl Viewer {
         self.status.as_ref()
     }
 
-    /// Whether a scene is being opened or a frame saved.
+    /// Whether a scene is being opened or a frame or scene saved.
     pub fn busy(&self) -> bool {
-        self.loading.is_some() || self.picking.is_some() || self.save.busy()
+        self.loading.is_some() || self.picking.is_some() || self.save.busy() || self.scene_dialog.is_some()
     }
 
     /// Seconds from creation to the first image shown, once there is one.
@@ -227,8 +268,7 @@ impl Viewer {
     /// Starts a new render session for the current scene and parameters (after a renderer
     /// failure, or when index/direct-light options change).
     pub fn restart_renderer(&mut self) {
-        let mut scene = self.scene.clone();
-        self.params.apply_to(&mut scene);
+        let scene = self.edited_scene();
         self.session = start_session(&self.ctx, scene, &self.settings, self.params.paused);
         self.render_failure = None;
         self.frame = None;
@@ -237,11 +277,52 @@ impl Viewer {
         self.pending_restart = Some((Instant::now(), 0));
     }
 
+    /// The scene as edited: the panel's parameters, the camera and the control points.
+    pub fn edited_scene(&self) -> Scene {
+        let mut scene = self.scene.clone();
+        self.params.apply_to(&mut scene);
+        let edits: Vec<(usize, BezierPatch)> = self
+            .editor
+            .patches
+            .iter()
+            .zip(scene.geometry.patches())
+            .enumerate()
+            .filter(|(_, (edited, (current, _)))| *edited != current)
+            .map(|(k, (edited, _))| (k, *edited))
+            .collect();
+        if !edits.is_empty() {
+            scene.geometry.update_patches(&edits);
+        }
+        scene
+    }
+
+    /// The control points as edited (geometry order).
+    pub fn patches(&self) -> &[BezierPatch] {
+        &self.editor.patches
+    }
+
+    /// The selected control points.
+    pub fn selection(&self) -> impl Iterator<Item = super::overlay::PointRef> + '_ {
+        self.editor.selection.iter().copied()
+    }
+
+    /// Whether the scene has edits not saved yet.
+    pub fn unsaved_edits(&self) -> bool {
+        self.editor.history.unsaved()
+    }
+
+    /// Where the image and overlay were placed in the last UI frame.
+    pub fn projection(&self) -> Option<&OverlayProjection> {
+        self.projection.as_ref()
+    }
+
     /// Replaces the scene (a successful open).
     fn replace_scene(&mut self, scene: Scene) {
         let scene = photon_mapped(scene);
         self.params = RenderParams::from_scene(&scene);
         self.ranges = Ranges::for_scene(&scene);
+        self.editor = Editor::new(&scene);
+        self.projection = None;
         self.scene = scene;
         self.restart_renderer();
         self.settings.zoom = Zoom::Fit;
@@ -408,6 +489,7 @@ impl Viewer {
         if let Some(event) = self.save.poll(&self.ctx) {
             self.on_save_event(event);
         }
+        self.poll_scene_dialog();
     }
 
     /// Shows `frame` as the newest image if it is newer (a later epoch, or a later pass of
@@ -437,21 +519,26 @@ impl Viewer {
         self.image_view.invalidate();
     }
 
-    /// The whole window: menu, side panel, status bar, image, dialogs.
+    /// The whole window: menu, side panel, status bar, image with its overlay, dialogs. The
+    /// parts emit [`Action`]s, carried out at the end of the frame by [`Viewer::apply`].
     pub fn ui(&mut self, ui: &mut egui::Ui) {
         self.poll();
-        keys::handle(self, ui.ctx());
+        let mut actions = Vec::new();
+        keys::handle(self, ui.ctx(), &mut actions);
         // Files dropped on the window open as scenes (the first one).
-        let dropped: Vec<PathBuf> = ui.input(|i| {
+        let dropped: Option<PathBuf> = ui.input(|i| {
             i.raw
                 .dropped_files
                 .iter()
                 .map(|f| f.path().to_path_buf())
-                .filter(|p| !p.as_os_str().is_empty())
-                .collect()
+                .find(|p| !p.as_os_str().is_empty())
         });
-        if let Some(path) = dropped.into_iter().next() {
-            self.open_scene(path);
+        actions.extend(dropped.map(Action::OpenScene));
+        // Closing with unsaved edits asks first.
+        if ui.input(|i| i.viewport().close_requested()) && !self.allow_close && self.editor.history.unsaved()
+        {
+            ui.ctx().send_viewport_cmd(egui::ViewportCommand::CancelClose);
+            actions.push(Action::Close);
         }
         if let Some(frame) = &self.frame {
             self.image_view.update_texture(
@@ -462,31 +549,76 @@ impl Viewer {
             );
         }
 
-        egui::Panel::top("caustic-menu").show(ui, |ui| controls::menu_ui(self, ui));
+        egui::Panel::top("caustic-menu").show(ui, |ui| controls::menu_ui(self, ui, &mut actions));
         egui::Panel::bottom("caustic-status").show(ui, |ui| controls::status_ui(self, ui));
         if self.settings.show_side_panel {
             egui::Panel::right("caustic-controls")
                 .resizable(true)
                 .default_size(290.0)
                 .show(ui, |ui| {
-                    egui::ScrollArea::vertical().show(ui, |ui| controls::side_panel_ui(self, ui));
+                    egui::ScrollArea::vertical()
+                        .show(ui, |ui| controls::side_panel_ui(self, ui, &mut actions));
                 });
         }
-        egui::CentralPanel::no_frame().show(ui, |ui| match &self.frame {
-            Some(frame) => {
-                let size = [frame.width, frame.height];
-                self.probe = self.image_view.ui(ui, &mut self.settings.zoom, size);
-            }
-            None => {
-                self.probe = None;
-                let text = if self.params.paused {
-                    "Paused before the first pass: press Space or Resume"
-                } else {
-                    "Rendering the first pass..."
-                };
-                ui.centered_and_justified(|ui| ui.label(text));
-            }
-        });
-        controls::dialogs_ui(self, ui.ctx());
+        egui::CentralPanel::no_frame().show(ui, |ui| self.central_ui(ui, &mut actions));
+        controls::dialogs_ui(self, ui.ctx(), &mut actions);
+        for action in actions {
+            self.apply(action);
+        }
+    }
+
+    /// Whether the overlay is shown and can be edited.
+    pub(super) fn editing(&self) -> bool {
+        self.settings.show_wireframe && !self.editor.patches.is_empty()
+    }
+
+    /// The image, the control-net overlay over it, and the mouse.
+    fn central_ui(&mut self, ui: &mut egui::Ui, actions: &mut Vec<Action>) {
+        let Some(frame) = &self.frame else {
+            self.probe = None;
+            let text = if self.params.paused {
+                "Paused before the first pass: press Space or Resume"
+            } else {
+                "Rendering the first pass..."
+            };
+            ui.centered_and_justified(|ui| ui.label(text));
+            return;
+        };
+        let size = [frame.width, frame.height];
+        // A left drag that starts on a control point moves it; elsewhere it pans the image.
+        let press = ui.input(|i| i.pointer.press_origin());
+        let grabbing = matches!(self.editor.gesture, Some(super::editor::Gesture::Points { .. }))
+            || (self.editing()
+                && view_input::grab_at(&self.editor, self.projection.as_ref(), press).is_some());
+        let shown = self.image_view.ui(ui, self.settings.zoom, size, !grabbing);
+        self.probe = shown.probe;
+        if shown.zoom != self.settings.zoom {
+            actions.push(Action::SetZoom {
+                zoom: shown.zoom,
+                recentre: false,
+            });
+        }
+        let mut camera = self.scene.camera.clone();
+        (camera.width, camera.height) = (size[0], size[1]);
+        let projection = OverlayProjection::new(&camera, shown.image, shown.view);
+        view_input::view_actions(
+            &self.editor,
+            &projection,
+            &shown.response,
+            self.editing(),
+            actions,
+        );
+        if self.editing() && self.overlay_installed {
+            let callback = crate::gpu::wireframe::WireframeCallback {
+                uniforms: projection.uniforms(ui.ctx().pixels_per_point()),
+                geometry: self.editor.overlay(),
+                generation: self.editor.generation,
+            };
+            ui.painter_at(shown.view)
+                .add(eframe::egui_wgpu::Callback::new_paint_callback(
+                    shown.view, callback,
+                ));
+        }
+        self.projection = Some(projection);
     }
 }

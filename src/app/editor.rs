@@ -1,0 +1,347 @@
+//! Shaping patches by hand: the control points as edited, the selection and hover, the
+//! gesture in progress (dragging points, or orbiting/panning/dollying the camera), and the
+//! undo history. The editor only keeps state and does the geometry of a gesture; the viewer
+//! ([`super::Viewer::apply`]) carries actions out and tells the render session.
+
+use std::collections::BTreeSet;
+use std::sync::Arc;
+
+use egui::{Pos2, Vec2};
+use glam::DVec3;
+
+use super::navigate;
+use super::overlay::{overlay_geometry, OverlayProjection, PointRef};
+use crate::geometry::BezierPatch;
+use crate::gpu::wireframe::WireframeGeometry;
+use crate::scene::{Camera, Scene};
+
+/// Radians of orbit per point dragged.
+const ORBIT_PER_POINT: f64 = 0.008;
+/// Dolly factor per point dragged: `exp(dy × DOLLY_PER_POINT)`.
+const DOLLY_PER_POINT: f64 = 0.006;
+
+/// What a camera drag does.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CameraMove {
+    /// Turntable about the pivot (right mouse button).
+    Orbit,
+    /// Parallel to the image plane (middle button, or Shift + right).
+    Pan,
+    /// Towards or away from the pivot (Ctrl + right).
+    Dolly,
+}
+
+/// A drag in progress.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Gesture {
+    /// Moving the selection by a grabbed control point.
+    Points {
+        /// The point under the cursor when the drag began.
+        grab: PointRef,
+        /// Where that point was on screen.
+        grab_screen: Pos2,
+        /// Every moved point and where it started.
+        start: Vec<(PointRef, DVec3)>,
+    },
+    /// Moving the camera.
+    Camera {
+        /// How.
+        how: CameraMove,
+        /// The camera and pivot when the drag began.
+        start: (Camera, DVec3),
+    },
+}
+
+/// One undoable change.
+// Edits are few (one per gesture): boxing the camera variant would buy nothing.
+#[allow(clippy::large_enum_variant)]
+#[derive(Clone, Debug, PartialEq)]
+pub enum Edit {
+    /// Control points: `(point, before, after)`.
+    Points(Vec<(PointRef, DVec3, DVec3)>),
+    /// The camera pose and orbit pivot.
+    Camera {
+        /// Before.
+        before: (Camera, DVec3),
+        /// After.
+        after: (Camera, DVec3),
+    },
+}
+
+impl Edit {
+    /// The change that undoes this one.
+    pub fn inverse(&self) -> Edit {
+        match self {
+            Edit::Points(moves) => Edit::Points(moves.iter().map(|(r, a, b)| (*r, *b, *a)).collect()),
+            Edit::Camera { before, after } => Edit::Camera {
+                before: after.clone(),
+                after: before.clone(),
+            },
+        }
+    }
+}
+
+/// Undo and redo stacks; each entry carries an id so that "unsaved" is a comparison.
+#[derive(Clone, Debug, Default)]
+pub struct History {
+    done: Vec<(u64, Edit)>,
+    undone: Vec<(u64, Edit)>,
+    next_id: u64,
+    saved: u64,
+}
+
+impl History {
+    /// Records a new change (clearing what could be redone).
+    pub fn record(&mut self, edit: Edit) {
+        self.next_id += 1;
+        self.done.push((self.next_id, edit));
+        self.undone.clear();
+    }
+
+    /// The change to apply to undo the last one.
+    pub fn undo(&mut self) -> Option<Edit> {
+        let (id, edit) = self.done.pop()?;
+        let inverse = edit.inverse();
+        self.undone.push((id, edit));
+        Some(inverse)
+    }
+
+    /// The change to apply to redo the last undone one.
+    pub fn redo(&mut self) -> Option<Edit> {
+        let (id, edit) = self.undone.pop()?;
+        self.done.push((id, edit.clone()));
+        Some(edit)
+    }
+
+    fn state(&self) -> u64 {
+        self.done.last().map_or(0, |(id, _)| *id)
+    }
+
+    /// Marks the current state as saved.
+    pub fn mark_saved(&mut self) {
+        self.saved = self.state();
+    }
+
+    /// Whether the state differs from the last save (or the scene as opened).
+    pub fn unsaved(&self) -> bool {
+        self.state() != self.saved
+    }
+
+    /// Whether there is something to undo / redo.
+    pub fn can_undo_redo(&self) -> (bool, bool) {
+        (!self.done.is_empty(), !self.undone.is_empty())
+    }
+}
+
+/// The editing state of the open scene.
+pub struct Editor {
+    /// Control points as edited (geometry order).
+    pub patches: Vec<BezierPatch>,
+    /// Control points as the scene file gave them.
+    pub loaded: Vec<BezierPatch>,
+    /// Selected control points.
+    pub selection: BTreeSet<PointRef>,
+    /// The control point under the cursor.
+    pub hovered: Option<PointRef>,
+    /// The drag in progress.
+    pub gesture: Option<Gesture>,
+    /// The point the camera orbits and dollies about.
+    pub pivot: DVec3,
+    /// The turntable's vertical.
+    pub world_up: DVec3,
+    /// Undo / redo.
+    pub history: History,
+    overlay: Arc<WireframeGeometry>,
+    /// Changes whenever the overlay's geometry does.
+    pub generation: u64,
+    overlay_stale: bool,
+}
+
+impl Editor {
+    /// The editor for a freshly opened scene.
+    pub fn new(scene: &Scene) -> Self {
+        let patches: Vec<BezierPatch> = scene.geometry.patches().iter().map(|(p, _)| *p).collect();
+        let cam = &scene.camera;
+        Self {
+            loaded: patches.clone(),
+            patches,
+            selection: BTreeSet::new(),
+            hovered: None,
+            gesture: None,
+            pivot: cam.position + cam.forward * cam.focal_distance,
+            world_up: navigate::world_up(cam.up),
+            history: History::default(),
+            overlay: Arc::default(),
+            generation: 0,
+            overlay_stale: true,
+        }
+    }
+
+    /// Position of a control point.
+    pub fn point(&self, r: PointRef) -> DVec3 {
+        self.patches[r.patch].points[r.index]
+    }
+
+    /// Whether `r` names a control point of this scene.
+    pub fn exists(&self, r: PointRef) -> bool {
+        r.patch < self.patches.len() && r.index < 16
+    }
+
+    /// Marks the overlay for rebuilding (hover, selection or points changed).
+    pub fn touch(&mut self) {
+        self.overlay_stale = true;
+    }
+
+    /// The overlay's geometry, rebuilt if something changed.
+    pub fn overlay(&mut self) -> Arc<WireframeGeometry> {
+        if self.overlay_stale {
+            self.overlay = Arc::new(overlay_geometry(&self.patches, self.hovered, &self.selection));
+            self.generation += 1;
+            self.overlay_stale = false;
+        }
+        self.overlay.clone()
+    }
+
+    /// Sets points; returns `(point, before, after)` for those that changed.
+    pub fn set_points(&mut self, moves: &[(PointRef, DVec3)]) -> Vec<(PointRef, DVec3, DVec3)> {
+        let mut changed = Vec::new();
+        for &(r, p) in moves {
+            if !self.exists(r) || !p.is_finite() {
+                continue;
+            }
+            let before = self.point(r);
+            if before != p {
+                self.patches[r.patch].points[r.index] = p;
+                changed.push((r, before, p));
+            }
+        }
+        if !changed.is_empty() {
+            self.touch();
+        }
+        changed
+    }
+
+    /// The points a drag moves when it grabs `grab`: the selection if `grab` is in it, else
+    /// `grab` alone.
+    pub fn drag_set(&self, grab: PointRef) -> Vec<(PointRef, DVec3)> {
+        if self.selection.contains(&grab) {
+            self.selection.iter().map(|r| (*r, self.point(*r))).collect()
+        } else {
+            vec![(grab, self.point(grab))]
+        }
+    }
+
+    /// Where the dragged points go with the cursor at `pointer`: parallel to the image plane
+    /// through the grabbed point (the grabbed point stays under the cursor), or along the
+    /// line of sight when `along_view` (dragging up moves away from the eye).
+    pub fn dragged_points(
+        &self,
+        proj: &OverlayProjection,
+        pointer: Pos2,
+        along_view: bool,
+    ) -> Vec<(PointRef, DVec3)> {
+        let Some(Gesture::Points {
+            grab,
+            grab_screen,
+            start,
+        }) = &self.gesture
+        else {
+            return Vec::new();
+        };
+        let Some(&(_, origin)) = start.iter().find(|(r, _)| r == grab) else {
+            return Vec::new();
+        };
+        let depth = proj.depth(origin);
+        let delta = if along_view {
+            let dy = (grab_screen.y - pointer.y) as f64;
+            let dir = (origin - proj.camera.position).normalize_or_zero();
+            dir * dy * proj.world_per_point(depth)
+        } else {
+            // Exact on the plane: the point under the moved cursor at the grabbed depth.
+            let offset = pointer - *grab_screen;
+            let here = proj.unproject(*grab_screen, depth);
+            proj.unproject(*grab_screen + offset, depth) - here
+        };
+        start.iter().map(|(r, p)| (*r, *p + delta)).collect()
+    }
+
+    /// The camera and pivot a camera drag gives for a cursor moved `delta` points since the
+    /// drag began.
+    pub fn dragged_camera(&self, proj: &OverlayProjection, delta: Vec2) -> Option<(Camera, DVec3)> {
+        let Some(Gesture::Camera { how, start }) = &self.gesture else {
+            return None;
+        };
+        let (cam, pivot) = start;
+        let (dx, dy) = (delta.x as f64, delta.y as f64);
+        Some(match how {
+            CameraMove::Orbit => (
+                navigate::orbit(
+                    cam,
+                    *pivot,
+                    self.world_up,
+                    -dx * ORBIT_PER_POINT,
+                    dy * ORBIT_PER_POINT,
+                ),
+                *pivot,
+            ),
+            CameraMove::Pan => {
+                let scale = proj.world_per_point((*pivot - cam.position).dot(cam.forward));
+                let shift = (-dx * cam.right + dy * cam.up) * scale;
+                (navigate::pan(cam, shift), *pivot + shift)
+            }
+            CameraMove::Dolly => (navigate::dolly(cam, *pivot, (dy * DOLLY_PER_POINT).exp()), *pivot),
+        })
+    }
+
+    /// A step of `points` screen points in the image plane, at the selection's depth: what
+    /// the arrow keys move the selection by.
+    pub fn nudge(&self, proj: &OverlayProjection, step: Vec2) -> Vec<(PointRef, DVec3)> {
+        let Some(first) = self.selection.first() else {
+            return Vec::new();
+        };
+        let c = &proj.camera;
+        let scale = proj.world_per_point(proj.depth(self.point(*first)));
+        let delta = (step.x as f64 * c.right - step.y as f64 * c.up) * scale;
+        self.selection
+            .iter()
+            .map(|r| (*r, self.point(*r) + delta))
+            .collect()
+    }
+
+    /// Centre and radius of the selection (all patches when nothing is selected).
+    pub fn selection_sphere(&self) -> (DVec3, f64) {
+        let points: Vec<DVec3> = if self.selection.is_empty() {
+            self.patches.iter().flat_map(|p| p.points).collect()
+        } else {
+            self.selection.iter().map(|r| self.point(*r)).collect()
+        };
+        if points.is_empty() {
+            return (self.pivot, 1.0);
+        }
+        let centre = points.iter().sum::<DVec3>() / points.len() as f64;
+        let radius = points.iter().map(|p| (*p - centre).length()).fold(0.0, f64::max);
+        (centre, radius.max(1e-3))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn history_undoes_redoes_and_knows_what_is_unsaved() {
+        let mut h = History::default();
+        let r = PointRef { patch: 0, index: 1 };
+        let edit = Edit::Points(vec![(r, DVec3::ZERO, DVec3::X)]);
+        assert!(!h.unsaved());
+        h.record(edit.clone());
+        assert!(h.unsaved());
+        h.mark_saved();
+        assert!(!h.unsaved());
+        assert_eq!(h.undo(), Some(Edit::Points(vec![(r, DVec3::X, DVec3::ZERO)])));
+        assert!(h.unsaved());
+        assert_eq!(h.redo(), Some(edit));
+        assert!(!h.unsaved());
+        assert_eq!(h.redo(), None);
+    }
+}

@@ -1,0 +1,253 @@
+//! Where the control-net overlay goes on screen and what it shows: the render camera's
+//! projection composed with the image's place in the view (so the net lies on the rendered
+//! surfaces at any zoom and pan), picking, and the overlay's geometry with hover and
+//! selection highlighted. The wgpu side is [`crate::gpu::wireframe`].
+
+use std::collections::BTreeSet;
+
+use egui::{Pos2, Rect};
+use glam::{DMat4, DVec2, DVec3, DVec4};
+
+use crate::geometry::BezierPatch;
+use crate::gpu::wireframe::{Marker, Segment, Uniforms, WireframeGeometry};
+use crate::scene::Camera;
+
+/// A control point: patch index in the scene geometry and point `4i + j`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct PointRef {
+    /// Patch index.
+    pub patch: usize,
+    /// Control point `4i + j`.
+    pub index: usize,
+}
+
+/// A control point is picked when the cursor is this close (points).
+pub const PICK_RADIUS: f32 = 8.0;
+/// Samples per patch boundary curve.
+const CURVE_SEGMENTS: usize = 16;
+
+/// The camera's projection into the view: `clip_from_world` maps a world point to the clip
+/// space of `view` (the paint callback's viewport), with the image occupying `image`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OverlayProjection {
+    /// The render camera.
+    pub camera: Camera,
+    /// Where the image is drawn (points; may extend past the view when zoomed in).
+    pub image: Rect,
+    /// The view the overlay is painted in (points).
+    pub view: Rect,
+    /// Clip space of `view` from world space.
+    pub clip_from_world: DMat4,
+}
+
+impl OverlayProjection {
+    /// The projection of `camera`'s image drawn at `image` inside `view`.
+    pub fn new(camera: &Camera, image: Rect, view: Rect) -> Self {
+        let c = camera;
+        let h = (0.5 * c.fov_y).tan();
+        let aspect = c.width as f64 / c.height as f64;
+        // Camera space: x right, y up, w the depth along the view axis (as Camera::project).
+        let rows = [
+            (c.right / (h * aspect)).extend(-c.position.dot(c.right) / (h * aspect)),
+            (c.up / h).extend(-c.position.dot(c.up) / h),
+            DVec4::ZERO,
+            c.forward.extend(-c.position.dot(c.forward)),
+        ];
+        let image_ndc_from_world = DMat4::from_cols(rows[0], rows[1], rows[2], rows[3]).transpose();
+        // The image's NDC square mapped into the view's NDC square.
+        let (ic, vc) = (image.center(), view.center());
+        let sx = (image.width() / view.width()) as f64;
+        let sy = (image.height() / view.height()) as f64;
+        let tx = ((ic.x - vc.x) / (0.5 * view.width())) as f64;
+        let ty = -((ic.y - vc.y) / (0.5 * view.height())) as f64;
+        let view_from_image = DMat4::from_cols(
+            DVec4::new(sx, 0.0, 0.0, 0.0),
+            DVec4::new(0.0, sy, 0.0, 0.0),
+            DVec4::new(0.0, 0.0, 1.0, 0.0),
+            DVec4::new(tx, ty, 0.0, 1.0),
+        );
+        Self {
+            camera: camera.clone(),
+            image,
+            view,
+            clip_from_world: view_from_image * image_ndc_from_world,
+        }
+    }
+
+    /// Where `p` appears in the view (points), computed as the GPU does (in `f32`, with the
+    /// uniform's matrix); `None` behind the eye.
+    pub fn to_screen(&self, p: DVec3) -> Option<Pos2> {
+        let c = self.clip_from_world.as_mat4() * p.as_vec3().extend(1.0);
+        if c.w <= 0.0 {
+            return None;
+        }
+        let v = self.view;
+        Some(Pos2::new(
+            v.center().x + c.x / c.w * 0.5 * v.width(),
+            v.center().y - c.y / c.w * 0.5 * v.height(),
+        ))
+    }
+
+    /// Image pixels per point.
+    fn pixels_per_point(&self) -> f64 {
+        self.camera.width as f64 / self.image.width() as f64
+    }
+
+    /// The image position (pixels) under screen point `s`.
+    pub fn image_pixel(&self, s: Pos2) -> DVec2 {
+        let local = s - self.image.min;
+        DVec2::new(local.x as f64, local.y as f64) * self.pixels_per_point()
+    }
+
+    /// The world point under screen point `s` at `depth` along the view axis (the inverse of
+    /// [`OverlayProjection::to_screen`] on that plane).
+    pub fn unproject(&self, s: Pos2, depth: f64) -> DVec3 {
+        let c = &self.camera;
+        c.position + c.pinhole_direction(self.image_pixel(s)) * depth
+    }
+
+    /// Depth of `p` along the view axis.
+    pub fn depth(&self, p: DVec3) -> f64 {
+        (p - self.camera.position).dot(self.camera.forward)
+    }
+
+    /// World length of one screen point at `depth`.
+    pub fn world_per_point(&self, depth: f64) -> f64 {
+        let c = &self.camera;
+        2.0 * (0.5 * c.fov_y).tan() * depth / c.height as f64 * self.pixels_per_point()
+    }
+
+    /// The uniforms for the GPU; `ppp` is physical pixels per point.
+    pub fn uniforms(&self, ppp: f32) -> Uniforms {
+        let scale = self.camera.position.length().max(1.0);
+        // Geometry nearer the eye than this (along the view axis) is cut off.
+        Uniforms {
+            clip_from_world: self.clip_from_world.as_mat4().to_cols_array_2d(),
+            viewport_px: [self.view.width() * ppp, self.view.height() * ppp],
+            near_w: (1e-5 * scale) as f32,
+            pixels_per_point: ppp,
+        }
+    }
+
+    /// The control point nearest `pointer` within [`PICK_RADIUS`], if any.
+    pub fn pick(&self, patches: &[BezierPatch], pointer: Pos2) -> Option<PointRef> {
+        let mut best: Option<(f32, PointRef)> = None;
+        for (patch, p) in patches.iter().enumerate() {
+            for (index, q) in p.points.iter().enumerate() {
+                let Some(s) = self.to_screen(*q) else {
+                    continue;
+                };
+                let d = s.distance(pointer);
+                if d <= PICK_RADIUS && best.is_none_or(|(b, _)| d < b) {
+                    best = Some((d, PointRef { patch, index }));
+                }
+            }
+        }
+        best.map(|(_, r)| r)
+    }
+}
+
+fn f32x3(p: DVec3) -> [f32; 3] {
+    p.as_vec3().to_array()
+}
+
+const NET: [f32; 4] = [0.55, 0.85, 1.0, 0.55];
+const NET_SELECTED: [f32; 4] = [0.7, 0.95, 1.0, 0.95];
+const BOUNDARY: [f32; 4] = [1.0, 0.62, 0.2, 0.85];
+const POINT: [f32; 4] = [0.92, 0.95, 1.0, 0.9];
+const POINT_HOVERED: [f32; 4] = [1.0, 0.92, 0.2, 1.0];
+const POINT_SELECTED: [f32; 4] = [1.0, 0.25, 0.45, 1.0];
+
+/// The overlay for `patches`: each control net (rows and columns), each patch's four
+/// boundary curves, and a marker per control point; hovered and selected points, and the nets
+/// of patches with a selected point, stand out.
+pub fn overlay_geometry(
+    patches: &[BezierPatch],
+    hovered: Option<PointRef>,
+    selection: &BTreeSet<PointRef>,
+) -> WireframeGeometry {
+    let mut g = WireframeGeometry::default();
+    let segment = |a: DVec3, b: DVec3, color: [f32; 4], width: f32| Segment {
+        a: f32x3(a),
+        b: f32x3(b),
+        color,
+        width,
+    };
+    for (k, p) in patches.iter().enumerate() {
+        let active = selection.iter().any(|s| s.patch == k) || hovered.is_some_and(|h| h.patch == k);
+        let (net, width) = if active { (NET_SELECTED, 1.6) } else { (NET, 1.0) };
+        for i in 0..4 {
+            for j in 0..3 {
+                g.segments
+                    .push(segment(p.point(i, j), p.point(i, j + 1), net, width));
+                g.segments
+                    .push(segment(p.point(j, i), p.point(j + 1, i), net, width));
+            }
+        }
+        for edge in 0..4 {
+            let at = |t: f64| match edge {
+                0 => p.eval(t, 0.0),
+                1 => p.eval(t, 1.0),
+                2 => p.eval(0.0, t),
+                _ => p.eval(1.0, t),
+            };
+            for s in 0..CURVE_SEGMENTS {
+                let (t0, t1) = (
+                    s as f64 / CURVE_SEGMENTS as f64,
+                    (s + 1) as f64 / CURVE_SEGMENTS as f64,
+                );
+                g.segments.push(segment(at(t0), at(t1), BOUNDARY, 1.5));
+            }
+        }
+        for (index, q) in p.points.iter().enumerate() {
+            let r = PointRef { patch: k, index };
+            let (color, size) = if selection.contains(&r) {
+                (POINT_SELECTED, 9.0)
+            } else if hovered == Some(r) {
+                (POINT_HOVERED, 10.0)
+            } else {
+                (POINT, 5.0)
+            };
+            g.markers.push(Marker {
+                position: f32x3(*q),
+                color,
+                size,
+            });
+        }
+    }
+    g
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn overlay_projection_agrees_with_the_camera_at_any_zoom_and_pan() {
+        let scene = crate::scene::Scene::builtin();
+        let cam = &scene.camera;
+        let view = Rect::from_min_size(Pos2::new(10.0, 30.0), egui::vec2(800.0, 600.0));
+        let (w, h) = (cam.width as f32, cam.height as f32);
+        // Fit, 2× zoom panned off-centre (partly outside the view), and a small image.
+        let images = [
+            Rect::from_center_size(view.center(), egui::vec2(w, h) * 1.25),
+            Rect::from_center_size(view.center() + egui::vec2(-300.0, 170.0), egui::vec2(w, h) * 2.0),
+            Rect::from_min_size(Pos2::new(40.0, 50.0), egui::vec2(w, h) * 0.3),
+        ];
+        for image in images {
+            let proj = OverlayProjection::new(cam, image, view);
+            let scale = image.width() / w;
+            for (p, _) in scene.geometry.patches() {
+                for q in p.points {
+                    let px = cam.project(q).expect("in front");
+                    let expected = image.min + egui::vec2(px.x as f32, px.y as f32) * scale;
+                    let got = proj.to_screen(q).expect("in front");
+                    assert!(got.distance(expected) < 0.5, "{got:?} vs {expected:?}");
+                    // And the plane-parallel inverse returns the point.
+                    let back = proj.unproject(got, proj.depth(q));
+                    assert!((back - q).length() < 1e-3, "{back} vs {q}");
+                }
+            }
+        }
+    }
+}

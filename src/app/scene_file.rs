@@ -1,0 +1,164 @@
+//! Saving the edited scene (File → Save scene / Save scene as…) and the question asked before
+//! unsaved edits would be lost (opening another scene, closing the window). A scene file is
+//! never replaced without the user's confirmation.
+
+use std::path::PathBuf;
+
+use super::action::AfterDiscard;
+use super::job::{Job, Poll};
+use super::viewer::{Status, Viewer};
+use crate::scene::save::save_scene;
+
+impl Viewer {
+    /// Does `after` now, or first asks what to do with unsaved edits.
+    pub(super) fn unless_unsaved(&mut self, after: AfterDiscard) {
+        if self.editor.history.unsaved() {
+            self.unsaved_question = Some(after);
+        } else {
+            self.proceed(after);
+        }
+    }
+
+    fn proceed(&mut self, after: AfterDiscard) {
+        match after {
+            AfterDiscard::Open(path) => self.open_scene(path),
+            AfterDiscard::Pick => self.pick_scene(),
+            AfterDiscard::Close => {
+                self.allow_close = true;
+                self.ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+            }
+        }
+    }
+
+    /// Answers the unsaved-edits question: discard (`Some(true)`), save first
+    /// (`Some(false)`), or cancel (`None`).
+    pub(super) fn resolve_unsaved(&mut self, choice: Option<bool>) {
+        let Some(after) = self.unsaved_question.take() else {
+            return;
+        };
+        match choice {
+            Some(true) => self.proceed(after),
+            Some(false) => {
+                self.after_save = Some(after);
+                self.save_scene();
+            }
+            None => {}
+        }
+    }
+
+    /// The scene's own file, when it was opened from one.
+    fn scene_file(&self) -> Option<PathBuf> {
+        self.scene.base_dir.as_ref()?;
+        Some(self.scene.source.clone()).filter(|p| p.is_file())
+    }
+
+    /// Saves to the scene's own file (after confirming), or asks where.
+    pub(super) fn save_scene(&mut self) {
+        match self.scene_file() {
+            Some(path) => self.confirm_scene_overwrite = Some(path),
+            None => self.pick_scene_file(),
+        }
+    }
+
+    /// The "save scene as" dialog (on a thread).
+    pub(super) fn pick_scene_file(&mut self) {
+        if self.scene_dialog.is_some() {
+            return;
+        }
+        let dir = self.settings.last_directory.clone();
+        let name = match self.scene.source.file_stem() {
+            Some(stem) if self.scene.base_dir.is_some() => format!("{}-edited.toml", stem.to_string_lossy()),
+            _ => "scene.toml".to_owned(),
+        };
+        self.scene_dialog = Some(Job::spawn("caustic-scene-dialog", &self.ctx, move || {
+            let mut dialog = rfd::FileDialog::new()
+                .set_title("Save scene")
+                .add_filter("caustic scene", &["toml"])
+                .set_file_name(name);
+            if let Some(d) = dir {
+                dialog = dialog.set_directory(d);
+            }
+            dialog.save_file()
+        }));
+    }
+
+    /// Takes the answer of the "save scene as" dialog.
+    pub(super) fn poll_scene_dialog(&mut self) {
+        let Some(job) = &self.scene_dialog else {
+            return;
+        };
+        match job.poll() {
+            Poll::Pending => {}
+            Poll::Ready(choice) => {
+                self.scene_dialog = None;
+                match choice {
+                    Some(path) => self.save_scene_to(path),
+                    None => {
+                        self.after_save = None;
+                        self.status = Some(Status::Info("Scene not saved".into()));
+                    }
+                }
+            }
+            Poll::Lost => {
+                self.scene_dialog = None;
+                self.after_save = None;
+                self.status = Some(Status::Error("the file dialog failed".into()));
+            }
+        }
+    }
+
+    /// Saves the scene to `path`, asking first if it exists.
+    pub fn save_scene_to(&mut self, path: PathBuf) {
+        let path = if path.extension().is_none() {
+            path.with_extension("toml")
+        } else {
+            path
+        };
+        if path.exists() {
+            self.confirm_scene_overwrite = Some(path);
+        } else {
+            self.write_scene(path, false);
+        }
+    }
+
+    /// Answers the scene overwrite question.
+    pub(super) fn confirm_scene_overwrite(&mut self, replace: bool) {
+        let Some(path) = self.confirm_scene_overwrite.take() else {
+            return;
+        };
+        if replace {
+            self.write_scene(path, true);
+        } else {
+            self.after_save = None;
+            self.status = Some(Status::Info(format!("{} kept as it was", path.display())));
+        }
+    }
+
+    fn write_scene(&mut self, path: PathBuf, overwrite: bool) {
+        let mut scene = self.edited_scene();
+        match save_scene(&scene, &self.editor.loaded, &path, overwrite) {
+            Ok(()) => {
+                // The file now holds the scene as edited: it is what "saved" means from here.
+                if let Ok(text) = std::fs::read_to_string(&path) {
+                    scene.text = text.into();
+                }
+                scene.source = path.clone();
+                scene.base_dir = path.parent().map(|d| d.to_path_buf());
+                self.scene = scene;
+                self.editor.loaded = self.editor.patches.clone();
+                self.editor.history.mark_saved();
+                if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+                    self.settings.last_directory = Some(dir.to_path_buf());
+                }
+                self.status = Some(Status::Info(format!("Saved scene to {}", path.display())));
+                if let Some(after) = self.after_save.take() {
+                    self.proceed(after);
+                }
+            }
+            Err(e) => {
+                self.after_save = None;
+                self.status = Some(Status::Error(format!("Scene not saved: {e}")));
+            }
+        }
+    }
+}
