@@ -84,3 +84,25 @@ pub fn time_intersect(name: &str, geometry: &SceneGeometry, rays: &[Ray], repeat
         ns_per_miss: time(&misses),
     }
 }
+
+/// Seconds to re-prepare one edited patch of `geometry` (its subdivision and the BVH update,
+/// [`SceneGeometry::update_patches`]), once per round, with control point `index` of `patch`
+/// moved a little further each round as a drag moves it. Sorted, fastest first.
+pub fn time_reprepare(geometry: &SceneGeometry, patch: usize, index: usize, rounds: usize) -> Vec<f64> {
+    let mut g = geometry.clone();
+    let Some((original, _)) = geometry.patches().get(patch).copied() else {
+        return Vec::new();
+    };
+    let size = original.bounds().diagonal().length();
+    let mut secs: Vec<f64> = (0..rounds)
+        .map(|k| {
+            let mut p = original;
+            p.points[index % 16] += DVec3::new(0.3, -0.2, 0.25) * size * 0.01 * (k + 1) as f64;
+            let start = Instant::now();
+            std::hint::black_box(g.update_patches(&[(patch, p)]));
+            start.elapsed().as_secs_f64()
+        })
+        .collect();
+    secs.sort_by(f64::total_cmp);
+    secs
+}

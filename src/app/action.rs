@@ -93,12 +93,12 @@ pub enum Action {
     SelectPatch(usize),
     /// Select nothing.
     ClearSelection,
-    /// A drag begins on a control point (at its screen position).
+    /// A drag begins on a control point.
     BeginPointDrag {
         /// The grabbed point.
         grab: PointRef,
-        /// Where it is on screen.
-        screen: Pos2,
+        /// Where the button went down (points).
+        press: Pos2,
     },
     /// The cursor of a point drag moved; `along_view` moves along the line of sight.
     DragPoints {
@@ -202,12 +202,20 @@ impl Viewer {
                 self.editor.selection.clear();
                 self.editor.touch();
             }
-            Action::BeginPointDrag { grab, screen } => {
-                if self.editor.exists(grab) {
-                    let start = self.editor.drag_set(grab);
+            Action::BeginPointDrag { grab, press } => {
+                let on_screen = self.editor.exists(grab).then(|| self.editor.point(grab));
+                let on_screen = on_screen.and_then(|q| self.projection.as_ref()?.to_screen(q));
+                if let Some(grab_screen) = on_screen {
+                    // Dragging an unselected point selects it (alone).
+                    if !self.editor.selection.contains(&grab) {
+                        self.editor.selection = [grab].into();
+                        self.editor.touch();
+                    }
+                    let start = self.editor.selected_points();
                     self.editor.gesture = Some(Gesture::Points {
                         grab,
-                        grab_screen: screen,
+                        grab_screen,
+                        press,
                         start,
                     });
                 }

@@ -1,12 +1,16 @@
 //! Scripted runs of the real window: `caustic view --screenshot FILE` saves a picture of the
 //! window (egui's own screenshot) once the render has reached some passes, and
-//! `caustic view --bench` measures launch-to-first-image, UI frame rate while rendering and
-//! slider-to-new-epoch-image latency, prints them and exits.
+//! `caustic view --bench` measures launch-to-first-image, UI frame rate while rendering,
+//! slider-to-new-epoch-image latency and, on scenes with patches, a control-point drag made
+//! through the same actions the mouse emits (each step to its new epoch's first image, the
+//! frame rate meanwhile, and the time to re-prepare the edited patch), prints them and exits.
 
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
+use super::action::Action;
+use super::overlay::PointRef;
 use super::viewer::Viewer;
 
 /// What to do besides showing the window.
@@ -42,6 +46,10 @@ const TIMEOUT: Duration = Duration::from_secs(300);
 const FPS_WINDOW: Duration = Duration::from_secs(5);
 /// Restarts measured.
 const LATENCY_ROUNDS: usize = 6;
+/// Steps of the control-point drag measured.
+const DRAG_ROUNDS: usize = 12;
+/// The control point the drag stage moves: patch 0, an inner point of its net.
+const DRAG_POINT: PointRef = PointRef { patch: 0, index: 5 };
 
 enum Stage {
     WaitFirstImage,
@@ -56,6 +64,13 @@ enum Stage {
     Latency {
         round: usize,
         sent: Option<Instant>,
+    },
+    Drag {
+        round: usize,
+        sent: Option<Instant>,
+        press: Option<egui::Pos2>,
+        start: Instant,
+        frames: u32,
     },
     Screenshot {
         requested: bool,
@@ -88,6 +103,10 @@ pub struct Automation {
     /// The same with the renderer paused.
     fps_paused: Option<(f64, f64, f64)>,
     latencies: Vec<f64>,
+    /// Control-point move to new-epoch image, each drag step (seconds).
+    drag_latencies: Vec<f64>,
+    /// UI frames per second while dragging.
+    drag_fps: Option<f64>,
     /// Exit status for the process (non-zero when the run failed).
     pub failed: Option<String>,
 }
@@ -103,17 +122,20 @@ impl Automation {
             fps: None,
             fps_paused: None,
             latencies: Vec::new(),
+            drag_latencies: Vec::new(),
+            drag_fps: None,
             failed: None,
         })
     }
 
-    fn finish(&mut self, ctx: &egui::Context, failure: Option<String>) {
+    /// Ends the run: closes the window without asking about the edits the run made.
+    fn finish(&mut self, viewer: &mut Viewer, failure: Option<String>) {
         if let Some(f) = &failure {
             eprintln!("caustic view: {f}");
         }
         self.failed = failure;
         self.stage = Stage::Done;
-        ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+        viewer.close_discarding_edits();
     }
 
     /// Advances the script; called once per UI frame after the viewer's own UI.
@@ -121,11 +143,11 @@ impl Automation {
         ctx.request_repaint();
         if let Some(f) = viewer.render_failure() {
             let f = f.to_owned();
-            self.finish(ctx, Some(format!("the renderer failed: {f}")));
+            self.finish(viewer, Some(format!("the renderer failed: {f}")));
             return;
         }
         if self.options.launched.elapsed() > TIMEOUT && !matches!(self.stage, Stage::Done) {
-            self.finish(ctx, Some(format!("gave up after {} s", TIMEOUT.as_secs())));
+            self.finish(viewer, Some(format!("gave up after {} s", TIMEOUT.as_secs())));
             return;
         }
         let now = Instant::now();
@@ -189,17 +211,72 @@ impl Automation {
                         *round += 1;
                         *sent = None;
                         if *round == LATENCY_ROUNDS {
-                            self.stage = Stage::Screenshot { requested: false };
+                            self.stage = if viewer.patches().is_empty() {
+                                Stage::Screenshot { requested: false }
+                            } else {
+                                Stage::Drag {
+                                    round: 0,
+                                    sent: None,
+                                    press: None,
+                                    start: now,
+                                    frames: 0,
+                                }
+                            };
                         }
                     } else if now - *at > Duration::from_secs(60) {
-                        self.finish(ctx, Some("no image 60 s after a restart".into()));
+                        self.finish(viewer, Some("no image 60 s after a restart".into()));
                     }
                 }
             },
+            Stage::Drag {
+                round,
+                sent,
+                press,
+                start,
+                frames,
+            } => {
+                *frames += 1;
+                let Some(at) = *sent else {
+                    // Each step as the mouse makes it: press on the point, then move.
+                    if press.is_none() {
+                        let point = viewer.patches()[DRAG_POINT.patch].points[DRAG_POINT.index];
+                        *press = viewer.projection().and_then(|p| p.to_screen(point));
+                    }
+                    let Some(screen) = *press else {
+                        return;
+                    };
+                    if *round == 0 {
+                        viewer.apply(Action::BeginPointDrag {
+                            grab: DRAG_POINT,
+                            press: screen,
+                        });
+                    }
+                    let step = (*round + 1) as f32;
+                    viewer.apply(Action::DragPoints {
+                        pointer: screen + egui::vec2(3.0, -2.0) * step,
+                        along_view: false,
+                    });
+                    *sent = Some(now);
+                    return;
+                };
+                if viewer.restart_latency_secs().is_some() && !viewer.restart_pending() {
+                    self.drag_latencies
+                        .push(viewer.restart_latency_secs().unwrap_or(0.0));
+                    *round += 1;
+                    *sent = None;
+                    if *round == DRAG_ROUNDS {
+                        self.drag_fps = Some(*frames as f64 / (now - *start).as_secs_f64());
+                        viewer.apply(Action::EndGesture);
+                        self.stage = Stage::Screenshot { requested: false };
+                    }
+                } else if now - at > Duration::from_secs(60) {
+                    self.finish(viewer, Some("no image 60 s after a control-point move".into()));
+                }
+            }
             Stage::Screenshot { requested } => {
                 let Some(path) = self.options.screenshot.clone() else {
                     self.report(viewer);
-                    self.finish(ctx, None);
+                    self.finish(viewer, None);
                     return;
                 };
                 let passes = viewer.frame().map_or(0, |f| f.pass);
@@ -227,9 +304,9 @@ impl Automation {
                     match outcome {
                         Ok(p) => {
                             println!("caustic view: screenshot saved to {}", p.display());
-                            self.finish(ctx, None);
+                            self.finish(viewer, None);
                         }
-                        Err(e) => self.finish(ctx, Some(e)),
+                        Err(e) => self.finish(viewer, Some(e)),
                     }
                 }
             }
@@ -269,6 +346,39 @@ impl Automation {
                 l[l.len() - 1] * 1e3,
                 ms.join(", ")
             );
+        }
+        if !self.drag_latencies.is_empty() {
+            let mut l = self.drag_latencies.clone();
+            l.sort_by(f64::total_cmp);
+            let ms: Vec<String> = self
+                .drag_latencies
+                .iter()
+                .map(|s| format!("{:.0}", s * 1e3))
+                .collect();
+            println!(
+                "  control-point drag step to new-epoch image: median {:.0} ms, max {:.0} ms over {} steps  (each: {} ms)",
+                l[l.len() / 2] * 1e3,
+                l[l.len() - 1] * 1e3,
+                l.len(),
+                ms.join(", ")
+            );
+            if let Some(fps) = self.drag_fps {
+                println!("  UI frame rate while dragging:  {fps:.1} fps");
+            }
+            let secs = crate::bench::time_reprepare(
+                &viewer.edited_scene().geometry,
+                DRAG_POINT.patch,
+                DRAG_POINT.index,
+                21,
+            );
+            if !secs.is_empty() {
+                println!(
+                    "  re-prepare one edited patch (subdivision + BVH update): median {:.2} ms, max {:.2} ms over {} edits",
+                    secs[secs.len() / 2] * 1e3,
+                    secs[secs.len() - 1] * 1e3,
+                    secs.len()
+                );
+            }
         }
         if let Some(f) = viewer.frame() {
             println!(

@@ -40,6 +40,8 @@ pub enum Gesture {
         grab: PointRef,
         /// Where that point was on screen.
         grab_screen: Pos2,
+        /// Where the button went down.
+        press: Pos2,
         /// Every moved point and where it started.
         start: Vec<(PointRef, DVec3)>,
     },
@@ -221,14 +223,9 @@ impl Editor {
         changed
     }
 
-    /// The points a drag moves when it grabs `grab`: the selection if `grab` is in it, else
-    /// `grab` alone.
-    pub fn drag_set(&self, grab: PointRef) -> Vec<(PointRef, DVec3)> {
-        if self.selection.contains(&grab) {
-            self.selection.iter().map(|r| (*r, self.point(*r))).collect()
-        } else {
-            vec![(grab, self.point(grab))]
-        }
+    /// The selected points and where they are: what a drag moves.
+    pub fn selected_points(&self) -> Vec<(PointRef, DVec3)> {
+        self.selection.iter().map(|r| (*r, self.point(*r))).collect()
     }
 
     /// Where the dragged points go with the cursor at `pointer`: parallel to the image plane
@@ -243,6 +240,7 @@ impl Editor {
         let Some(Gesture::Points {
             grab,
             grab_screen,
+            press,
             start,
         }) = &self.gesture
         else {
@@ -252,13 +250,14 @@ impl Editor {
             return Vec::new();
         };
         let depth = proj.depth(origin);
+        // The grabbed point follows the cursor's motion since the press.
+        let offset = pointer - *press;
         let delta = if along_view {
-            let dy = (grab_screen.y - pointer.y) as f64;
+            let dy = -offset.y as f64;
             let dir = (origin - proj.camera.position).normalize_or_zero();
             dir * dy * proj.world_per_point(depth)
         } else {
-            // Exact on the plane: the point under the moved cursor at the grabbed depth.
-            let offset = pointer - *grab_screen;
+            // Exact on the plane: the point under the moved screen position at its depth.
             let here = proj.unproject(*grab_screen, depth);
             proj.unproject(*grab_screen + offset, depth) - here
         };

@@ -19,6 +19,11 @@ impl Viewer {
         }
     }
 
+    /// Closes the window without asking about unsaved edits (scripted runs).
+    pub(super) fn close_discarding_edits(&mut self) {
+        self.proceed(AfterDiscard::Close);
+    }
+
     fn proceed(&mut self, after: AfterDiscard) {
         match after {
             AfterDiscard::Open(path) => self.open_scene(path),

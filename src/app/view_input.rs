@@ -46,9 +46,8 @@ pub fn view_actions(
 
     // Drags: points with the left button, the camera with the right or middle one.
     if response.drag_started_by(PointerButton::Primary) && editing {
-        if let Some(grab) = grab_at(editor, Some(projection), press) {
-            let screen = projection.to_screen(editor.point(grab)).unwrap_or_default();
-            out.push(Action::BeginPointDrag { grab, screen });
+        if let (Some(grab), Some(press)) = (grab_at(editor, Some(projection), press), press) {
+            out.push(Action::BeginPointDrag { grab, press });
         }
     }
     let camera_move = if response.drag_started_by(PointerButton::Middle) {

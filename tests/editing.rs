@@ -1,0 +1,334 @@
+//! Shaping patches in the viewer as a person would, through egui_kittest: the mouse picks and
+//! drags control points of the built-in teapot, the moves sent to the render session follow
+//! the camera's geometry exactly, undo and redo restore the scene, the camera orbits from the
+//! view, the edited scene saves to TOML that loads back bit for bit, and a wgpu snapshot of
+//! the control-net overlay over a rendered teapot.
+#![cfg(feature = "viewer")]
+
+use std::path::Path;
+
+use caustic::app::overlay::PointRef;
+use caustic::app::settings::ViewerSettings;
+use caustic::app::viewer::Status;
+use caustic::app::Viewer;
+use caustic::geometry::BezierPatch;
+use caustic::render::ppm::{Control, Ppm, PpmOptions, PpmStats};
+use caustic::render::session::{Command, Frame};
+use caustic::scene::{RendererKind, Scene};
+use egui::{Event, Modifiers, PointerButton, Pos2, Vec2};
+use egui_kittest::kittest::Queryable;
+use egui_kittest::Harness;
+use glam::DVec3;
+
+const SIZE: (u32, u32) = (160, 120);
+
+type App<'a> = Harness<'a, Option<Viewer>>;
+
+fn teapot() -> Scene {
+    let mut scene = Scene::builtin();
+    (scene.camera.width, scene.camera.height) = SIZE;
+    scene.settings.photons_per_pass = 20_000;
+    scene
+}
+
+/// A flat grey frame: something to place the image (and its overlay) by.
+fn flat_frame() -> Frame {
+    let n = (SIZE.0 * SIZE.1) as usize;
+    Frame {
+        epoch: 0,
+        renderer: RendererKind::Ppm,
+        pass: 1,
+        photons: 1,
+        elapsed_secs: 0.1,
+        stats: PpmStats::default(),
+        width: SIZE.0,
+        height: SIZE.1,
+        radiance: vec![[0.2f32; 3]; n].into(),
+        radius: vec![0.0f32; n].into(),
+        gathered: vec![0.0f32; n].into(),
+        preview: false,
+    }
+}
+
+fn harness<'a>(builder: egui_kittest::HarnessBuilder<Option<Viewer>>) -> App<'a> {
+    builder.with_size(Vec2::new(1100.0, 720.0)).build_ui_state(
+        |ui, viewer: &mut Option<Viewer>| {
+            if let Some(v) = viewer {
+                v.ui(ui);
+            }
+        },
+        None,
+    )
+}
+
+fn editing_app<'a>() -> App<'a> {
+    let mut h = harness(Harness::builder());
+    let mut v = Viewer::with_pause(&h.ctx, teapot(), ViewerSettings::default(), true);
+    v.show_frame(flat_frame());
+    *h.state_mut() = Some(v);
+    h.run_steps(2);
+    h
+}
+
+fn viewer<'h>(h: &'h App<'_>) -> &'h Viewer {
+    h.state().as_ref().expect("viewer")
+}
+
+fn sent(h: &App<'_>) -> Vec<Command> {
+    viewer(h).recent_commands().cloned().collect()
+}
+
+/// A control point at least 3 pick radii from every other one on screen, and where it is.
+fn isolated_point(v: &Viewer) -> (PointRef, Pos2) {
+    let proj = v.projection().expect("the image was placed");
+    let screen: Vec<(PointRef, Pos2)> = v
+        .patches()
+        .iter()
+        .enumerate()
+        .flat_map(|(patch, p)| (0..16).map(move |index| (PointRef { patch, index }, p.points[index])))
+        .filter_map(|(r, q)| Some((r, proj.to_screen(q)?)))
+        .collect();
+    screen
+        .iter()
+        .copied()
+        .filter(|(_, s)| proj.view.shrink(20.0).contains(*s))
+        .find(|(r, s)| {
+            screen
+                .iter()
+                .all(|(o, t)| o == r || t.distance(*s) > 3.0 * caustic::app::overlay::PICK_RADIUS)
+        })
+        .expect("an isolated control point")
+}
+
+fn pointer(h: &mut App<'_>, pos: Pos2, button: PointerButton, pressed: bool, modifiers: Modifiers) {
+    h.event(Event::PointerMoved(pos));
+    h.event(Event::PointerButton {
+        pos,
+        button,
+        pressed,
+        modifiers,
+    });
+    h.step();
+}
+
+/// Presses at `from`, moves in steps by `by`, releases.
+fn drag(h: &mut App<'_>, from: Pos2, by: Vec2, button: PointerButton) {
+    h.event(Event::PointerMoved(from));
+    h.step();
+    pointer(h, from, button, true, Modifiers::NONE);
+    for k in 1..=5 {
+        h.event(Event::PointerMoved(from + by * (k as f32 / 5.0)));
+        h.step();
+    }
+    pointer(h, from + by, button, false, Modifiers::NONE);
+    h.step();
+}
+
+fn last_move(commands: &[Command], r: PointRef) -> Option<DVec3> {
+    commands.iter().rev().find_map(|c| match c {
+        Command::MoveControlPoint {
+            patch,
+            index,
+            position,
+        } if *patch == r.patch && *index == r.index => Some(*position),
+        _ => None,
+    })
+}
+
+#[test]
+fn click_selects_drag_moves_by_the_camera_geometry_and_undo_redo_restore() {
+    let mut h = editing_app();
+    let original: Vec<BezierPatch> = viewer(&h).patches().to_vec();
+    let (r, s) = isolated_point(viewer(&h));
+    let near = s + Vec2::new(3.0, 2.0);
+
+    // A click near the point selects it.
+    h.event(Event::PointerMoved(near));
+    h.step();
+    pointer(&mut h, near, PointerButton::Primary, true, Modifiers::NONE);
+    pointer(&mut h, near, PointerButton::Primary, false, Modifiers::NONE);
+    h.step();
+    assert_eq!(viewer(&h).selection().collect::<Vec<_>>(), vec![r]);
+
+    // A drag of (40, -25) points moves it in the plane through it parallel to the image.
+    let by = Vec2::new(40.0, -25.0);
+    drag(&mut h, near, by, PointerButton::Primary);
+    let p0 = original[r.patch].points[r.index];
+    let p1 = last_move(&sent(&h), r).expect("the drag sent moves");
+    assert_eq!(viewer(&h).patches()[r.patch].points[r.index], p1);
+    let cam = &viewer(&h).scene().camera;
+    let depth = |p: DVec3| (p - cam.position).dot(cam.forward);
+    assert!((depth(p1) - depth(p0)).abs() < 1e-6 * depth(p0), "depth changed");
+    let proj = viewer(&h).projection().expect("placed").clone();
+    let points_per_pixel = proj.image.width() as f64 / SIZE.0 as f64;
+    let moved = (cam.project(p1).expect("front") - cam.project(p0).expect("front")) * points_per_pixel;
+    assert!(
+        (moved.x - 40.0).abs() < 0.01 && (moved.y + 25.0).abs() < 0.01,
+        "moved {moved}"
+    );
+    assert!(viewer(&h).unsaved_edits());
+
+    // Undo restores the scene exactly (and tells the session); redo re-applies.
+    h.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);
+    h.step();
+    assert_eq!(viewer(&h).patches(), &original[..]);
+    assert_eq!(last_move(&sent(&h), r), Some(p0));
+    assert!(!viewer(&h).unsaved_edits());
+    h.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, egui::Key::Z);
+    h.step();
+    assert_eq!(viewer(&h).patches()[r.patch].points[r.index], p1);
+
+    // Dragging empty image space pans the image, moving no point.
+    let before = sent(&h).len();
+    drag(
+        &mut h,
+        proj.view.min + Vec2::new(15.0, 15.0),
+        Vec2::new(30.0, 10.0),
+        PointerButton::Primary,
+    );
+    assert!(!sent(&h)[before..]
+        .iter()
+        .any(|c| matches!(c, Command::MoveControlPoint { .. })));
+}
+
+#[test]
+fn a_whole_patch_moves_as_one_and_the_arrow_keys_nudge_it() {
+    let mut h = editing_app();
+    let original: Vec<BezierPatch> = viewer(&h).patches().to_vec();
+    let (r, s) = isolated_point(viewer(&h));
+    pointer(&mut h, s, PointerButton::Primary, true, Modifiers::NONE);
+    pointer(&mut h, s, PointerButton::Primary, false, Modifiers::NONE);
+    h.key_press(egui::Key::A);
+    h.step();
+    assert_eq!(viewer(&h).selection().count(), 16);
+    h.key_press(egui::Key::ArrowRight);
+    h.step();
+    let moved = &viewer(&h).patches()[r.patch];
+    let delta = moved.points[0] - original[r.patch].points[0];
+    assert!(delta.length() > 0.0);
+    for k in 0..16 {
+        assert!(((moved.points[k] - original[r.patch].points[k]) - delta).length() < 1e-12);
+    }
+    // To the right on screen: along the camera's right vector.
+    let cam = &viewer(&h).scene().camera;
+    assert!(delta.normalize().dot(cam.right) > 0.999999);
+    h.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);
+    h.step();
+    assert_eq!(viewer(&h).patches(), &original[..]);
+}
+
+#[test]
+fn the_camera_orbits_from_the_view_and_undo_puts_it_back() {
+    let mut h = editing_app();
+    let camera = viewer(&h).scene().camera.clone();
+    let view = viewer(&h).projection().expect("placed").view;
+    drag(
+        &mut h,
+        view.center(),
+        Vec2::new(60.0, 0.0),
+        PointerButton::Secondary,
+    );
+    let moved = viewer(&h).scene().camera.clone();
+    assert_ne!(moved.position, camera.position);
+    assert!(matches!(sent(&h).last(), Some(Command::SetCamera(c)) if *c == moved));
+    // The orbit keeps the distance to the pivot (the point the camera looked at).
+    let pivot = camera.position + camera.forward * camera.focal_distance;
+    assert!(((moved.position - pivot).length() - camera.focal_distance).abs() < 1e-9);
+    h.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);
+    h.step();
+    assert_eq!(viewer(&h).scene().camera, camera);
+}
+
+#[test]
+fn the_edited_scene_saves_and_loads_back_with_the_same_patches() {
+    let mut h = editing_app();
+    let (r, s) = isolated_point(viewer(&h));
+    drag(&mut h, s, Vec2::new(-20.0, 30.0), PointerButton::Primary);
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("edited.toml");
+    h.state_mut()
+        .as_mut()
+        .expect("viewer")
+        .save_scene_to(path.clone());
+    h.step();
+    assert!(
+        matches!(viewer(&h).status(), Some(Status::Info(s)) if s.contains("Saved scene")),
+        "{:?}",
+        viewer(&h).status()
+    );
+    assert!(!viewer(&h).unsaved_edits());
+    let back = Scene::load(&path).expect("the saved scene loads");
+    let patches: Vec<BezierPatch> = back.geometry.patches().iter().map(|(p, _)| *p).collect();
+    assert_eq!(patches, viewer(&h).patches());
+    assert_ne!(patches[r.patch], Scene::builtin().geometry.patches()[r.patch].0);
+    // Saving again over it asks first; Cancel keeps the file byte for byte.
+    let before = std::fs::read(&path).expect("saved");
+    h.state_mut()
+        .as_mut()
+        .expect("viewer")
+        .save_scene_to(path.clone());
+    h.run_steps(3);
+    h.get_by_label("Cancel").click();
+    h.run_steps(2);
+    assert_eq!(std::fs::read(&path).expect("kept"), before);
+}
+
+#[test]
+fn opening_another_scene_with_unsaved_edits_asks_first() {
+    let mut h = editing_app();
+    let (_, s) = isolated_point(viewer(&h));
+    drag(&mut h, s, Vec2::new(25.0, 0.0), PointerButton::Primary);
+    let other = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell.toml");
+    h.state_mut()
+        .as_mut()
+        .expect("viewer")
+        .apply(caustic::app::Action::OpenScene(other));
+    h.run_steps(3);
+    assert!(
+        h.query_by_label_contains("not saved").is_some(),
+        "no question asked"
+    );
+    h.get_by_label("Cancel").click();
+    h.run_steps(2);
+    assert!(
+        viewer(&h).unsaved_edits() && !viewer(&h).busy(),
+        "the edits were dropped"
+    );
+    assert_eq!(viewer(&h).scene().source, Path::new("<built-in>"));
+}
+
+/// Three deterministic passes of the small teapot.
+fn teapot_frame() -> Frame {
+    let scene = teapot();
+    let mut ppm = Ppm::new(&scene, PpmOptions::default());
+    for _ in 0..3 {
+        ppm.run_pass(&scene, &mut |_| Control::Continue);
+    }
+    let mut frame = Frame::from_ppm(&ppm, 0, 1.0);
+    frame.stats.elapsed_secs = 1.0;
+    frame.stats.photon_secs = 0.5;
+    frame
+}
+
+#[test]
+fn overlay_snapshot_over_the_teapot() {
+    let render_state = egui_kittest::wgpu::create_render_state(
+        egui_kittest::wgpu::default_wgpu_setup(),
+        eframe::egui_wgpu::RendererOptions::PREDICTABLE,
+    );
+    let renderer = egui_kittest::wgpu::WgpuTestRenderer::from_render_state(render_state.clone());
+    let mut h = harness(Harness::builder().renderer(renderer));
+    let mut v = Viewer::with_pause(&h.ctx, teapot(), ViewerSettings::default(), true);
+    // egui_kittest's render pass has no depth attachment.
+    v.install_overlay(&render_state, None);
+    v.show_frame(teapot_frame());
+    v.settings.exposure_stops = 1.0;
+    *h.state_mut() = Some(v);
+    h.run_steps(2);
+    let (_, s) = isolated_point(viewer(&h));
+    pointer(&mut h, s, PointerButton::Primary, true, Modifiers::NONE);
+    pointer(&mut h, s, PointerButton::Primary, false, Modifiers::NONE);
+    h.key_press(egui::Key::A);
+    h.run_steps(3);
+    h.snapshot("editing_overlay");
+}
