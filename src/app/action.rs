@@ -168,11 +168,21 @@ impl Viewer {
             Action::ShowSidePanel(on) => self.settings.show_side_panel = on,
             Action::ShowHelp(on) => self.show_help = on,
             Action::ShowWireframe(on) => self.settings.show_wireframe = on,
-            edit => self.apply_edit_action(edit),
+            a @ (Action::Hover(_)
+            | Action::Select { .. }
+            | Action::SelectPatch(_)
+            | Action::ClearSelection) => self.apply_selection(a),
+            a @ (Action::BeginPointDrag { .. }
+            | Action::DragPoints { .. }
+            | Action::BeginCameraDrag(_)
+            | Action::DragCamera(_)
+            | Action::EndGesture) => self.apply_gesture(a),
+            edit => self.apply_edit(edit),
         }
     }
 
-    fn apply_edit_action(&mut self, action: Action) {
+    /// Hover and selection.
+    fn apply_selection(&mut self, action: Action) {
         match action {
             Action::Hover(point) => {
                 if self.editor.hovered != point {
@@ -202,6 +212,13 @@ impl Viewer {
                 self.editor.selection.clear();
                 self.editor.touch();
             }
+            other => unreachable!("not a selection action: {other:?}"),
+        }
+    }
+
+    /// Mouse drags of points and of the camera.
+    fn apply_gesture(&mut self, action: Action) {
+        match action {
             Action::BeginPointDrag { grab, press } => {
                 let on_screen = self.editor.exists(grab).then(|| self.editor.point(grab));
                 let on_screen = on_screen.and_then(|q| self.projection.as_ref()?.to_screen(q));
@@ -240,6 +257,13 @@ impl Viewer {
                 }
             }
             Action::EndGesture => self.end_gesture(),
+            other => unreachable!("not a gesture action: {other:?}"),
+        }
+    }
+
+    /// One-step edits and undo/redo.
+    fn apply_edit(&mut self, action: Action) {
+        match action {
             Action::SetPoint(point, position) => {
                 let changed = self.move_points(&[(point, position)]);
                 self.record(Edit::Points(changed));

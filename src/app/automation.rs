@@ -65,13 +65,7 @@ enum Stage {
         round: usize,
         sent: Option<Instant>,
     },
-    Drag {
-        round: usize,
-        sent: Option<Instant>,
-        press: Option<egui::Pos2>,
-        start: Instant,
-        frames: u32,
-    },
+    Drag(DragStage),
     Screenshot {
         requested: bool,
     },
@@ -89,6 +83,63 @@ impl Stage {
             ui_secs: 0.0,
             paused,
         }
+    }
+}
+
+/// The drag stage of `--bench`: a control point dragged step by step through the same
+/// actions the mouse emits, each step timed to its new epoch's first image.
+struct DragStage {
+    round: usize,
+    /// When the current step was made.
+    sent: Option<Instant>,
+    /// Where the drag pressed (the point's place on screen).
+    press: Option<egui::Pos2>,
+    start: Instant,
+    frames: u32,
+}
+
+impl DragStage {
+    /// One UI frame of the stage: `Some(Ok(frames per second))` when done, `Some(Err)` when
+    /// the renderer showed nothing for a minute.
+    fn step(
+        &mut self,
+        viewer: &mut Viewer,
+        now: Instant,
+        latencies: &mut Vec<f64>,
+    ) -> Option<Result<f64, String>> {
+        self.frames += 1;
+        let Some(at) = self.sent else {
+            if self.press.is_none() {
+                let point = viewer.patches()[DRAG_POINT.patch].points[DRAG_POINT.index];
+                self.press = viewer.projection().and_then(|p| p.to_screen(point));
+            }
+            let screen = self.press?;
+            if self.round == 0 {
+                viewer.apply(Action::BeginPointDrag {
+                    grab: DRAG_POINT,
+                    press: screen,
+                });
+            }
+            let step = (self.round + 1) as f32;
+            viewer.apply(Action::DragPoints {
+                pointer: screen + egui::vec2(3.0, -2.0) * step,
+                along_view: false,
+            });
+            self.sent = Some(now);
+            return None;
+        };
+        if viewer.restart_latency_secs().is_some() && !viewer.restart_pending() {
+            latencies.push(viewer.restart_latency_secs().unwrap_or(0.0));
+            self.round += 1;
+            self.sent = None;
+            if self.round == DRAG_ROUNDS {
+                viewer.apply(Action::EndGesture);
+                return Some(Ok(self.frames as f64 / (now - self.start).as_secs_f64()));
+            }
+        } else if now - at > Duration::from_secs(60) {
+            return Some(Err("no image 60 s after a control-point move".into()));
+        }
+        None
     }
 }
 
@@ -214,13 +265,13 @@ impl Automation {
                             self.stage = if viewer.patches().is_empty() {
                                 Stage::Screenshot { requested: false }
                             } else {
-                                Stage::Drag {
+                                Stage::Drag(DragStage {
                                     round: 0,
                                     sent: None,
                                     press: None,
                                     start: now,
                                     frames: 0,
-                                }
+                                })
                             };
                         }
                     } else if now - *at > Duration::from_secs(60) {
@@ -228,89 +279,58 @@ impl Automation {
                     }
                 }
             },
-            Stage::Drag {
-                round,
-                sent,
-                press,
-                start,
-                frames,
-            } => {
-                *frames += 1;
-                let Some(at) = *sent else {
-                    // Each step as the mouse makes it: press on the point, then move.
-                    if press.is_none() {
-                        let point = viewer.patches()[DRAG_POINT.patch].points[DRAG_POINT.index];
-                        *press = viewer.projection().and_then(|p| p.to_screen(point));
-                    }
-                    let Some(screen) = *press else {
-                        return;
-                    };
-                    if *round == 0 {
-                        viewer.apply(Action::BeginPointDrag {
-                            grab: DRAG_POINT,
-                            press: screen,
-                        });
-                    }
-                    let step = (*round + 1) as f32;
-                    viewer.apply(Action::DragPoints {
-                        pointer: screen + egui::vec2(3.0, -2.0) * step,
-                        along_view: false,
-                    });
-                    *sent = Some(now);
-                    return;
-                };
-                if viewer.restart_latency_secs().is_some() && !viewer.restart_pending() {
-                    self.drag_latencies
-                        .push(viewer.restart_latency_secs().unwrap_or(0.0));
-                    *round += 1;
-                    *sent = None;
-                    if *round == DRAG_ROUNDS {
-                        self.drag_fps = Some(*frames as f64 / (now - *start).as_secs_f64());
-                        viewer.apply(Action::EndGesture);
-                        self.stage = Stage::Screenshot { requested: false };
-                    }
-                } else if now - at > Duration::from_secs(60) {
-                    self.finish(viewer, Some("no image 60 s after a control-point move".into()));
+            Stage::Drag(drag) => match drag.step(viewer, now, &mut self.drag_latencies) {
+                Some(Ok(fps)) => {
+                    self.drag_fps = Some(fps);
+                    self.stage = Stage::Screenshot { requested: false };
                 }
-            }
-            Stage::Screenshot { requested } => {
-                let Some(path) = self.options.screenshot.clone() else {
-                    self.report(viewer);
-                    self.finish(viewer, None);
-                    return;
-                };
-                let passes = viewer.frame().map_or(0, |f| f.pass);
-                let whitted = viewer
-                    .frame()
-                    .is_some_and(|f| f.renderer == crate::scene::RendererKind::Whitted);
-                if !*requested && (passes >= self.options.screenshot_after_passes || whitted) {
-                    *requested = true;
-                    let result = self.screenshot_result.clone();
-                    let force = self.options.force;
-                    let waker = ctx.clone();
-                    ctx.request_screenshot(move |image| {
-                        let outcome = save_screenshot(&image, &path, force);
-                        if let Ok(mut r) = result.lock() {
-                            *r = Some(outcome);
-                        }
-                        waker.request_repaint();
-                    });
-                }
-                let done = self.screenshot_result.lock().ok().and_then(|mut r| r.take());
-                if let Some(outcome) = done {
-                    if self.options.bench {
-                        self.report(viewer);
-                    }
-                    match outcome {
-                        Ok(p) => {
-                            println!("caustic view: screenshot saved to {}", p.display());
-                            self.finish(viewer, None);
-                        }
-                        Err(e) => self.finish(viewer, Some(e)),
-                    }
-                }
-            }
+                Some(Err(e)) => self.finish(viewer, Some(e)),
+                None => {}
+            },
+            Stage::Screenshot { .. } => self.screenshot_step(viewer, ctx),
             Stage::Done => {}
+        }
+    }
+
+    /// Takes the screenshot once enough passes are done, then ends the run.
+    fn screenshot_step(&mut self, viewer: &mut Viewer, ctx: &egui::Context) {
+        let Stage::Screenshot { requested } = &mut self.stage else {
+            return;
+        };
+        let Some(path) = self.options.screenshot.clone() else {
+            self.report(viewer);
+            self.finish(viewer, None);
+            return;
+        };
+        let passes = viewer.frame().map_or(0, |f| f.pass);
+        let whitted = viewer
+            .frame()
+            .is_some_and(|f| f.renderer == crate::scene::RendererKind::Whitted);
+        if !*requested && (passes >= self.options.screenshot_after_passes || whitted) {
+            *requested = true;
+            let result = self.screenshot_result.clone();
+            let force = self.options.force;
+            let waker = ctx.clone();
+            ctx.request_screenshot(move |image| {
+                let outcome = save_screenshot(&image, &path, force);
+                if let Ok(mut r) = result.lock() {
+                    *r = Some(outcome);
+                }
+                waker.request_repaint();
+            });
+        }
+        let done = self.screenshot_result.lock().ok().and_then(|mut r| r.take());
+        if let Some(outcome) = done {
+            if self.options.bench {
+                self.report(viewer);
+            }
+            match outcome {
+                Ok(p) => {
+                    println!("caustic view: screenshot saved to {}", p.display());
+                    self.finish(viewer, None);
+                }
+                Err(e) => self.finish(viewer, Some(e)),
+            }
         }
     }
 
@@ -391,9 +411,6 @@ impl Automation {
 
 /// Writes a window screenshot as PNG (temp name + rename; refuses to replace unless `force`).
 fn save_screenshot(image: &egui::ColorImage, path: &std::path::Path, force: bool) -> Result<PathBuf, String> {
-    if path.exists() && !force {
-        return Err(format!("{} exists (pass --force to replace it)", path.display()));
-    }
     let [w, h] = image.size;
     let bytes: Vec<u8> = image
         .pixels
@@ -402,9 +419,13 @@ fn save_screenshot(image: &egui::ColorImage, path: &std::path::Path, force: bool
         .collect();
     let rgba = image::RgbaImage::from_raw(w as u32, h as u32, bytes)
         .ok_or_else(|| "screenshot has an inconsistent size".to_owned())?;
-    let tmp = path.with_extension("png.partial");
-    rgba.save_with_format(&tmp, image::ImageFormat::Png)
-        .map_err(|e| format!("{}: {e}", path.display()))?;
-    std::fs::rename(&tmp, path).map_err(|e| format!("{}: {e}", path.display()))?;
+    crate::files::write_atomically(path, force, |tmp| {
+        rgba.save_with_format(tmp, image::ImageFormat::Png)
+            .map_err(|e| e.to_string())
+    })
+    .map_err(|e| match e {
+        crate::files::WriteError::Exists(p) => format!("{} exists (pass --force to replace it)", p.display()),
+        other => other.to_string(),
+    })?;
     Ok(path.to_path_buf())
 }

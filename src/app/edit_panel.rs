@@ -7,46 +7,64 @@ use super::action::Action;
 use super::overlay::PointRef;
 use super::viewer::Viewer;
 
-/// The Edit menu.
-pub fn edit_menu_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) {
+/// An editing command offered by both the Edit menu and the side panel.
+struct EditCommand {
+    label: &'static str,
+    keys: &'static str,
+    tip: &'static str,
+    action: Option<Action>,
+}
+
+/// Undo, redo, whole patch, select none, frame: `action` is `None` where it does not apply.
+fn edit_commands(viewer: &Viewer) -> [EditCommand; 5] {
     let (can_undo, can_redo) = viewer.editor.history.can_undo_redo();
     let selected = viewer.editor.selection.first().copied();
+    [
+        EditCommand {
+            label: "Undo",
+            keys: "Ctrl+Z",
+            tip: "Undo the last control-point or camera edit",
+            action: can_undo.then_some(Action::Undo),
+        },
+        EditCommand {
+            label: "Redo",
+            keys: "Ctrl+Shift+Z",
+            tip: "Redo the last undone edit",
+            action: can_redo.then_some(Action::Redo),
+        },
+        EditCommand {
+            label: "Whole patch",
+            keys: "A",
+            tip: "Select all 16 control points of the selected point's patch, to move it as one",
+            action: selected.map(|r| Action::SelectPatch(r.patch)),
+        },
+        EditCommand {
+            label: "Select none",
+            keys: "Esc",
+            tip: "Clear the selection",
+            action: selected.map(|_| Action::ClearSelection),
+        },
+        EditCommand {
+            label: "Frame",
+            keys: "C",
+            tip: "Turn and move the camera onto the selection (or all patches)",
+            action: Some(Action::FrameSelection),
+        },
+    ]
+}
+
+/// The Edit menu.
+pub fn edit_menu_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) {
     ui.menu_button("Edit", |ui| {
-        if ui
-            .add_enabled(can_undo, egui::Button::new("Undo  (Ctrl+Z)"))
-            .on_hover_text("Undo the last control-point or camera edit")
-            .clicked()
-        {
-            out.push(Action::Undo);
-        }
-        if ui
-            .add_enabled(can_redo, egui::Button::new("Redo  (Ctrl+Shift+Z)"))
-            .on_hover_text("Redo the last undone edit")
-            .clicked()
-        {
-            out.push(Action::Redo);
-        }
-        ui.separator();
-        if ui
-            .add_enabled(selected.is_some(), egui::Button::new("Select whole patch  (A)"))
-            .on_hover_text("Select all 16 control points of the selected point's patch, to move it as one")
-            .clicked()
-        {
-            out.extend(selected.map(|r| Action::SelectPatch(r.patch)));
-        }
-        if ui
-            .add_enabled(selected.is_some(), egui::Button::new("Select none  (Esc)"))
-            .on_hover_text("Clear the selection")
-            .clicked()
-        {
-            out.push(Action::ClearSelection);
-        }
-        if ui
-            .button("Frame selection  (C)")
-            .on_hover_text("Turn and move the camera onto the selection (or all patches)")
-            .clicked()
-        {
-            out.push(Action::FrameSelection);
+        for c in edit_commands(viewer) {
+            let button = egui::Button::new(format!("{}  ({})", c.label, c.keys));
+            if ui
+                .add_enabled(c.action.is_some(), button)
+                .on_hover_text(c.tip)
+                .clicked()
+            {
+                out.extend(c.action);
+            }
         }
     });
 }
@@ -105,35 +123,16 @@ pub fn edit_panel_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) 
             ui.label(format!("{n} points selected in {} patch(es)", patches.len()));
         }
     }
-    ui.horizontal(|ui| {
-        let (can_undo, can_redo) = editor.history.can_undo_redo();
-        if ui
-            .add_enabled(can_undo, egui::Button::new("Undo"))
-            .on_hover_text("Ctrl+Z")
-            .clicked()
-        {
-            out.push(Action::Undo);
-        }
-        if ui
-            .add_enabled(can_redo, egui::Button::new("Redo"))
-            .on_hover_text("Ctrl+Shift+Z")
-            .clicked()
-        {
-            out.push(Action::Redo);
-        }
-        if ui
-            .add_enabled(n > 0, egui::Button::new("Whole patch"))
-            .on_hover_text("Select every control point of the selected point's patch (A)")
-            .clicked()
-        {
-            out.extend(editor.selection.first().map(|r| Action::SelectPatch(r.patch)));
-        }
-        if ui
-            .button("Frame")
-            .on_hover_text("Point the camera at the selection, or at all patches (C)")
-            .clicked()
-        {
-            out.push(Action::FrameSelection);
+    ui.horizontal_wrapped(|ui| {
+        for c in edit_commands(viewer) {
+            let tip = format!("{} ({})", c.tip, c.keys);
+            if ui
+                .add_enabled(c.action.is_some(), egui::Button::new(c.label))
+                .on_hover_text(tip)
+                .clicked()
+            {
+                out.extend(c.action);
+            }
         }
     });
     let label = if viewer.unsaved_edits() {
