@@ -1,0 +1,365 @@
+//! `caustic bench`: measurement commands that print figures (nothing is asserted): ray/patch
+//! intersection, the ray tracer, photon throughput and error against time.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+use clap::{Subcommand, ValueEnum};
+
+use super::load_scene;
+use caustic::bench::{teapot_geometry, teapot_view, time_intersect};
+use caustic::geometry::{PatchMethod, SubdivisionParams};
+use caustic::render::ppm::{Control, IndexKind, Ppm, PpmOptions};
+use caustic::render::render_whitted;
+use caustic::scene::Scene;
+
+#[derive(Subcommand)]
+pub enum BenchCommand {
+    /// Ray/teapot intersection: ns per hitting and per missing primary ray, one thread.
+    Intersect {
+        /// Image side in pixels (rays = size²).
+        #[arg(long, default_value_t = 512)]
+        size: usize,
+        /// Times each ray set is traced (more = steadier figures).
+        #[arg(long, default_value_t = 3)]
+        repeat: usize,
+        /// Which intersectors to time.
+        #[arg(long, value_enum, default_value_t = MethodChoice::Both)]
+        method: MethodChoice,
+        /// Subdivision depth of the per-ray (seed) intersector.
+        #[arg(long, default_value_t = 5)]
+        per_ray_depth: u32,
+        /// Prepared leaves: flatness (control-point deviation / leaf diagonal).
+        #[arg(long, default_value_t = SubdivisionParams::default().flatness)]
+        flatness: f64,
+        /// Prepared leaves: largest leaf diagonal / patch diagonal.
+        #[arg(long, default_value_t = SubdivisionParams::default().max_size)]
+        max_size: f64,
+        /// Prepared leaves: subdivision depth limit.
+        #[arg(long, default_value_t = SubdivisionParams::default().max_depth)]
+        max_depth: u32,
+    },
+    /// Photon mapping: photon paths per core-second at the given thread counts.
+    Ppm {
+        /// Scene file.
+        #[arg(default_value = "scenes/smallppm.toml")]
+        scene: PathBuf,
+        /// Photons per pass.
+        #[arg(long, default_value_t = 500_000)]
+        photons: u64,
+        /// Passes per measurement.
+        #[arg(long, default_value_t = 3)]
+        passes: u32,
+        /// Thread counts to measure.
+        #[arg(long, value_delimiter = ',', default_value = "1,2")]
+        threads: Vec<usize>,
+    },
+    /// Photon mapping: RMSE against a long reference render over time, for the hash grid and
+    /// the kd-tree, with and without direct light by shadow rays.
+    Convergence {
+        /// Scene file.
+        #[arg(default_value = "scenes/smallppm.toml")]
+        scene: PathBuf,
+        /// Image width (height follows the scene's aspect).
+        #[arg(long, default_value_t = 256)]
+        width: u32,
+        /// Photons per pass.
+        #[arg(long, default_value_t = 100_000)]
+        photons: u64,
+        /// Passes of each measured configuration.
+        #[arg(long, default_value_t = 32)]
+        passes: u32,
+        /// Passes of the reference render (grid, no direct light, another seed).
+        #[arg(long, default_value_t = 400)]
+        reference_passes: u32,
+        /// Write every (configuration, pass, seconds, RMSE) row to this CSV file.
+        #[arg(long)]
+        csv: Option<PathBuf>,
+    },
+    /// Whitted ray tracer: rays per second on a scene, at the given thread counts.
+    Whitted {
+        /// Scene file; the built-in scene when omitted.
+        scene: Option<PathBuf>,
+        /// Image width (height follows the scene's aspect).
+        #[arg(long, default_value_t = 640)]
+        width: u32,
+        /// Thread counts to measure.
+        #[arg(long, value_delimiter = ',', default_value = "1,2")]
+        threads: Vec<usize>,
+    },
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum MethodChoice {
+    Prepared,
+    PerRay,
+    Both,
+}
+
+/// Runs a bench command.
+pub fn bench(what: BenchCommand) -> Result<()> {
+    match what {
+        BenchCommand::Intersect {
+            size,
+            repeat,
+            method,
+            per_ray_depth,
+            flatness,
+            max_size,
+            max_depth,
+        } => {
+            let params = SubdivisionParams {
+                flatness,
+                max_size,
+                max_depth,
+            };
+            bench_intersect(size, repeat, method, per_ray_depth, params)
+        }
+        BenchCommand::Whitted {
+            scene,
+            width,
+            threads,
+        } => bench_whitted(scene.as_deref(), width, &threads),
+        BenchCommand::Ppm {
+            scene,
+            photons,
+            passes,
+            threads,
+        } => bench_ppm(&scene, photons, passes, &threads),
+        BenchCommand::Convergence {
+            scene,
+            width,
+            photons,
+            passes,
+            reference_passes,
+            csv,
+        } => bench_convergence(&scene, width, photons, passes, reference_passes, csv.as_deref()),
+    }
+}
+
+fn bench_ppm(scene_path: &Path, photons: u64, passes: u32, threads: &[usize]) -> Result<()> {
+    if photons == 0 || passes == 0 {
+        bail!("--photons and --passes must be at least 1");
+    }
+    let mut scene = Scene::load(scene_path)?;
+    scene.settings.photons_per_pass = photons;
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    println!(
+        "Photon mapping on {}, {w}x{h}, {passes} passes of {photons} photons",
+        scene.source.display()
+    );
+    println!(
+        "{:>8} {:>12} {:>16} {:>22} {:>10}",
+        "threads", "photon s", "photon paths/s", "paths per core-second", "scaling"
+    );
+    let mut base = None;
+    for &n in threads {
+        if n == 0 {
+            bail!("--threads values must be at least 1");
+        }
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(n).build()?;
+        let stats = pool.install(|| {
+            let mut ppm = Ppm::new(&scene, PpmOptions::default());
+            for _ in 0..passes {
+                ppm.run_pass(&scene, &mut |_| Control::Continue);
+            }
+            ppm.stats().clone()
+        });
+        let rate = stats.photons as f64 / stats.photon_secs;
+        let scaling = base.map_or(1.0, |b: f64| rate / b);
+        base.get_or_insert(rate);
+        println!(
+            "{n:>8} {:>12.3} {rate:>16.0} {:>22.0} {scaling:>9.2}x",
+            stats.photon_secs,
+            rate / n as f64
+        );
+    }
+    Ok(())
+}
+
+fn rmse(a: &[[f32; 3]], b: &[[f32; 3]]) -> f64 {
+    let sum: f64 = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| (0..3).map(|c| (x[c] as f64 - y[c] as f64).powi(2)).sum::<f64>())
+        .sum();
+    (sum / (3 * a.len()) as f64).sqrt()
+}
+
+fn bench_convergence(
+    scene_path: &Path,
+    width: u32,
+    photons: u64,
+    passes: u32,
+    reference_passes: u32,
+    csv: Option<&Path>,
+) -> Result<()> {
+    if photons == 0 || passes == 0 || reference_passes == 0 || width == 0 {
+        bail!("--width, --photons, --passes and --reference-passes must be at least 1");
+    }
+    if let Some(p) = csv {
+        if p.exists() {
+            bail!("{}: the file exists; choose another name", p.display());
+        }
+    }
+    let mut scene = Scene::load(scene_path)?;
+    let aspect = scene.camera.height as f64 / scene.camera.width as f64;
+    scene.camera.width = width;
+    scene.camera.height = ((width as f64 * aspect).round() as u32).max(1);
+    scene.settings.photons_per_pass = photons;
+    println!(
+        "Convergence on {}, {}x{}, {photons} photons per pass; reference: {reference_passes} passes",
+        scene.source.display(),
+        scene.camera.width,
+        scene.camera.height
+    );
+    let mut reference_scene = scene.clone();
+    reference_scene.settings.seed ^= 0x5eed;
+    let bar = indicatif::ProgressBar::new(reference_passes as u64);
+    let mut reference = Ppm::new(&reference_scene, PpmOptions::default());
+    for _ in 0..reference_passes {
+        reference.run_pass(&reference_scene, &mut |_| Control::Continue);
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    let reference = reference.radiance();
+    let configs = [
+        ("hash grid", IndexKind::HashGrid, false),
+        ("kd-tree", IndexKind::KdTree, false),
+        ("hash grid + direct", IndexKind::HashGrid, true),
+        ("kd-tree + direct", IndexKind::KdTree, true),
+    ];
+    let mut rows = Vec::new();
+    let mut curves = Vec::new();
+    for (name, index, direct_light) in configs {
+        let options = PpmOptions {
+            index,
+            direct_light,
+            ..Default::default()
+        };
+        let mut ppm = Ppm::new(&scene, options);
+        let mut curve = Vec::new();
+        for _ in 0..passes {
+            ppm.run_pass(&scene, &mut |_| Control::Continue);
+            let s = ppm.stats();
+            let e = rmse(&ppm.radiance(), &reference);
+            rows.push(format!("{name},{},{:.4},{e:.6e}", s.passes, s.elapsed_secs));
+            curve.push((s.elapsed_secs, e));
+        }
+        curves.push((name, curve));
+    }
+    // Target: the error the plain hash grid reaches after half its passes.
+    let target = curves[0].1[(passes as usize / 2).saturating_sub(1)].1;
+    println!(
+        "{:<22} {:>12} {:>14} {:>22}",
+        "configuration", "final RMSE", "seconds", "seconds to RMSE target"
+    );
+    for (name, curve) in &curves {
+        let (secs, err) = curve[curve.len() - 1];
+        let reach = curve
+            .iter()
+            .find(|(_, e)| *e <= target)
+            .map_or("not reached".to_owned(), |(t, _)| format!("{t:.2}"));
+        println!("{name:<22} {err:>12.4e} {secs:>14.2} {reach:>22}");
+    }
+    println!(
+        "RMSE target {target:.4e} (the hash grid's error after {} passes)",
+        passes / 2
+    );
+    if let Some(p) = csv {
+        let mut text = String::from("configuration,pass,seconds,rmse\n");
+        for r in rows {
+            text.push_str(&r);
+            text.push('\n');
+        }
+        std::fs::write(p, text).with_context(|| format!("{}: cannot write the CSV file", p.display()))?;
+        println!("rows written to {}", p.display());
+    }
+    Ok(())
+}
+
+fn bench_whitted(scene_path: Option<&Path>, width: u32, threads: &[usize]) -> Result<()> {
+    let mut scene = load_scene(scene_path)?;
+    let aspect = scene.camera.height as f64 / scene.camera.width as f64;
+    scene.camera.width = width.clamp(1, 16384);
+    scene.camera.height = ((width as f64 * aspect).round() as u32).max(1);
+    println!(
+        "Whitted ray tracer on {}, {}x{}",
+        scene.source.display(),
+        scene.camera.width,
+        scene.camera.height
+    );
+    println!(
+        "{:>8} {:>10} {:>14} {:>12}",
+        "threads", "seconds", "camera rays/s", "speed-up"
+    );
+    let mut base = None;
+    for &n in threads {
+        if n == 0 {
+            bail!("--threads values must be at least 1");
+        }
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(n).build()?;
+        let (_, stats) = pool.install(|| render_whitted(&scene, &|_| {}));
+        let rate = stats.camera_rays as f64 / stats.elapsed_secs;
+        let speedup = base.map_or(1.0, |b: f64| stats.elapsed_secs.recip() * b);
+        base.get_or_insert(stats.elapsed_secs);
+        println!(
+            "{n:>8} {:>10.3} {rate:>14.0} {speedup:>11.2}x",
+            stats.elapsed_secs
+        );
+    }
+    Ok(())
+}
+
+fn bench_intersect(
+    size: usize,
+    repeat: usize,
+    method: MethodChoice,
+    per_ray_depth: u32,
+    params: SubdivisionParams,
+) -> Result<()> {
+    if size == 0 || size > 8192 {
+        bail!("--size must be between 1 and 8192, got {size}");
+    }
+    if repeat == 0 {
+        bail!("--repeat must be at least 1");
+    }
+    if !(1..=30).contains(&per_ray_depth) {
+        bail!("--per-ray-depth must be between 1 and 30, got {per_ray_depth}");
+    }
+    if !(params.flatness > 0.0 && params.max_size > 0.0 && params.max_depth <= 12) {
+        bail!("--flatness and --max-size must be positive and --max-depth at most 12");
+    }
+    let rays = teapot_view(size, size);
+    println!("Utah teapot (32 patches), {size}x{size} primary rays, 1 thread, {repeat} repeats");
+    println!(
+        "{:<22} {:>9} {:>9} {:>12} {:>13}",
+        "intersector", "hit rays", "miss rays", "ns/hit ray", "ns/miss ray"
+    );
+    let mut methods = Vec::new();
+    if method != MethodChoice::PerRay {
+        methods.push(("prepared".to_owned(), PatchMethod::Prepared(params)));
+    }
+    if method != MethodChoice::Prepared {
+        methods.push((
+            format!("per-ray (depth {per_ray_depth})"),
+            PatchMethod::PerRay { depth: per_ray_depth },
+        ));
+    }
+    for (name, m) in methods {
+        let start = std::time::Instant::now();
+        let geometry = teapot_geometry(m);
+        let prep_ms = start.elapsed().as_secs_f64() * 1e3;
+        let t = time_intersect(&name, &geometry, &rays, repeat);
+        println!(
+            "{:<22} {:>9} {:>9} {:>12.1} {:>13.1}",
+            t.method, t.hit_rays, t.miss_rays, t.ns_per_hit, t.ns_per_miss
+        );
+        let s = geometry.stats();
+        println!(
+            "    prepare {prep_ms:.2} ms; {} BVH primitives ({} patch leaves), {} nodes, depth {}",
+            s.primitives, s.patch_leaves, s.bvh_nodes, s.bvh_depth
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,74 @@
+//! The `caustic` command line: argument parsing and dispatch; each command lives in a file of
+//! its own ([`view`], [`render`], [`export`], [`bench`]).
+
+mod bench;
+mod export;
+mod render;
+mod view;
+
+use std::path::Path;
+
+use anyhow::{Context, Result};
+use clap::{Parser, Subcommand};
+
+use caustic::scene::Scene;
+
+#[derive(Parser)]
+#[command(
+    name = "caustic",
+    version,
+    about = "Progressive photon mapping of exact Bézier patches"
+)]
+struct Cli {
+    /// What to do; without one, the viewer opens on the built-in scene.
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Open the viewer window on a scene (the built-in teapot scene when omitted).
+    View(view::ViewArgs),
+    /// Render a scene to an image (PNG: tonemapped sRGB; EXR: linear float).
+    Render(render::RenderArgs),
+    /// Write a scene's Bézier patches, tessellated, as a Wavefront OBJ file.
+    ExportObj(export::ExportArgs),
+    /// Measure performance; prints figures (nothing is asserted).
+    Bench {
+        #[command(subcommand)]
+        what: bench::BenchCommand,
+    },
+}
+
+/// Parses the command line and runs the command.
+pub fn run() -> Result<()> {
+    let launched = std::time::Instant::now();
+    // No subcommand: the viewer with `view`'s own defaults.
+    let command = Cli::parse()
+        .command
+        .unwrap_or_else(|| Command::View(view::ViewArgs::parse_from(["caustic view"])));
+    match command {
+        Command::View(args) => view::view(args, launched),
+        Command::Render(args) => render::render(args),
+        Command::ExportObj(args) => export::export_obj(args),
+        Command::Bench { what } => bench::bench(what),
+    }
+}
+
+/// A progress bar over `len` steps (drawn only on a terminal).
+fn progress_bar(len: u64, template: &str, message: String) -> Result<indicatif::ProgressBar> {
+    let bar = indicatif::ProgressBar::new(len).with_style(
+        indicatif::ProgressStyle::with_template(template)
+            .context("progress bar template")?
+            .progress_chars("=> "),
+    );
+    bar.set_message(message);
+    Ok(bar)
+}
+
+fn load_scene(path: Option<&Path>) -> Result<Scene> {
+    match path {
+        Some(p) => Ok(Scene::load(p)?),
+        None => Ok(Scene::builtin()),
+    }
+}

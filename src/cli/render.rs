@@ -1,0 +1,251 @@
+//! `caustic render`: a scene to a PNG or EXR image, ray traced or photon mapped, with a
+//! progress bar and the render's figures in the image's metadata.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Result};
+use clap::ValueEnum;
+
+use super::{load_scene, progress_bar};
+use caustic::render::ppm::{Control, IndexKind, Ppm, PpmOptions};
+use caustic::render::{image_metadata, render_whitted};
+use caustic::scene::{RendererKind, Scene};
+
+/// `caustic render`'s flags.
+#[derive(clap::Args)]
+pub struct RenderArgs {
+    /// Scene file (TOML); the built-in teapot scene when omitted.
+    scene: Option<PathBuf>,
+    /// Output image: .png or .exr.
+    #[arg(short, long)]
+    out: PathBuf,
+    /// Override the scene's image width.
+    #[arg(long)]
+    width: Option<u32>,
+    /// Override the scene's image height.
+    #[arg(long)]
+    height: Option<u32>,
+    /// Override the scene's seed.
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Override the scene's renderer.
+    #[arg(long, value_enum)]
+    renderer: Option<RendererChoice>,
+    /// PNG exposure in stops (EXR is always linear).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    exposure: f32,
+    /// Replace the output file if it exists.
+    #[arg(long)]
+    force: bool,
+    #[command(flatten)]
+    ppm: PpmArgs,
+}
+
+/// Photon-mapping flags of `render`.
+#[derive(clap::Args, Clone, Debug)]
+pub struct PpmArgs {
+    /// Photon mapping: passes to run.
+    #[arg(long, default_value_t = 16)]
+    passes: u32,
+    /// Photon mapping: stop after this many seconds even if passes remain.
+    #[arg(long, allow_negative_numbers = true)]
+    time_limit: Option<f64>,
+    /// Photon mapping: photons per pass (default: the scene's).
+    #[arg(long)]
+    photons: Option<u64>,
+    /// Photon mapping: radius reduction α in (0, 1] (default: the scene's).
+    #[arg(long, allow_negative_numbers = true)]
+    alpha: Option<f64>,
+    /// Photon mapping: initial radius in scene units (default: the scene's, or automatic).
+    #[arg(long, allow_negative_numbers = true)]
+    radius: Option<f64>,
+    /// Photon mapping: spatial index over visible points.
+    #[arg(long, value_enum, default_value_t = IndexChoice::Grid)]
+    index: IndexChoice,
+    /// Photon mapping: direct light from point/spot lights by shadow rays.
+    #[arg(long)]
+    direct_light: bool,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum IndexChoice {
+    Grid,
+    Kd,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum RendererChoice {
+    Whitted,
+    Ppm,
+}
+
+/// Renders a scene to an image with the ray tracer or photon mapping.
+pub fn render(args: RenderArgs) -> Result<()> {
+    let RenderArgs {
+        scene: scene_path,
+        out,
+        width,
+        height,
+        seed,
+        renderer,
+        exposure,
+        force,
+        ppm,
+    } = args;
+    let out = out.as_path();
+    if caustic::render::film::Format::from_path(out).is_none() {
+        bail!("{}: unknown image format (use .png or .exr)", out.display());
+    }
+    if out.exists() && !force {
+        bail!(
+            "{}: the file exists; choose another name or pass --force to overwrite it",
+            out.display()
+        );
+    }
+    if !exposure.is_finite() || exposure.abs() > 64.0 {
+        bail!("--exposure must be a finite number of stops between -64 and 64, got {exposure}");
+    }
+    let mut scene = load_scene(scene_path.as_deref())?;
+    for (flag, v) in [("--width", width), ("--height", height)] {
+        if let Some(v) = v {
+            if !(1..=16384).contains(&v) {
+                bail!("{flag} must be between 1 and 16384 pixels, got {v}");
+            }
+        }
+    }
+    if let Some(w) = width {
+        scene.camera.width = w;
+    }
+    if let Some(h) = height {
+        scene.camera.height = h;
+    }
+    if let Some(s) = seed {
+        scene.settings.seed = s;
+    }
+    let kind = match renderer {
+        Some(RendererChoice::Whitted) => RendererKind::Whitted,
+        Some(RendererChoice::Ppm) => RendererKind::Ppm,
+        None => scene.settings.renderer,
+    };
+    if kind == RendererKind::Ppm {
+        return render_ppm(scene, out, exposure, force, &ppm);
+    }
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    let bar = progress_bar(
+        h as u64,
+        "{msg} [{bar:40}] {pos}/{len} rows, {elapsed} (eta {eta})",
+        format!("ray tracing {w}x{h}"),
+    )?;
+    let (image, stats) = render_whitted(&scene, &|rows| bar.inc(rows as u64));
+    bar.finish_and_clear();
+    let mut metadata = image_metadata(&scene, "whitted");
+    metadata.push(("caustic:camera_rays".into(), stats.camera_rays.to_string()));
+    metadata.push((
+        "caustic:elapsed_secs".into(),
+        format!("{:.3}", stats.elapsed_secs),
+    ));
+    image.save(out, exposure, &metadata, force)?;
+    println!(
+        "{}: {w}x{h} ray traced in {:.2} s ({} camera rays, {} edge pixels re-sampled, {:.0} rays/s)",
+        out.display(),
+        stats.elapsed_secs,
+        stats.camera_rays,
+        stats.edge_pixels,
+        stats.camera_rays as f64 / stats.elapsed_secs.max(1e-9)
+    );
+    Ok(())
+}
+
+fn render_ppm(mut scene: Scene, out: &Path, exposure: f32, force: bool, args: &PpmArgs) -> Result<()> {
+    if args.passes == 0 {
+        bail!("--passes must be at least 1");
+    }
+    if let Some(t) = args.time_limit {
+        if !(t.is_finite() && t > 0.0) {
+            bail!("--time-limit must be a positive number of seconds, got {t}");
+        }
+    }
+    if let Some(p) = args.photons {
+        if p == 0 || p > 1_000_000_000 {
+            bail!("--photons must be between 1 and 1000000000, got {p}");
+        }
+        scene.settings.photons_per_pass = p;
+    }
+    if let Some(a) = args.alpha {
+        if !(a > 0.0 && a <= 1.0) {
+            bail!("--alpha must be in (0, 1], got {a}");
+        }
+        scene.settings.alpha = a;
+    }
+    if let Some(r) = args.radius {
+        if !(r.is_finite() && r > 0.0) {
+            bail!("--radius must be a positive number of scene units, got {r}");
+        }
+        scene.settings.initial_radius = Some(r);
+    }
+    let options = PpmOptions {
+        index: match args.index {
+            IndexChoice::Grid => IndexKind::HashGrid,
+            IndexChoice::Kd => IndexKind::KdTree,
+        },
+        direct_light: args.direct_light,
+        ..Default::default()
+    };
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    let mut ppm = Ppm::new(&scene, options);
+    let bar = progress_bar(
+        args.passes as u64,
+        "{msg} [{bar:40}] pass {pos}/{len}, {elapsed} (eta {eta})",
+        format!("photon mapping {w}x{h}"),
+    )?;
+    let start = std::time::Instant::now();
+    for _ in 0..args.passes {
+        if args
+            .time_limit
+            .is_some_and(|t| start.elapsed().as_secs_f64() >= t)
+        {
+            break;
+        }
+        ppm.run_pass(&scene, &mut |_| Control::Continue);
+        let s = ppm.stats();
+        bar.set_message(format!(
+            "photon mapping {w}x{h}, {:.2} M photons/s",
+            s.photons as f64 / s.photon_secs.max(1e-9) / 1e6
+        ));
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    let s = ppm.stats().clone();
+    let image = caustic::render::Image {
+        width: w,
+        height: h,
+        pixels: ppm.radiance(),
+    };
+    let mut metadata = image_metadata(&scene, "ppm");
+    metadata.extend([
+        ("caustic:passes".into(), s.passes.to_string()),
+        ("caustic:photons".into(), s.photons.to_string()),
+        ("caustic:alpha".into(), ppm.alpha.to_string()),
+        ("caustic:mean_radius".into(), format!("{:.6}", s.mean_radius)),
+        ("caustic:elapsed_secs".into(), format!("{:.3}", s.elapsed_secs)),
+    ]);
+    image.save(out, exposure, &metadata, force)?;
+    println!(
+        "{}: {w}x{h}, {} passes, {} photons in {:.2} s ({:.0} photons/s while tracing photons), mean radius {:.4}, {} visible points",
+        out.display(),
+        s.passes,
+        s.photons,
+        s.elapsed_secs,
+        s.photons as f64 / s.photon_secs.max(1e-9),
+        s.mean_radius,
+        s.visible_points
+    );
+    println!(
+        "  time: eye passes {:.3} s ({} of them), index builds {:.3} s, photons {:.3} s",
+        s.eye_secs, s.eye_passes, s.index_secs, s.photon_secs
+    );
+    for skipped in &s.skipped {
+        println!("  skipped: {skipped}");
+    }
+    Ok(())
+}

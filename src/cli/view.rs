@@ -1,0 +1,63 @@
+//! `caustic view`: the viewer window, or a scripted run of it.
+
+use std::path::PathBuf;
+
+#[cfg(feature = "viewer")]
+use anyhow::bail;
+use anyhow::Result;
+use clap::Parser;
+
+/// `caustic view` (also what `caustic` alone runs, with these defaults).
+#[derive(Parser)]
+pub struct ViewArgs {
+    /// Scene file (TOML).
+    pub scene: Option<PathBuf>,
+    /// Save a screenshot of the window (PNG) once the render has reached
+    /// --after-passes passes, then close.
+    #[arg(long, value_name = "FILE.png")]
+    pub screenshot: Option<PathBuf>,
+    /// Passes to wait for before --screenshot.
+    #[arg(long, default_value_t = 4, value_name = "N")]
+    pub after_passes: u32,
+    /// Replace an existing --screenshot file.
+    #[arg(long)]
+    pub force: bool,
+    /// Measure launch-to-first-image, UI frame rate while rendering and the latency from
+    /// an aperture change to the new image; print them and close.
+    #[arg(long)]
+    pub bench: bool,
+}
+
+/// Opens the viewer (only with the `viewer` feature).
+#[cfg(feature = "viewer")]
+pub fn view(args: ViewArgs, launched: std::time::Instant) -> Result<()> {
+    let ViewArgs {
+        scene,
+        screenshot,
+        after_passes,
+        force,
+        bench,
+    } = args;
+    if let Some(p) = &screenshot {
+        if p.extension().is_none_or(|e| !e.eq_ignore_ascii_case("png")) {
+            bail!(
+                "--screenshot {}: the screenshot is written as PNG; name it .png",
+                p.display()
+            );
+        }
+    }
+    let launch = caustic::app::LaunchOptions {
+        screenshot,
+        screenshot_after_passes: after_passes.max(1),
+        force,
+        bench,
+        launched,
+    };
+    caustic::app::run(scene, launch)
+}
+
+/// Without the `viewer` feature there is no window to open.
+#[cfg(not(feature = "viewer"))]
+pub fn view(_: ViewArgs, _: std::time::Instant) -> Result<()> {
+    anyhow::bail!("this caustic was built without the viewer (the `viewer` feature); use `caustic render`")
+}
