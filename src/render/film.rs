@@ -38,12 +38,21 @@ pub enum FilmError {
     },
 }
 
-/// sRGB transfer function of a linear value in [0, 1].
+/// The sRGB transfer pair (IEC 61966-2-1): the encoded value of a linear one in [0, 1]...
 pub fn linear_to_srgb(v: f32) -> f32 {
     if v <= 0.003_130_8 {
         12.92 * v
     } else {
         1.055 * v.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// ...and the linear value of an encoded one in [0, 1] (texture images are read with it).
+pub fn srgb_to_linear(c: f64) -> f64 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
     }
 }
 

@@ -21,7 +21,7 @@ use super::film::Image;
 use super::rng::{mix64, stream_rng, streams};
 use crate::geometry::Ray;
 use crate::scene::camera::concentric_disk;
-use crate::scene::material::{fresnel_dielectric, reflect, refract};
+use crate::scene::material::{dielectric, reflect};
 use crate::scene::{MaterialKind, Scene};
 
 /// What a render did.
@@ -122,15 +122,11 @@ impl Tracer<'_> {
                 emitted + color * self.trace(&hit.spawn(dir), depth + 1, state)
             }
             MaterialKind::Glass { ior } => {
-                // Entering from outside (front) or leaving the glass.
-                let eta = if front { 1.0 / ior } else { ior };
-                let cos_i = -ray.dir.dot(n);
-                let fresnel = fresnel_dielectric(cos_i, eta);
+                let glass = dielectric(ray.dir, n, ior, front);
                 let mut radiance = emitted;
-                let reflected = reflect(ray.dir, n);
-                radiance += fresnel * self.trace(&hit.spawn(reflected), depth + 1, state);
-                if let Some(t) = refract(ray.dir, n, eta) {
-                    radiance += (1.0 - fresnel) * color * self.trace(&hit.spawn(t), depth + 1, state);
+                radiance += glass.fresnel * self.trace(&hit.spawn(glass.reflected), depth + 1, state);
+                if let Some(t) = glass.refracted {
+                    radiance += (1.0 - glass.fresnel) * color * self.trace(&hit.spawn(t), depth + 1, state);
                 }
                 radiance
             }

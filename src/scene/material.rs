@@ -59,6 +59,30 @@ pub fn fresnel_dielectric(cos_i: f64, eta: f64) -> f64 {
     0.5 * (r_parallel * r_parallel + r_perpendicular * r_perpendicular)
 }
 
+/// What a smooth dielectric does to a ray: Fresnel reflectance, and the reflected and (unless
+/// totally internally reflected) refracted directions.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DielectricEvent {
+    /// Fraction reflected.
+    pub fresnel: f64,
+    /// Reflected direction.
+    pub reflected: DVec3,
+    /// Refracted direction; `None` under total internal reflection.
+    pub refracted: Option<DVec3>,
+}
+
+/// The one glass interaction every tracer uses: a unit direction `d` meets a surface of index
+/// `ior` with unit normal `n` facing against `d`, entering it (`front`: from outside) or
+/// leaving it.
+pub fn dielectric(d: DVec3, n: DVec3, ior: f64, front: bool) -> DielectricEvent {
+    let eta = if front { 1.0 / ior } else { ior };
+    DielectricEvent {
+        fresnel: fresnel_dielectric(-d.dot(n), eta),
+        reflected: reflect(d, n),
+        refracted: refract(d, n, eta),
+    }
+}
+
 /// Mirror reflection of `d` about the unit normal `n`.
 pub fn reflect(d: DVec3, n: DVec3) -> DVec3 {
     d - 2.0 * d.dot(n) * n

@@ -67,14 +67,9 @@ pub struct TextureError {
     pub source: image::ImageError,
 }
 
-/// sRGB transfer function to linear.
+/// An 8-bit sRGB-encoded channel as linear.
 fn srgb_to_linear(c: u8) -> f64 {
-    let c = c as f64 / 255.0;
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
+    crate::render::film::srgb_to_linear(c as f64 / 255.0)
 }
 
 impl TextureSource {

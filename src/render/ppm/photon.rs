@@ -11,7 +11,7 @@ use rand_pcg::Pcg64Mcg;
 
 use crate::geometry::Ray;
 use crate::scene::light::cosine_hemisphere;
-use crate::scene::material::{fresnel_dielectric, reflect, refract};
+use crate::scene::material::{dielectric, reflect};
 use crate::scene::{MaterialKind, Scene};
 
 /// Counters of one batch of photons.
@@ -131,14 +131,13 @@ impl<'a> PhotonSource<'a> {
                     ray = hit.spawn(reflect(ray.dir, n));
                 }
                 MaterialKind::Glass { ior } => {
-                    let eta = if front { 1.0 / ior } else { ior };
-                    let fresnel = fresnel_dielectric(-ray.dir.dot(n), eta);
-                    match refract(ray.dir, n, eta) {
-                        Some(t) if rng.random::<f64>() >= fresnel => {
+                    let glass = dielectric(ray.dir, n, ior, front);
+                    match glass.refracted {
+                        Some(t) if rng.random::<f64>() >= glass.fresnel => {
                             flux *= color;
                             ray = hit.spawn(t);
                         }
-                        _ => ray = hit.spawn(reflect(ray.dir, n)),
+                        _ => ray = hit.spawn(glass.reflected),
                     }
                 }
             }

@@ -11,7 +11,7 @@ use rand::Rng;
 use rand_pcg::Pcg64Mcg;
 
 use crate::geometry::Ray;
-use crate::scene::material::{fresnel_dielectric, reflect, refract};
+use crate::scene::material::{dielectric, reflect};
 use crate::scene::{Light, MaterialKind, Scene};
 
 /// Where photons are gathered for one pixel (or one branch of one pixel's eye path).
@@ -129,10 +129,10 @@ impl EyeWalk<'_> {
                 self.walk(&r, throughput * color, depth + 1, rng, out);
             }
             MaterialKind::Glass { ior } => {
-                let eta = if surface.front { 1.0 / ior } else { ior };
-                let fresnel = fresnel_dielectric(-ray.dir.dot(n), eta);
-                let reflected = hit.spawn(reflect(ray.dir, n));
-                let refracted = refract(ray.dir, n, eta).map(|t| hit.spawn(t));
+                let glass = dielectric(ray.dir, n, ior, surface.front);
+                let fresnel = glass.fresnel;
+                let reflected = hit.spawn(glass.reflected);
+                let refracted = glass.refracted.map(|t| hit.spawn(t));
                 match (self.branching, refracted) {
                     (_, None) => self.walk(&reflected, throughput, depth + 1, rng, out),
                     (Branching::Split, Some(t)) => {
