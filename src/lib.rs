@@ -13,8 +13,8 @@
 //! * `app` and `gpu` (feature `viewer`, on by default): the eframe viewer and the wgpu
 //!   control-net overlay it draws; the render core does not depend on them.
 //!
-//! The architecture of record is DESIGN.md (kept beside the project); module docs name the
-//! paper or source of every algorithm they implement.
+//! README.md describes the program and where each part lives; module docs name the paper or
+//! source of every algorithm they implement.
 
 #![forbid(unsafe_code)]
 

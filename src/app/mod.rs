@@ -1,4 +1,4 @@
-//! The desktop viewer (DESIGN.md §4): eframe with the wgpu renderer, the render session on its
+//! The desktop viewer: eframe with the wgpu renderer, the render session on its
 //! own thread, the image with exposure, zoom and a pixel probe, a side panel of parameters
 //! and statistics, open and save dialogs, persisted preferences.
 //!

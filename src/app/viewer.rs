@@ -110,6 +110,7 @@ fn session_options(settings: &ViewerSettings, start_paused: bool) -> SessionOpti
         first_pass_photons: Some(VIEWER_FIRST_PASS_PHOTONS),
         start_paused,
         preview_divisor: Some(VIEWER_PREVIEW_DIVISOR),
+        ..Default::default()
     }
 }
 

@@ -6,12 +6,13 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use clap::{Subcommand, ValueEnum};
 
-use super::load_scene;
+use super::{load_scene, photon_map};
 use caustic::bench::{teapot_geometry, teapot_view, time_intersect};
 use caustic::geometry::{PatchMethod, SubdivisionParams};
-use caustic::render::ppm::{Control, IndexKind, Ppm, PpmOptions};
+use caustic::render::ppm::{IndexKind, PpmOptions};
 use caustic::render::render_whitted;
-use caustic::scene::Scene;
+use caustic::render::session::SessionOptions;
+use caustic::scene::{RendererKind, Scene};
 
 #[derive(Subcommand)]
 pub enum BenchCommand {
@@ -152,19 +153,18 @@ fn bench_ppm(scene_path: &Path, photons: u64, passes: u32, threads: &[usize]) ->
         "{:>8} {:>12} {:>16} {:>22} {:>10}",
         "threads", "photon s", "photon paths/s", "paths per core-second", "scaling"
     );
+    scene.settings.renderer = RendererKind::Ppm;
     let mut base = None;
     for &n in threads {
         if n == 0 {
             bail!("--threads values must be at least 1");
         }
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(n).build()?;
-        let stats = pool.install(|| {
-            let mut ppm = Ppm::new(&scene, PpmOptions::default());
-            for _ in 0..passes {
-                ppm.run_pass(&scene, &mut |_| Control::Continue);
-            }
-            ppm.stats().clone()
-        });
+        let session = SessionOptions {
+            max_passes: Some(passes),
+            threads: Some(n),
+            ..Default::default()
+        };
+        let stats = photon_map(scene.clone(), session, |_| {})?.stats;
         let rate = stats.photons as f64 / stats.photon_secs;
         let scaling = base.map_or(1.0, |b: f64| rate / b);
         base.get_or_insert(rate);
@@ -213,16 +213,16 @@ fn bench_convergence(
         scene.camera.width,
         scene.camera.height
     );
+    scene.settings.renderer = RendererKind::Ppm;
     let mut reference_scene = scene.clone();
     reference_scene.settings.seed ^= 0x5eed;
     let bar = indicatif::ProgressBar::new(reference_passes as u64);
-    let mut reference = Ppm::new(&reference_scene, PpmOptions::default());
-    for _ in 0..reference_passes {
-        reference.run_pass(&reference_scene, &mut |_| Control::Continue);
-        bar.inc(1);
-    }
+    let limit = |passes| SessionOptions {
+        max_passes: Some(passes),
+        ..Default::default()
+    };
+    let reference = photon_map(reference_scene, limit(reference_passes), |_| bar.inc(1))?.radiance;
     bar.finish_and_clear();
-    let reference = reference.radiance();
     let configs = [
         ("hash grid", IndexKind::HashGrid, false),
         ("kd-tree", IndexKind::KdTree, false),
@@ -237,15 +237,17 @@ fn bench_convergence(
             direct_light,
             ..Default::default()
         };
-        let mut ppm = Ppm::new(&scene, options);
         let mut curve = Vec::new();
-        for _ in 0..passes {
-            ppm.run_pass(&scene, &mut |_| Control::Continue);
-            let s = ppm.stats();
-            let e = rmse(&ppm.radiance(), &reference);
+        let session = SessionOptions {
+            ppm: options,
+            ..limit(passes)
+        };
+        photon_map(scene.clone(), session, |f| {
+            let s = &f.stats;
+            let e = rmse(&f.radiance, &reference);
             rows.push(format!("{name},{},{:.4},{e:.6e}", s.passes, s.elapsed_secs));
             curve.push((s.elapsed_secs, e));
-        }
+        })?;
         curves.push((name, curve));
     }
     // Target: the error the plain hash grid reaches after half its passes.

@@ -8,9 +8,10 @@ mod view;
 
 use std::path::Path;
 
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand};
 
+use caustic::render::session::{Frame, RenderSession, SessionOptions};
 use caustic::scene::Scene;
 
 #[derive(Parser)]
@@ -71,4 +72,24 @@ fn load_scene(path: Option<&Path>) -> Result<Scene> {
         Some(p) => Ok(Scene::load(p)?),
         None => Ok(Scene::builtin()),
     }
+}
+
+/// Photon-maps `scene` (its renderer must be photon mapping) on a headless render session —
+/// the viewer's render loop — until the session's limits end it; `on_frame` sees every
+/// completed pass. Returns the last frame.
+fn photon_map(scene: Scene, options: SessionOptions, mut on_frame: impl FnMut(&Frame)) -> Result<Frame> {
+    let options = SessionOptions {
+        every_frame: true,
+        ..options
+    };
+    let session = RenderSession::start_with(scene, options, None);
+    let mut last = None;
+    for frame in session.frames().iter() {
+        on_frame(&frame);
+        last = Some(frame);
+    }
+    if let Some(failure) = session.failure() {
+        bail!("the renderer failed: {failure}");
+    }
+    last.context("the renderer stopped before completing a pass")
 }

@@ -2,12 +2,14 @@
 //! progress bar and the render's figures in the image's metadata.
 
 use std::path::{Path, PathBuf};
+use std::time::Duration;
 
 use anyhow::{bail, Result};
 use clap::ValueEnum;
 
-use super::{load_scene, progress_bar};
-use caustic::render::ppm::{Control, IndexKind, Ppm, PpmOptions};
+use super::{load_scene, photon_map, progress_bar};
+use caustic::render::ppm::{IndexKind, PpmOptions};
+use caustic::render::session::SessionOptions;
 use caustic::render::{image_metadata, render_whitted};
 use caustic::scene::{RendererKind, Scene};
 
@@ -192,40 +194,38 @@ fn render_ppm(mut scene: Scene, out: &Path, exposure: f32, force: bool, args: &P
         ..Default::default()
     };
     let (w, h) = (scene.camera.width, scene.camera.height);
-    let mut ppm = Ppm::new(&scene, options);
     let bar = progress_bar(
         args.passes as u64,
         "{msg} [{bar:40}] pass {pos}/{len}, {elapsed} (eta {eta})",
         format!("photon mapping {w}x{h}"),
     )?;
-    let start = std::time::Instant::now();
-    for _ in 0..args.passes {
-        if args
-            .time_limit
-            .is_some_and(|t| start.elapsed().as_secs_f64() >= t)
-        {
-            break;
-        }
-        ppm.run_pass(&scene, &mut |_| Control::Continue);
-        let s = ppm.stats();
+    scene.settings.renderer = RendererKind::Ppm;
+    let session = SessionOptions {
+        ppm: options,
+        max_passes: Some(args.passes),
+        time_limit: args.time_limit.map(Duration::from_secs_f64),
+        ..Default::default()
+    };
+    let frame = photon_map(scene.clone(), session, |f| {
+        let s = &f.stats;
         bar.set_message(format!(
             "photon mapping {w}x{h}, {:.2} M photons/s",
             s.photons as f64 / s.photon_secs.max(1e-9) / 1e6
         ));
-        bar.inc(1);
-    }
+        bar.set_position(s.passes as u64);
+    })?;
     bar.finish_and_clear();
-    let s = ppm.stats().clone();
+    let s = frame.stats.clone();
     let image = caustic::render::Image {
         width: w,
         height: h,
-        pixels: ppm.radiance(),
+        pixels: frame.radiance.to_vec(),
     };
     let mut metadata = image_metadata(&scene, "ppm");
     metadata.extend([
         ("caustic:passes".into(), s.passes.to_string()),
         ("caustic:photons".into(), s.photons.to_string()),
-        ("caustic:alpha".into(), ppm.alpha.to_string()),
+        ("caustic:alpha".into(), scene.settings.alpha.to_string()),
         ("caustic:mean_radius".into(), format!("{:.6}", s.mean_radius)),
         ("caustic:elapsed_secs".into(), format!("{:.3}", s.elapsed_secs)),
     ]);

@@ -2,7 +2,7 @@
 //!
 //! Two intersectors share one root finder:
 //!
-//! * **Prepared** (the default, DESIGN.md §2): at scene preparation each patch is subdivided
+//! * **Prepared** (the default): at scene preparation each patch is subdivided
 //!   adaptively into [`PatchLeaf`]s — sub-patches that are nearly bilinear — each carrying its
 //!   `(u,v)` window in the original patch and its control points. The leaves' bounds go into
 //!   the scene BVH, so the per-ray work is BVH traversal plus a Newton solve on the one or two

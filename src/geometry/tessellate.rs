@@ -1,5 +1,5 @@
-//! Tessellation of Bézier patches into triangle meshes, for `caustic export-obj`, the viewer's
-//! surface preview and comparisons with tessellating renderers.
+//! Tessellation of Bézier patches into triangle meshes, for `caustic export-obj` and
+//! comparisons with tessellating renderers.
 
 use glam::{DVec2, DVec3};
 

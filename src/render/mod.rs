@@ -1,5 +1,5 @@
 //! Renderers and what they render into: progressive photon mapping, the Whitted ray tracer, the film (linear RGB with
-//! tonemapping and PNG/EXR output) and deterministic random streams. DESIGN.md §3.
+//! tonemapping and PNG/EXR output) and deterministic random streams.
 
 pub mod film;
 pub mod ppm;

@@ -1,5 +1,5 @@
 //! Deterministic random streams: every random number derives from (seed, stream, index) — a
-//! pixel, a photon, a pass — so a render is identical for any thread count (DESIGN.md §1).
+//! pixel, a photon, a pass — so a render is identical for any thread count.
 
 use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;

@@ -1,4 +1,4 @@
-//! The render session (DESIGN.md §1): photon-mapping passes (or one ray-traced frame) on a
+//! The render session: photon-mapping passes (or one ray-traced frame) on a
 //! thread of their own, steered by [`Command`]s over an unbounded channel and reporting a
 //! [`Frame`] after each pass over a `bounded(1)` channel with `try_send` — the renderer never
 //! waits for whoever watches; a frame nobody took is simply replaced by a newer one.
@@ -16,7 +16,7 @@ use std::panic::AssertUnwindSafe;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use crossbeam_channel::{bounded, unbounded, Receiver, Sender, TryRecvError};
 use glam::DVec3;
@@ -63,7 +63,7 @@ pub enum Command {
     /// End the session's thread.
     Shutdown,
     /// Makes the render thread panic with this message. It exists to exercise the error path
-    /// of whoever watches the session (the viewer's tests and `caustic view --fail-render`).
+    /// of whoever watches the session (the viewer's tests).
     Fail(String),
 }
 
@@ -132,6 +132,17 @@ pub struct SessionOptions {
     /// 1/`n` of the resolution (one pass of [`SessionOptions::first_pass_photons`] or 16,384
     /// photons), so a changed setting shows within a fraction of a full pass.
     pub preview_divisor: Option<u32>,
+    /// End the session after this many completed passes of an epoch (a ray-traced frame
+    /// counts as one); `None`: render until shut down.
+    pub max_passes: Option<u32>,
+    /// End the session once an epoch has run this long (checked before each pass).
+    pub time_limit: Option<Duration>,
+    /// Deliver every frame, waiting for the receiver to take it (a headless consumer that
+    /// needs each pass); by default a frame not yet taken is replaced and the renderer never
+    /// waits.
+    pub every_frame: bool,
+    /// Render in a pool of this many threads (`None`: rayon's global pool).
+    pub threads: Option<usize>,
 }
 
 /// A render running on its own thread.
@@ -145,7 +156,7 @@ pub struct RenderSession {
 }
 
 /// Called after each frame is offered (the viewer passes `ctx.request_repaint`).
-pub type Waker = Box<dyn Fn() + Send>;
+pub type Waker = Box<dyn Fn() + Send + Sync>;
 
 impl RenderSession {
     /// Starts rendering `scene` on a new thread (named `caustic-render`), in the global rayon
@@ -175,14 +186,18 @@ impl RenderSession {
             .name("caustic-render".into())
             .spawn(move || {
                 let outcome = std::panic::catch_unwind(AssertUnwindSafe(|| {
-                    run(
-                        scene,
-                        options,
-                        command_rx,
-                        (frame_tx, stale),
-                        &waker,
-                        interrupt_flag,
-                    )
+                    let render = || {
+                        let channel = (frame_tx, stale);
+                        run(scene, options, command_rx, (&channel, &waker), interrupt_flag)
+                    };
+                    match options
+                        .threads
+                        .map(|n| rayon::ThreadPoolBuilder::new().num_threads(n).build())
+                    {
+                        Some(Ok(pool)) => pool.install(render),
+                        Some(Err(e)) => panic!("cannot start {:?} render threads: {e}", options.threads),
+                        None => render(),
+                    }
                 }));
                 if let Err(payload) = outcome {
                     let message = payload
@@ -332,9 +347,16 @@ fn pixel_statistics(ppm: &Ppm) -> (Arc<[f32]>, Arc<[f32]>) {
     (radius.into(), gathered.into())
 }
 
-/// Offers a frame without waiting: a frame the viewer has not taken yet is replaced.
-fn offer(frame: Frame, (frames, stale): &(Sender<Frame>, Receiver<Frame>), waker: &Option<Waker>) {
-    if let Err(crossbeam_channel::TrySendError::Full(frame)) = frames.try_send(frame) {
+/// Where frames go: the channel (with a receiver to take back a frame nobody took) and the
+/// waker.
+type Output<'a> = (&'a (Sender<Frame>, Receiver<Frame>), &'a Option<Waker>);
+
+/// Offers a frame: without waiting, replacing a frame the viewer has not taken yet, or (with
+/// [`SessionOptions::every_frame`]) waiting until the receiver has room.
+fn offer(frame: Frame, ((frames, stale), waker): Output, every_frame: bool) {
+    if every_frame {
+        let _ = frames.send(frame);
+    } else if let Err(crossbeam_channel::TrySendError::Full(frame)) = frames.try_send(frame) {
         let _ = stale.try_recv();
         let _ = frames.try_send(frame);
     }
@@ -391,143 +413,362 @@ fn preview(
     })
 }
 
+/// What the session does next ([`SessionState::next`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Next {
+    /// Nothing until a command arrives (paused, or the ray-traced frame is done).
+    Wait,
+    /// Apply the restarting commands gathered and open a new epoch.
+    Restart,
+    /// A low-resolution preview of the new epoch.
+    Preview,
+    /// A photon-mapping pass.
+    Pass,
+    /// The ray-traced frame of this epoch.
+    Trace,
+    /// End the session.
+    Stop,
+}
+
+/// The session's rules, free of threads and channels: which commands apply at once, which
+/// gather into a restart, when to wait, and what to render next.
+#[derive(Clone, Debug)]
+pub struct SessionState {
+    options: SessionOptions,
+    /// Epochs begun (each restart opens one).
+    pub epoch: u64,
+    /// Paused by [`Command::Pause`].
+    pub paused: bool,
+    /// α for the coming updates.
+    pub alpha: f64,
+    /// Photons per full pass.
+    pub photons_per_pass: u64,
+    renderer: RendererKind,
+    patches: usize,
+    /// Passes completed in this epoch (the ray-traced frame counts as one).
+    pub passes: u32,
+    preview_due: bool,
+    pending: Vec<Command>,
+    shutdown: bool,
+}
+
+/// What [`SessionState::apply`] made of a command.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Effect {
+    /// Out of range: ignored (the UI validates before sending).
+    Ignored,
+    /// Applied at once (α, photons per pass, pause, resume), nothing discarded.
+    Applied,
+    /// Gathered: the accumulation restarts under a new epoch.
+    Restarts,
+    /// The session ends.
+    Shutdown,
+    /// The render thread must fail with this message.
+    Fail(String),
+}
+
+impl SessionState {
+    /// The state at the start of a session on `scene`.
+    pub fn new(scene: &Scene, options: SessionOptions) -> Self {
+        Self {
+            options,
+            epoch: 0,
+            paused: options.start_paused,
+            alpha: scene.settings.alpha,
+            photons_per_pass: scene.settings.photons_per_pass,
+            renderer: scene.settings.renderer,
+            patches: scene.geometry.patches().len(),
+            passes: 0,
+            preview_due: options.preview_divisor.is_some(),
+            pending: Vec::new(),
+            shutdown: false,
+        }
+    }
+
+    /// Takes a command.
+    pub fn apply(&mut self, command: Command) -> Effect {
+        if !valid(&command, self.patches) {
+            return Effect::Ignored;
+        }
+        if command.restarts() {
+            if let Command::SetRenderer(r) = command {
+                self.renderer = r;
+            }
+            self.pending.push(command);
+            return Effect::Restarts;
+        }
+        match command {
+            Command::SetAlpha(a) => self.alpha = a,
+            Command::SetPhotonsPerPass(n) => self.photons_per_pass = n,
+            Command::Pause => self.paused = true,
+            Command::Resume => self.paused = false,
+            Command::Fail(message) => return Effect::Fail(message),
+            _ => {
+                self.shutdown = true;
+                return Effect::Shutdown;
+            }
+        }
+        Effect::Applied
+    }
+
+    /// Whether the pass in progress must be dropped (a restart or the end waits).
+    pub fn must_abort(&self) -> bool {
+        self.shutdown || !self.pending.is_empty()
+    }
+
+    /// Whether the session's limits are reached.
+    fn finished(&self, epoch_secs: Duration) -> bool {
+        self.options.max_passes.is_some_and(|n| self.passes >= n)
+            || (self.renderer == RendererKind::Ppm
+                && self.options.time_limit.is_some_and(|t| epoch_secs >= t))
+    }
+
+    /// What to do next, `epoch_secs` into the epoch.
+    pub fn next(&self, epoch_secs: Duration) -> Next {
+        if self.shutdown || self.finished(epoch_secs) {
+            Next::Stop
+        } else if !self.pending.is_empty() {
+            Next::Restart
+        } else if self.paused || (self.renderer == RendererKind::Whitted && self.passes > 0) {
+            Next::Wait
+        } else if self.renderer == RendererKind::Whitted {
+            Next::Trace
+        } else if self.preview_due {
+            Next::Preview
+        } else {
+            Next::Pass
+        }
+    }
+
+    /// Whether to wait for a command before going on (also between photon batches).
+    fn idle(&self) -> bool {
+        !self.must_abort() && (self.paused || (self.renderer == RendererKind::Whitted && self.passes > 0))
+    }
+
+    /// Opens a new epoch: the gathered commands are applied to `scene`.
+    pub fn restart(&mut self, scene: &mut Scene) {
+        apply_to_scene(scene, std::mem::take(&mut self.pending));
+        scene.settings.alpha = self.alpha;
+        scene.settings.photons_per_pass = self.photons_per_pass;
+        self.renderer = scene.settings.renderer;
+        self.epoch += 1;
+        self.passes = 0;
+        self.preview_due = self.options.preview_divisor.is_some();
+    }
+
+    /// Photons of the pass after `completed` passes: the ramp from
+    /// [`SessionOptions::first_pass_photons`] doubling up to the photons per pass.
+    pub fn pass_photons(&self, completed: u32) -> u64 {
+        match self.options.first_pass_photons {
+            Some(first) => self
+                .photons_per_pass
+                .min(first.saturating_mul(1 << completed.min(40))),
+            None => self.photons_per_pass,
+        }
+    }
+}
+
+/// Applies the commands waiting on the channel; while the state is idle, waits for more.
+/// Returns `false` when every sender is gone.
+fn drain(state: &mut SessionState, commands: &Receiver<Command>) -> bool {
+    loop {
+        let next = if state.idle() {
+            commands.recv().map_err(|_| TryRecvError::Disconnected)
+        } else {
+            commands.try_recv()
+        };
+        match next {
+            Ok(command) => {
+                if let Effect::Fail(message) = state.apply(command) {
+                    panic!("{message}");
+                }
+            }
+            Err(TryRecvError::Empty) => return true,
+            Err(TryRecvError::Disconnected) => {
+                state.shutdown = true;
+                return false;
+            }
+        }
+    }
+}
+
+/// The ray-traced frame of an epoch (`None` when a command interrupted it).
+fn trace(scene: &Scene, epoch: u64, epoch_start: Instant, interrupted: &Interrupt) -> Option<Frame> {
+    let (image, stats) = render_whitted_until(scene, &|_| {}, &|| interrupted())?;
+    let pixels = image.pixels.len();
+    Some(Frame {
+        epoch,
+        renderer: RendererKind::Whitted,
+        pass: 1,
+        photons: 0,
+        elapsed_secs: epoch_start.elapsed().as_secs_f64(),
+        stats: PpmStats {
+            passes: 1,
+            elapsed_secs: stats.elapsed_secs,
+            ..Default::default()
+        },
+        width: image.width,
+        height: image.height,
+        radiance: image.pixels.into(),
+        radius: vec![0.0; pixels].into(),
+        gathered: vec![0.0; pixels].into(),
+        preview: false,
+    })
+}
+
+/// The render thread: a loop over [`SessionState::next`].
 fn run(
-    scene: Scene,
+    mut scene: Scene,
     options: SessionOptions,
     commands: Receiver<Command>,
-    channel: (Sender<Frame>, Receiver<Frame>),
-    waker: &Option<Waker>,
+    output: Output,
     interrupt: Arc<AtomicBool>,
 ) {
     let interrupted: Interrupt = {
         let flag = interrupt.clone();
         Arc::new(move || flag.load(Ordering::Acquire))
     };
-    let mut scene = scene;
-    let mut ppm = Ppm::new(&scene, options.ppm);
-    ppm.set_interrupt(Some(interrupted.clone()));
-    let mut preview_due = options.preview_divisor.is_some();
-    let mut epoch = 0u64;
+    let new_ppm = |scene: &Scene| {
+        let mut ppm = Ppm::new(scene, options.ppm);
+        ppm.set_interrupt(Some(interrupted.clone()));
+        ppm
+    };
+    let mut state = SessionState::new(&scene, options);
+    let mut ppm = new_ppm(&scene);
     let mut epoch_start = Instant::now();
-    let mut paused = options.start_paused;
-    // The ray tracer makes one frame per epoch, then waits for commands.
-    let mut traced = false;
-    let photons_per_pass = std::cell::Cell::new(scene.settings.photons_per_pass);
     loop {
-        let patches = scene.geometry.patches().len();
-        let mut pending: Vec<Command> = Vec::new();
-        let mut shutdown = false;
-        // Between batches (and passes): apply commands; while paused or done, wait for them.
-        let mut control = |alpha: &mut f64| -> Control {
-            // Whatever interrupted the pass is among the commands drained below.
-            interrupt.store(false, Ordering::Release);
-            loop {
-                let next = if (paused || traced) && pending.is_empty() {
-                    commands.recv().map_err(|_| TryRecvError::Disconnected)
-                } else {
-                    commands.try_recv()
-                };
-                let command = match next {
-                    Ok(c) => c,
-                    Err(TryRecvError::Empty) => break,
-                    Err(TryRecvError::Disconnected) => {
-                        shutdown = true;
-                        return Control::Abort;
-                    }
-                };
-                let restarts = valid(&command, patches).then(|| command.restarts());
-                match (restarts, command) {
-                    (None, _) => {} // out of range: ignored (the UI validates before sending)
-                    (Some(true), c) => pending.push(c),
-                    (Some(false), Command::SetAlpha(a)) => *alpha = a,
-                    (Some(false), Command::SetPhotonsPerPass(n)) => photons_per_pass.set(n),
-                    (Some(false), Command::Pause) => paused = true,
-                    (Some(false), Command::Resume) => paused = false,
-                    (Some(false), Command::Fail(message)) => panic!("{message}"),
-                    (Some(false), _) => {
-                        shutdown = true;
-                        return Control::Abort;
-                    }
-                }
-            }
-            if pending.is_empty() {
-                Control::Continue
-            } else {
-                Control::Abort
-            }
-        };
-        let mut alpha = ppm.alpha;
-        let go_on = control(&mut alpha) == Control::Continue;
-        ppm.alpha = alpha;
-        let outcome = match (go_on, scene.settings.renderer) {
-            (false, _) => None,
-            (true, RendererKind::Whitted) if traced => None,
-            (true, RendererKind::Ppm) if preview_due => {
-                preview_due = false;
-                let divisor = options.preview_divisor.unwrap_or(4);
-                if let Some(frame) = preview(&mut scene, &options, divisor, &interrupted, epoch, epoch_start)
-                {
-                    offer(frame, &channel, waker);
-                }
-                None
-            }
-            (true, RendererKind::Ppm) => {
-                let target = photons_per_pass.get();
-                ppm.photons_per_pass = match options.first_pass_photons {
-                    Some(first) => target.min(first.saturating_mul(1 << ppm.stats().passes.min(40))),
-                    None => target,
-                };
-                Some(ppm.run_pass(&scene, &mut control))
-            }
-            (true, RendererKind::Whitted) => {
-                // Give up the frame as soon as a command waits: it may change the picture.
-                match render_whitted_until(&scene, &|_| {}, &|| interrupted()) {
-                    Some((image, stats)) => {
-                        traced = true;
-                        let pixels = image.pixels.len();
-                        let frame = Frame {
-                            epoch,
-                            renderer: RendererKind::Whitted,
-                            pass: 1,
-                            photons: 0,
-                            elapsed_secs: epoch_start.elapsed().as_secs_f64(),
-                            stats: PpmStats {
-                                passes: 1,
-                                elapsed_secs: stats.elapsed_secs,
-                                ..Default::default()
-                            },
-                            width: image.width,
-                            height: image.height,
-                            radiance: image.pixels.into(),
-                            radius: vec![0.0; pixels].into(),
-                            gathered: vec![0.0; pixels].into(),
-                            preview: false,
-                        };
-                        offer(frame, &channel, waker);
-                    }
-                    None => continue,
-                }
-                None
-            }
-        };
-        if shutdown {
+        // Whatever interrupted a pass is among the commands drained here.
+        interrupt.store(false, Ordering::Release);
+        if !drain(&mut state, &commands) {
             return;
         }
-        if !pending.is_empty() {
-            apply_to_scene(&mut scene, pending);
-            scene.settings.alpha = ppm.alpha;
-            scene.settings.photons_per_pass = photons_per_pass.get();
-            epoch += 1;
-            epoch_start = Instant::now();
-            traced = false;
-            ppm = Ppm::new(&scene, options.ppm);
-            ppm.set_interrupt(Some(interrupted.clone()));
-            preview_due = options.preview_divisor.is_some();
-            continue;
+        match state.next(epoch_start.elapsed()) {
+            Next::Stop => return,
+            Next::Wait => {}
+            Next::Restart => {
+                state.restart(&mut scene);
+                ppm = new_ppm(&scene);
+                epoch_start = Instant::now();
+            }
+            Next::Preview => {
+                state.preview_due = false;
+                let divisor = options.preview_divisor.unwrap_or(4);
+                if let Some(frame) = preview(
+                    &mut scene,
+                    &options,
+                    divisor,
+                    &interrupted,
+                    state.epoch,
+                    epoch_start,
+                ) {
+                    offer(frame, output, options.every_frame);
+                }
+            }
+            Next::Trace => {
+                if let Some(frame) = trace(&scene, state.epoch, epoch_start, &interrupted) {
+                    state.passes = 1;
+                    offer(frame, output, options.every_frame);
+                }
+            }
+            Next::Pass => {
+                ppm.alpha = state.alpha;
+                ppm.photons_per_pass = state.pass_photons(ppm.stats().passes);
+                // Between batches: commands apply; a restart or the end drops the pass.
+                let mut control = |alpha: &mut f64| {
+                    interrupt.store(false, Ordering::Release);
+                    drain(&mut state, &commands);
+                    *alpha = state.alpha;
+                    if state.must_abort() {
+                        Control::Abort
+                    } else {
+                        Control::Continue
+                    }
+                };
+                if ppm.run_pass(&scene, &mut control) == PassOutcome::Completed {
+                    state.passes = ppm.stats().passes;
+                    let frame = Frame::from_ppm(&ppm, state.epoch, epoch_start.elapsed().as_secs_f64());
+                    offer(frame, output, options.every_frame);
+                }
+            }
         }
-        if outcome == Some(PassOutcome::Completed) {
-            let frame = Frame::from_ppm(&ppm, epoch, epoch_start.elapsed().as_secs_f64());
-            offer(frame, &channel, waker);
-        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn state() -> SessionState {
+        let mut scene = Scene::builtin();
+        scene.settings.renderer = RendererKind::Ppm;
+        SessionState::new(
+            &scene,
+            SessionOptions {
+                preview_divisor: Some(4),
+                first_pass_photons: Some(1000),
+                ..Default::default()
+            },
+        )
+    }
+
+    #[test]
+    fn commands_apply_gather_or_are_ignored_by_the_rules() {
+        let mut s = state();
+        let now = Duration::ZERO;
+        assert_eq!(s.next(now), Next::Preview);
+        assert_eq!(s.apply(Command::SetAlpha(0.5)), Effect::Applied);
+        assert_eq!(s.apply(Command::SetAlpha(1.5)), Effect::Ignored);
+        assert_eq!(s.alpha, 0.5);
+        assert_eq!(s.apply(Command::Pause), Effect::Applied);
+        assert_eq!(s.next(now), Next::Wait);
+        assert!(s.idle());
+        assert_eq!(s.apply(Command::SetAperture(0.1)), Effect::Restarts);
+        assert!(s.must_abort() && !s.idle());
+        assert_eq!(s.next(now), Next::Restart);
+        let mut scene = Scene::builtin();
+        scene.settings.renderer = RendererKind::Ppm;
+        s.restart(&mut scene);
+        assert_eq!(
+            (s.epoch, scene.camera.aperture, scene.settings.alpha),
+            (1, 0.1, 0.5)
+        );
+        assert_eq!(s.next(now), Next::Wait, "still paused");
+        s.apply(Command::Resume);
+        assert_eq!(s.next(now), Next::Preview);
+        assert_eq!(
+            s.apply(Command::MoveControlPoint {
+                patch: 99,
+                index: 0,
+                position: DVec3::ZERO
+            }),
+            Effect::Ignored
+        );
+        assert_eq!(s.apply(Command::Fail("x".into())), Effect::Fail("x".into()));
+        assert_eq!(s.apply(Command::Shutdown), Effect::Shutdown);
+        assert_eq!(s.next(now), Next::Stop);
+    }
+
+    #[test]
+    fn passes_ramp_up_and_limits_end_the_session() {
+        let mut s = state();
+        s.photons_per_pass = 5000;
+        assert_eq!([0, 1, 2, 3].map(|k| s.pass_photons(k)), [1000, 2000, 4000, 5000]);
+        s.options.max_passes = Some(3);
+        s.preview_due = false;
+        s.passes = 2;
+        assert_eq!(s.next(Duration::ZERO), Next::Pass);
+        s.passes = 3;
+        assert_eq!(s.next(Duration::ZERO), Next::Stop);
+        s.options.max_passes = None;
+        s.options.time_limit = Some(Duration::from_secs(2));
+        assert_eq!(s.next(Duration::from_secs(1)), Next::Pass);
+        assert_eq!(s.next(Duration::from_secs(2)), Next::Stop);
+        // The ray tracer makes one frame, then waits.
+        s.options.time_limit = None;
+        s.apply(Command::SetRenderer(RendererKind::Whitted));
+        s.restart(&mut Scene::builtin());
+        assert_eq!(s.next(Duration::ZERO), Next::Trace);
+        s.passes = 1;
+        assert_eq!(s.next(Duration::ZERO), Next::Wait);
     }
 }

@@ -1,6 +1,6 @@
 //! Scenes: the file format, validation with errors that name file, line and field, and the
 //! runtime scene the renderers read (camera, materials, textures, lights, geometry).
-//! DESIGN.md §3; the format reference is `scenes/FORMAT.md`.
+//! The format reference is `scenes/FORMAT.md`.
 
 pub mod camera;
 pub mod format;
