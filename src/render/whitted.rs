@@ -52,6 +52,52 @@ struct Tracer<'s> {
 }
 
 impl Tracer<'_> {
+    /// The first pass's colour of pixel `(x, y)` and its path/shadow hash: one centre ray,
+    /// or every lens sample (stratified) when the aperture is open.
+    fn first_sample(&self, x: u32, y: u32, rays: &AtomicUsize) -> (DVec3, u64) {
+        let (scene, camera) = (self.scene, &self.scene.camera);
+        let index = (y as u64) * camera.width as u64 + x as u64;
+        let mut rng = stream_rng(scene.settings.seed, streams::WHITTED_PIXEL, index);
+        if camera.aperture > 0.0 {
+            let n = scene.settings.dof_samples;
+            let grid = (n as f64).sqrt().ceil() as u32;
+            let mut sum = DVec3::ZERO;
+            for s in 0..n {
+                let cell = DVec2::new((s % grid) as f64, (s / grid % grid) as f64);
+                let lens = concentric_disk((cell + DVec2::new(rng.random(), rng.random())) / grid as f64);
+                let px = DVec2::new(x as f64 + rng.random::<f64>(), y as f64 + rng.random::<f64>());
+                let mut state = PathState { id: 0, rng: &mut rng };
+                sum += self.trace(&camera.ray(px, lens), 0, &mut state);
+            }
+            rays.fetch_add(n as usize, Ordering::Relaxed);
+            (sum / n as f64, 0)
+        } else {
+            let mut state = PathState { id: 0, rng: &mut rng };
+            let px = Scene::pixel_center(x, y);
+            let c = self.trace(&camera.ray(px, DVec2::ZERO), 0, &mut state);
+            rays.fetch_add(1, Ordering::Relaxed);
+            (c, state.id)
+        }
+    }
+
+    /// The mean of a 4×4 grid of rays over pixel `i` = `(x, y)` (edge anti-aliasing).
+    fn edge_samples(&self, i: usize, x: i64, y: i64) -> DVec3 {
+        let camera = &self.scene.camera;
+        let mut rng = stream_rng(self.scene.settings.seed, streams::WHITTED_EDGE, i as u64);
+        let mut sum = DVec3::ZERO;
+        for sy in 0..4 {
+            for sx in 0..4 {
+                let px = DVec2::new(
+                    x as f64 + (sx as f64 + 0.5) / 4.0,
+                    y as f64 + (sy as f64 + 0.5) / 4.0,
+                );
+                let mut state = PathState { id: 0, rng: &mut rng };
+                sum += self.trace(&camera.ray(px, DVec2::ZERO), 0, &mut state);
+            }
+        }
+        sum / 16.0
+    }
+
     /// Radiance arriving along `ray` after at most `max_depth - depth` more bounces.
     fn trace(&self, ray: &Ray, depth: u32, state: &mut PathState) -> DVec3 {
         let scene = self.scene;
@@ -151,7 +197,6 @@ pub fn render_whitted_until(
     let start = Instant::now();
     let camera = &scene.camera;
     let (w, h) = (camera.width, camera.height);
-    let seed = scene.settings.seed;
     let tracer = Tracer { scene };
     let dof = camera.aperture > 0.0;
     let rays = AtomicUsize::new(0);
@@ -163,35 +208,7 @@ pub fn render_whitted_until(
             if cancelled() {
                 return vec![(DVec3::ZERO, 0); w as usize];
             }
-            let row: Vec<(DVec3, u64)> = (0..w)
-                .map(|x| {
-                    let index = (y as u64) * w as u64 + x as u64;
-                    let mut rng = stream_rng(seed, streams::WHITTED_PIXEL, index);
-                    if dof {
-                        let n = scene.settings.dof_samples;
-                        let grid = (n as f64).sqrt().ceil() as u32;
-                        let mut sum = DVec3::ZERO;
-                        for s in 0..n {
-                            let cell = DVec2::new((s % grid) as f64, (s / grid % grid) as f64);
-                            let lens = concentric_disk(
-                                (cell + DVec2::new(rng.random(), rng.random())) / grid as f64,
-                            );
-                            let px =
-                                DVec2::new(x as f64 + rng.random::<f64>(), y as f64 + rng.random::<f64>());
-                            let mut state = PathState { id: 0, rng: &mut rng };
-                            sum += tracer.trace(&camera.ray(px, lens), 0, &mut state);
-                        }
-                        rays.fetch_add(n as usize, Ordering::Relaxed);
-                        (sum / n as f64, 0)
-                    } else {
-                        let mut state = PathState { id: 0, rng: &mut rng };
-                        let px = Scene::pixel_center(x, y);
-                        let c = tracer.trace(&camera.ray(px, DVec2::ZERO), 0, &mut state);
-                        rays.fetch_add(1, Ordering::Relaxed);
-                        (c, state.id)
-                    }
-                })
-                .collect();
+            let row: Vec<(DVec3, u64)> = (0..w).map(|x| tracer.first_sample(x, y, &rays)).collect();
             progress(1);
             row
         })
@@ -216,20 +233,8 @@ pub fn render_whitted_until(
                 });
             let c = if on_edge && !cancelled() {
                 edge_pixels.fetch_add(1, Ordering::Relaxed);
-                let mut rng = stream_rng(seed, streams::WHITTED_EDGE, i as u64);
-                let mut sum = DVec3::ZERO;
-                for sy in 0..4 {
-                    for sx in 0..4 {
-                        let px = DVec2::new(
-                            x as f64 + (sx as f64 + 0.5) / 4.0,
-                            y as f64 + (sy as f64 + 0.5) / 4.0,
-                        );
-                        let mut state = PathState { id: 0, rng: &mut rng };
-                        sum += tracer.trace(&camera.ray(px, DVec2::ZERO), 0, &mut state);
-                    }
-                }
                 rays.fetch_add(16, Ordering::Relaxed);
-                sum / 16.0
+                tracer.edge_samples(i, x, y)
             } else {
                 color
             };

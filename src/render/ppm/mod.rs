@@ -144,6 +144,25 @@ pub struct Slot {
     pub tau: DVec3,
 }
 
+impl Slot {
+    /// An empty slot of `pixel` (its radius is set before the first pass).
+    fn new(pixel: u32) -> Self {
+        Self {
+            pixel,
+            radius2: 0.0,
+            n: 0.0,
+            tau: DVec3::ZERO,
+        }
+    }
+}
+
+/// What one pass's photons left: flux `Φ` and photon count `M` per slot, and counts.
+struct Gathered {
+    phi: Vec<DVec3>,
+    m: Vec<u32>,
+    counts: PhotonCounts,
+}
+
 /// Run statistics.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct PpmStats {
@@ -293,13 +312,11 @@ impl Ppm {
         (self.width, self.height)
     }
 
-    /// Traces the eye pass; `false` when interrupted (nothing changed then).
-    fn eye_pass(&mut self, scene: &Scene) -> bool {
+    /// Traces an eye ray per pixel (per pixel sample), in parallel; `None` when interrupted.
+    fn trace_eye_pass(&self, scene: &Scene) -> Option<Vec<visible::EyeResult>> {
         let (w, h) = (self.width as u64, self.height as u64);
         let pass = self.stats.passes as u64;
-        let stochastic = self.stochastic;
-        let direct_light = self.options.direct_light;
-        let seed = self.seed;
+        let (stochastic, direct_light, seed) = (self.stochastic, self.options.direct_light, self.seed);
         let interrupt = self.interrupt.as_deref();
         let skipped = std::sync::atomic::AtomicBool::new(false);
         let results: Vec<visible::EyeResult> = (0..w * h)
@@ -337,9 +354,15 @@ impl Ppm {
                 }
             })
             .collect();
-        if skipped.into_inner() {
+        (!skipped.into_inner()).then_some(results)
+    }
+
+    /// Traces the eye pass; `false` when interrupted (nothing changed then).
+    fn eye_pass(&mut self, scene: &Scene) -> bool {
+        let Some(results) = self.trace_eye_pass(scene) else {
             return false;
-        }
+        };
+        let stochastic = self.stochastic;
         // Classic PPM keeps its one eye pass at once; a stochastic pass's directly seen light
         // counts only when the pass completes (an abandoned pass is traced again).
         if !stochastic {
@@ -356,48 +379,18 @@ impl Ppm {
             for mut vp in r.points {
                 if !stochastic {
                     vp.slot = self.slots.len() as u32;
-                    self.slots.push(Slot {
-                        pixel: pixel as u32,
-                        radius2: 0.0,
-                        n: 0.0,
-                        tau: DVec3::ZERO,
-                    });
+                    self.slots.push(Slot::new(pixel as u32));
                 }
                 self.points.push(vp);
             }
         }
         if stochastic && self.slots.is_empty() {
-            self.slots = (0..w * h)
-                .map(|i| Slot {
-                    pixel: i as u32,
-                    radius2: 0.0,
-                    n: 0.0,
-                    tau: DVec3::ZERO,
-                })
-                .collect();
+            self.slots = (0..self.width * self.height).map(Slot::new).collect();
         }
-        // Initial radius: given, or twice the footprint of one pixel at the median distance
-        // of the visible points from the eye. (smallppm's rule — the visible points' bounding
-        // box over the image size — explodes for an infinite floor reaching the horizon.)
         if self.stats.passes == 0 && self.slots.iter().all(|s| s.radius2 == 0.0) {
-            let r0 = self.initial_radius.unwrap_or_else(|| {
-                let mut distances: Vec<f64> = self
-                    .points
-                    .iter()
-                    .map(|p| {
-                        (p.position - scene.camera.position)
-                            .dot(scene.camera.forward)
-                            .abs()
-                    })
-                    .collect();
-                if distances.is_empty() {
-                    return 1e-3;
-                }
-                let mid = distances.len() / 2;
-                let median = *distances.select_nth_unstable_by(mid, f64::total_cmp).1;
-                let pixel = 2.0 * (0.5 * scene.camera.fov_y).tan() / h as f64;
-                (2.0 * median * pixel).max(1e-9)
-            });
+            let r0 = self
+                .initial_radius
+                .unwrap_or_else(|| self.automatic_radius(scene));
             for s in &mut self.slots {
                 s.radius2 = r0 * r0;
             }
@@ -406,6 +399,25 @@ impl Ppm {
             vp.radius2 = self.slots[vp.slot as usize].radius2;
         }
         true
+    }
+
+    /// The automatic initial radius: twice the footprint of one pixel at the median distance
+    /// of the visible points from the eye. (smallppm's rule — the visible points' bounding
+    /// box over the image size — explodes for an infinite floor reaching the horizon.)
+    fn automatic_radius(&self, scene: &Scene) -> f64 {
+        let cam = &scene.camera;
+        let mut distances: Vec<f64> = self
+            .points
+            .iter()
+            .map(|p| (p.position - cam.position).dot(cam.forward).abs())
+            .collect();
+        if distances.is_empty() {
+            return 1e-3;
+        }
+        let mid = distances.len() / 2;
+        let median = *distances.select_nth_unstable_by(mid, f64::total_cmp).1;
+        let pixel = 2.0 * (0.5 * cam.fov_y).tan() / self.height as f64;
+        (2.0 * median * pixel).max(1e-9)
     }
 
     /// Runs one pass: eye pass if needed, photons in batches (calling `control(&mut α)`
@@ -434,6 +446,24 @@ impl Ppm {
         if self.interrupted() {
             return PassOutcome::Aborted;
         }
+        let photon_start = Instant::now();
+        let Some(gathered) = self.photon_pass(scene, &index, control) else {
+            return PassOutcome::Aborted;
+        };
+        self.stats.photon_secs += photon_start.elapsed().as_secs_f64();
+        self.update(gathered);
+        self.stats.elapsed_secs += start.elapsed().as_secs_f64();
+        PassOutcome::Completed
+    }
+
+    /// Traces this pass's photons in batches and gathers their flux at the visible points;
+    /// `None` when `control` aborts the pass.
+    fn photon_pass(
+        &mut self,
+        scene: &Scene,
+        index: &SpatialIndex,
+        control: &mut dyn FnMut(&mut f64) -> Control,
+    ) -> Option<Gathered> {
         let source = PhotonSource::new(scene, self.options.direct_light);
         // Positions and radii packed tightly: the candidate test reads nothing else.
         let reach: Vec<[f64; 4]> = self
@@ -441,65 +471,75 @@ impl Ppm {
             .iter()
             .map(|v| [v.position.x, v.position.y, v.position.z, v.radius2])
             .collect();
-        let reach = &reach;
-        let mut phi = vec![DVec3::ZERO; self.slots.len()];
-        let mut m = vec![0u32; self.slots.len()];
-        let photons = self.photons_per_pass;
-        let first_photon = self.stats.photons;
-        let chunks = photons.div_ceil(CHUNK);
-        let mut counts = PhotonCounts::default();
-        let photon_start = Instant::now();
+        let mut out = Gathered {
+            phi: vec![DVec3::ZERO; self.slots.len()],
+            m: vec![0u32; self.slots.len()],
+            counts: PhotonCounts::default(),
+        };
+        let chunks = self.photons_per_pass.div_ceil(CHUNK);
         let chunks_per_batch = self.options.batch_photons.div_ceil(CHUNK).max(1);
         let mut chunk = 0;
         while chunk < chunks {
             if control(&mut self.alpha) == Control::Abort {
-                return PassOutcome::Aborted;
+                return None;
             }
             let end = (chunk + chunks_per_batch).min(chunks);
             let results: Vec<(Vec<Deposit>, PhotonCounts)> = (chunk..end)
                 .into_par_iter()
-                .map(|c| {
-                    let mut deposits: Vec<Deposit> = Vec::new();
-                    let mut counts = PhotonCounts::default();
-                    let lo = c * CHUNK;
-                    let hi = ((c + 1) * CHUNK).min(photons);
-                    for i in lo..hi {
-                        let mut rng = stream_rng(self.seed, streams::PHOTON, first_photon + i);
-                        let points = &self.points;
-                        source.trace(&mut rng, &mut counts, &mut |p, n, flux| {
-                            // Hand the flux to every visible point on this side of the surface
-                            // whose search sphere holds the photon.
-                            index.for_candidates(points, p, &mut |k| {
-                                let [x, y, z, r2] = reach[k as usize];
-                                if (DVec3::new(x, y, z) - p).length_squared() <= r2 {
-                                    let vp = &points[k as usize];
-                                    if vp.normal.dot(n) > 1e-3 {
-                                        deposits.push((vp.slot, vp.weight * flux, 1));
-                                    }
-                                }
-                            });
-                        });
-                        if deposits.len() > MAX_CHUNK_DEPOSITS {
-                            compact(&mut deposits);
-                        }
-                    }
-                    (deposits, counts)
-                })
+                .map(|c| self.trace_chunk(c, &source, index, &reach))
                 .collect();
             // Fold in chunk order: the same sums whatever the thread count.
             for (deposits, c) in results {
                 for (slot, flux, count) in deposits {
-                    phi[slot as usize] += flux;
-                    m[slot as usize] += count;
-                    counts.deposits += count as u64;
+                    out.phi[slot as usize] += flux;
+                    out.m[slot as usize] += count;
+                    out.counts.deposits += count as u64;
                 }
-                counts.paths += c.paths;
-                counts.bounces += c.bounces;
+                out.counts.paths += c.paths;
+                out.counts.bounces += c.bounces;
             }
             chunk = end;
         }
-        self.stats.photon_secs += photon_start.elapsed().as_secs_f64();
+        Some(out)
+    }
 
+    /// Traces photon chunk `c` of this pass: the deposits it makes and its counts.
+    fn trace_chunk(
+        &self,
+        c: u64,
+        source: &PhotonSource,
+        index: &SpatialIndex,
+        reach: &[[f64; 4]],
+    ) -> (Vec<Deposit>, PhotonCounts) {
+        let mut deposits: Vec<Deposit> = Vec::new();
+        let mut counts = PhotonCounts::default();
+        let (photons, first_photon) = (self.photons_per_pass, self.stats.photons);
+        let points = &self.points;
+        for i in c * CHUNK..((c + 1) * CHUNK).min(photons) {
+            let mut rng = stream_rng(self.seed, streams::PHOTON, first_photon + i);
+            source.trace(&mut rng, &mut counts, &mut |p, n, flux| {
+                // Hand the flux to every visible point on this side of the surface whose
+                // search sphere holds the photon.
+                index.for_candidates(points, p, &mut |k| {
+                    let [x, y, z, r2] = reach[k as usize];
+                    if (DVec3::new(x, y, z) - p).length_squared() <= r2 {
+                        let vp = &points[k as usize];
+                        if vp.normal.dot(n) > 1e-3 {
+                            deposits.push((vp.slot, vp.weight * flux, 1));
+                        }
+                    }
+                });
+            });
+            if deposits.len() > MAX_CHUNK_DEPOSITS {
+                compact(&mut deposits);
+            }
+        }
+        (deposits, counts)
+    }
+
+    /// Folds a completed pass into the slots and the statistics.
+    fn update(&mut self, gathered: Gathered) {
+        let Gathered { phi, m, counts } = gathered;
         // Compute new photon counts, radii and flux (Hachisuka et al. 2008, eqs. 6–11).
         let alpha = self.alpha;
         for (k, s) in self.slots.iter_mut().enumerate() {
@@ -518,7 +558,7 @@ impl Ppm {
             self.stats.eye_passes += 1;
         }
         self.stats.passes += 1;
-        self.stats.photons += photons;
+        self.stats.photons += self.photons_per_pass;
         self.stats.bounces += counts.bounces;
         self.stats.deposits += counts.deposits;
         self.stats.visible_points = self.points.len();
@@ -529,8 +569,6 @@ impl Ppm {
             .map(|s| s.radius2.sqrt())
             .collect();
         self.stats.mean_radius = gathered.iter().sum::<f64>() / gathered.len().max(1) as f64;
-        self.stats.elapsed_secs += start.elapsed().as_secs_f64();
-        PassOutcome::Completed
     }
 
     /// Linear RGB radiance per pixel: `τ/(π R² N_emitted)` of every slot of the pixel plus the
