@@ -192,6 +192,44 @@ fn click_selects_drag_moves_by_the_camera_geometry_and_undo_redo_restore() {
 }
 
 #[test]
+fn a_seam_point_moves_with_its_twins_so_the_patches_stay_joined() {
+    let mut h = editing_app();
+    let v = viewer(&h);
+    let proj = v.projection().expect("placed").clone();
+    let patches = v.patches().to_vec();
+    let all: Vec<(PointRef, DVec3)> = patches
+        .iter()
+        .enumerate()
+        .flat_map(|(patch, p)| (0..16).map(move |index| (PointRef { patch, index }, p.points[index])))
+        .collect();
+    // A point shared by two patches, with no other point near it on screen.
+    let (r, s) = all
+        .iter()
+        .filter(|(r, p)| all.iter().any(|(o, q)| o.patch != r.patch && q == p))
+        .filter_map(|(r, p)| Some((*r, *p, proj.to_screen(*p)?)))
+        .filter(|(_, _, s)| proj.view.shrink(20.0).contains(*s))
+        .find(|(_, p, s)| {
+            all.iter()
+                .all(|(_, q)| q == p || proj.to_screen(*q).is_none_or(|t| t.distance(*s) > 24.0))
+        })
+        .map(|(r, _, s)| (r, s))
+        .expect("a seam point");
+    let by = Vec2::new(12.0, -18.0);
+    drag(&mut h, s, by, PointerButton::Primary);
+    let twins: Vec<PointRef> = viewer(&h).selection().collect();
+    assert!(twins.len() >= 2 && twins.contains(&r), "{twins:?}");
+    let moved = viewer(&h).patches()[r.patch].points[r.index];
+    assert_ne!(moved, patches[r.patch].points[r.index]);
+    for t in &twins {
+        assert_eq!(
+            viewer(&h).patches()[t.patch].points[t.index],
+            moved,
+            "{t:?} left behind"
+        );
+    }
+}
+
+#[test]
 fn a_whole_patch_moves_as_one_and_the_arrow_keys_nudge_it() {
     let mut h = editing_app();
     let original: Vec<BezierPatch> = viewer(&h).patches().to_vec();
@@ -200,7 +238,16 @@ fn a_whole_patch_moves_as_one_and_the_arrow_keys_nudge_it() {
     pointer(&mut h, s, PointerButton::Primary, false, Modifiers::NONE);
     h.key_press(egui::Key::A);
     h.step();
-    assert_eq!(viewer(&h).selection().count(), 16);
+    // The patch's 16 points, and the neighbours' points welded to its edges.
+    let selected: Vec<PointRef> = viewer(&h).selection().collect();
+    assert!((0..16).all(|index| selected.contains(&PointRef {
+        patch: r.patch,
+        index
+    })));
+    let own = &original[r.patch].points;
+    assert!(selected
+        .iter()
+        .all(|s| s.patch == r.patch || own.contains(&original[s.patch].points[s.index])));
     h.key_press(egui::Key::ArrowRight);
     h.step();
     let moved = &viewer(&h).patches()[r.patch];

@@ -194,17 +194,24 @@ impl Viewer {
                 if !self.editor.exists(point) {
                     return;
                 }
+                // A point shared by patches (a seam) is selected with its twins, so the
+                // patches stay joined when it moves.
+                let welded = self.editor.welded(point);
                 if !add {
-                    self.editor.selection.clear();
-                    self.editor.selection.insert(point);
-                } else if !self.editor.selection.remove(&point) {
-                    self.editor.selection.insert(point);
+                    self.editor.selection = welded.into_iter().collect();
+                } else if self.editor.selection.contains(&point) {
+                    for r in welded {
+                        self.editor.selection.remove(&r);
+                    }
+                } else {
+                    self.editor.selection.extend(welded);
                 }
                 self.editor.touch();
             }
             Action::SelectPatch(patch) => {
                 if patch < self.editor.patches.len() {
-                    self.editor.selection = (0..16).map(|index| PointRef { patch, index }).collect();
+                    let points = (0..16).map(|index| PointRef { patch, index });
+                    self.editor.selection = points.flat_map(|r| self.editor.welded(r)).collect();
                     self.editor.touch();
                 }
             }
@@ -223,9 +230,9 @@ impl Viewer {
                 let on_screen = self.editor.exists(grab).then(|| self.editor.point(grab));
                 let on_screen = on_screen.and_then(|q| self.projection.as_ref()?.to_screen(q));
                 if let Some(grab_screen) = on_screen {
-                    // Dragging an unselected point selects it (alone).
+                    // Dragging an unselected point selects it (with its twins at seams).
                     if !self.editor.selection.contains(&grab) {
-                        self.editor.selection = [grab].into();
+                        self.editor.selection = self.editor.welded(grab).into_iter().collect();
                         self.editor.touch();
                     }
                     let start = self.editor.selected_points();

@@ -184,6 +184,26 @@ impl Editor {
         self.patches[r.patch].points[r.index]
     }
 
+    /// `r` and every other control point at the same place (within a billionth of its patch's
+    /// size): the points a seam or a collapsed edge shares, which move together.
+    pub fn welded(&self, r: PointRef) -> Vec<PointRef> {
+        if !self.exists(r) {
+            return Vec::new();
+        }
+        let p = self.point(r);
+        let tolerance = 1e-9 * self.patches[r.patch].bounds().diagonal().length();
+        let mut out = vec![r];
+        for (patch, q) in self.patches.iter().enumerate() {
+            for (index, point) in q.points.iter().enumerate() {
+                let other = PointRef { patch, index };
+                if other != r && (*point - p).length() <= tolerance {
+                    out.push(other);
+                }
+            }
+        }
+        out
+    }
+
     /// Whether `r` names a control point of this scene.
     pub fn exists(&self, r: PointRef) -> bool {
         r.patch < self.patches.len() && r.index < 16
