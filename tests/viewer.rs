@@ -378,14 +378,15 @@ impl eframe::Storage for MemoryStorage {
 
 #[test]
 fn settings_survive_storage_and_bad_stored_values_are_repaired() {
-    use caustic::app::settings::{DisplayMode, IndexChoice, Zoom, STORAGE_KEY};
+    use caustic::app::settings::{DisplayMode, Zoom, STORAGE_KEY};
+    use caustic::render::ppm::IndexKind;
     let settings = ViewerSettings {
         exposure_stops: 1.5,
         zoom: Zoom::Scale(2.0),
         display: DisplayMode::Radius,
         show_side_panel: false,
         direct_light: true,
-        index: IndexChoice::KdTree,
+        index: IndexKind::KdTree,
         last_directory: Some(PathBuf::from("/some/where")),
         show_wireframe: false,
     };

@@ -11,8 +11,9 @@ use glam::DVec3;
 use super::editor::{CameraMove, Edit, Gesture};
 use super::overlay::PointRef;
 use super::params::RenderParams;
-use super::settings::{DisplayMode, IndexChoice, Zoom, EXPOSURE_LIMIT};
+use super::settings::{DisplayMode, Zoom, EXPOSURE_LIMIT};
 use super::viewer::{Status, Viewer};
+use crate::render::ppm::IndexKind;
 use crate::render::session::Command;
 use crate::scene::Camera;
 
@@ -62,7 +63,7 @@ pub enum Action {
     /// Direct light by shadow rays on or off (restarts the session).
     SetDirectLight(bool),
     /// The spatial index (restarts the session).
-    SetIndex(IndexChoice),
+    SetIndex(IndexKind),
     /// Exposure in stops.
     SetExposure(f32),
     /// Image placement; `recentre` also clears the pan.

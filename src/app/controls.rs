@@ -7,8 +7,9 @@ use egui_plot::{Line, Plot, PlotPoints};
 use super::action::Action;
 use super::keys::HELP;
 use super::params::{ALPHA_RANGE, DEPTH_RANGE, PHOTONS_RANGE};
-use super::settings::{DisplayMode, IndexChoice, Zoom};
+use super::settings::{DisplayMode, Zoom};
 use super::viewer::{Status, Viewer};
+use crate::render::ppm::IndexKind;
 use crate::scene::RendererKind;
 
 /// Seconds as `1.23 s` or `4 min 05 s`.
@@ -267,9 +268,9 @@ pub fn side_panel_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) 
         let mut index = viewer.settings.index;
         ui.horizontal(|ui| {
             ui.label("Index").on_hover_text("Spatial index over visible points; the image is the same, the speed differs");
-            ui.selectable_value(&mut index, IndexChoice::HashGrid, "Hash grid")
+            ui.selectable_value(&mut index, IndexKind::HashGrid, "Hash grid")
                 .on_hover_text("Hashed uniform grid (fastest here)");
-            ui.selectable_value(&mut index, IndexChoice::KdTree, "kd-tree")
+            ui.selectable_value(&mut index, IndexKind::KdTree, "kd-tree")
                 .on_hover_text("The seed report's kd-tree");
         });
         if index != viewer.settings.index {

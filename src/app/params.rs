@@ -42,8 +42,11 @@ pub struct Ranges {
 pub const PHOTONS_RANGE: (u64, u64) = (1_000, 10_000_000);
 /// α slider range (α = 1 keeps the radius; the paper uses 0.7).
 pub const ALPHA_RANGE: (f64, f64) = (0.05, 1.0);
-/// Depth slider range (the session accepts 1..=64).
-pub const DEPTH_RANGE: (u32, u32) = (1, 64);
+/// Depth slider range: all the session accepts.
+pub const DEPTH_RANGE: (u32, u32) = (
+    *crate::render::limits::MAX_DEPTH.start(),
+    *crate::render::limits::MAX_DEPTH.end(),
+);
 
 impl RenderParams {
     /// The scene file's values.

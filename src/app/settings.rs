@@ -5,6 +5,8 @@ use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 
+use crate::render::ppm::IndexKind;
+
 /// Largest exposure, in stops either way, the viewer keeps.
 pub const EXPOSURE_LIMIT: f32 = 20.0;
 
@@ -49,15 +51,6 @@ impl DisplayMode {
     }
 }
 
-/// Spatial index choice as stored.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub enum IndexChoice {
-    /// Hashed grid.
-    HashGrid,
-    /// kd-tree.
-    KdTree,
-}
-
 /// Viewer preferences persisted with eframe storage.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
@@ -73,7 +66,7 @@ pub struct ViewerSettings {
     /// Direct light from point/spot lights by shadow rays.
     pub direct_light: bool,
     /// Spatial index over visible points.
-    pub index: IndexChoice,
+    pub index: IndexKind,
     /// Folder the last scene was opened from or frame saved to (file dialogs start there).
     pub last_directory: Option<PathBuf>,
     /// The control-net overlay is drawn (and can be edited).
@@ -88,7 +81,7 @@ impl Default for ViewerSettings {
             display: DisplayMode::Radiance,
             show_side_panel: true,
             direct_light: false,
-            index: IndexChoice::HashGrid,
+            index: IndexKind::HashGrid,
             last_directory: None,
             show_wireframe: true,
         }

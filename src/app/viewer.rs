@@ -16,11 +16,11 @@ use super::keys;
 use super::overlay::OverlayProjection;
 use super::params::{Ranges, RenderParams};
 use super::save::{default_file_name, SaveEvent, SaveFlow, Snapshot};
-use super::settings::{IndexChoice, ViewerSettings, Zoom};
+use super::settings::{ViewerSettings, Zoom};
 use super::view_input;
 use crate::geometry::BezierPatch;
 use crate::render::image_metadata;
-use crate::render::ppm::{IndexKind, PpmOptions};
+use crate::render::ppm::PpmOptions;
 use crate::render::session::{Command, Frame, RenderSession, SessionOptions};
 use crate::scene::{RendererKind, Scene};
 
@@ -99,10 +99,7 @@ pub struct Viewer {
 fn session_options(settings: &ViewerSettings, start_paused: bool) -> SessionOptions {
     SessionOptions {
         ppm: PpmOptions {
-            index: match settings.index {
-                IndexChoice::HashGrid => IndexKind::HashGrid,
-                IndexChoice::KdTree => IndexKind::KdTree,
-            },
+            index: settings.index,
             direct_light: settings.direct_light,
             batch_photons: VIEWER_BATCH_PHOTONS,
             ..Default::default()

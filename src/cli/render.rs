@@ -5,9 +5,9 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use anyhow::{bail, Result};
-use clap::ValueEnum;
 
 use super::{load_scene, photon_map, progress_bar};
+use caustic::render::limits;
 use caustic::render::ppm::{IndexKind, PpmOptions};
 use caustic::render::session::SessionOptions;
 use caustic::render::{image_metadata, render_whitted};
@@ -32,7 +32,7 @@ pub struct RenderArgs {
     seed: Option<u64>,
     /// Override the scene's renderer.
     #[arg(long, value_enum)]
-    renderer: Option<RendererChoice>,
+    renderer: Option<RendererKind>,
     /// PNG exposure in stops (EXR is always linear).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     exposure: f32,
@@ -62,23 +62,11 @@ pub struct PpmArgs {
     #[arg(long, allow_negative_numbers = true)]
     radius: Option<f64>,
     /// Photon mapping: spatial index over visible points.
-    #[arg(long, value_enum, default_value_t = IndexChoice::Grid)]
-    index: IndexChoice,
+    #[arg(long, value_enum, default_value_t = IndexKind::HashGrid)]
+    index: IndexKind,
     /// Photon mapping: direct light from point/spot lights by shadow rays.
     #[arg(long)]
     direct_light: bool,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum IndexChoice {
-    Grid,
-    Kd,
-}
-
-#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum RendererChoice {
-    Whitted,
-    Ppm,
 }
 
 /// Renders a scene to an image with the ray tracer or photon mapping.
@@ -110,9 +98,7 @@ pub fn render(args: RenderArgs) -> Result<()> {
     let mut scene = load_scene(scene_path.as_deref())?;
     for (flag, v) in [("--width", width), ("--height", height)] {
         if let Some(v) = v {
-            if !(1..=16384).contains(&v) {
-                bail!("{flag} must be between 1 and 16384 pixels, got {v}");
-            }
+            flag_check(flag, limits::image_side(v))?;
         }
     }
     if let Some(w) = width {
@@ -125,8 +111,7 @@ pub fn render(args: RenderArgs) -> Result<()> {
         scene.settings.seed = s;
     }
     let kind = match renderer {
-        Some(RendererChoice::Whitted) => RendererKind::Whitted,
-        Some(RendererChoice::Ppm) => RendererKind::Ppm,
+        Some(kind) => kind,
         None => scene.settings.renderer,
     };
     if kind == RendererKind::Ppm {
@@ -168,28 +153,16 @@ fn render_ppm(mut scene: Scene, out: &Path, exposure: f32, force: bool, args: &P
         }
     }
     if let Some(p) = args.photons {
-        if p == 0 || p > 1_000_000_000 {
-            bail!("--photons must be between 1 and 1000000000, got {p}");
-        }
-        scene.settings.photons_per_pass = p;
+        scene.settings.photons_per_pass = flag_check("--photons", limits::photons_per_pass(p))?;
     }
     if let Some(a) = args.alpha {
-        if !(a > 0.0 && a <= 1.0) {
-            bail!("--alpha must be in (0, 1], got {a}");
-        }
-        scene.settings.alpha = a;
+        scene.settings.alpha = flag_check("--alpha", limits::alpha(a))?;
     }
     if let Some(r) = args.radius {
-        if !(r.is_finite() && r > 0.0) {
-            bail!("--radius must be a positive number of scene units, got {r}");
-        }
-        scene.settings.initial_radius = Some(r);
+        scene.settings.initial_radius = Some(flag_check("--radius", limits::radius(r))?);
     }
     let options = PpmOptions {
-        index: match args.index {
-            IndexChoice::Grid => IndexKind::HashGrid,
-            IndexChoice::Kd => IndexKind::KdTree,
-        },
+        index: args.index,
         direct_light: args.direct_light,
         ..Default::default()
     };
@@ -248,4 +221,9 @@ fn render_ppm(mut scene: Scene, out: &Path, exposure: f32, force: bool, args: &P
         println!("  skipped: {skipped}");
     }
     Ok(())
+}
+
+/// A flag's value checked against [`limits`]: the message names the flag.
+fn flag_check<T>(flag: &str, checked: Result<T, limits::Invalid>) -> Result<T> {
+    checked.map_err(|e| anyhow::anyhow!("{flag} {e}"))
 }

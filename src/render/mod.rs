@@ -2,6 +2,7 @@
 //! tonemapping and PNG/EXR output) and deterministic random streams.
 
 pub mod film;
+pub mod limits;
 pub mod ppm;
 pub mod rng;
 pub mod session;

@@ -21,6 +21,7 @@ use std::time::{Duration, Instant};
 use crossbeam_channel::{bounded, unbounded, Receiver, Sender, TryRecvError};
 use glam::DVec3;
 
+use super::limits;
 use super::ppm::{Control, Interrupt, PassOutcome, Ppm, PpmOptions, PpmStats};
 use super::whitted::render_whitted_until;
 use crate::geometry::BezierPatch;
@@ -265,14 +266,14 @@ impl Drop for RenderSession {
 /// Whether a command's values are valid for a scene with `patches` patches.
 fn valid(command: &Command, patches: usize) -> bool {
     match command {
-        Command::SetAlpha(a) => *a > 0.0 && *a <= 1.0,
-        Command::SetPhotonsPerPass(n) => *n > 0,
+        Command::SetAlpha(a) => limits::alpha(*a).is_ok(),
+        Command::SetPhotonsPerPass(n) => limits::photons_per_pass(*n).is_ok(),
         Command::Pause | Command::Resume | Command::Shutdown | Command::Fail(_) => true,
-        Command::SetInitialRadius(r) => r.is_none_or(|r| r.is_finite() && r > 0.0),
-        Command::SetMaxDepth(d) => (1..=64).contains(d),
+        Command::SetInitialRadius(r) => r.is_none_or(|r| limits::radius(r).is_ok()),
+        Command::SetMaxDepth(d) => limits::max_depth(*d).is_ok(),
         Command::SetCamera(_) | Command::Restart | Command::SetRenderer(_) => true,
-        Command::SetAperture(a) => a.is_finite() && *a >= 0.0,
-        Command::SetFocalDistance(f) => f.is_finite() && *f > 0.0,
+        Command::SetAperture(a) => limits::aperture(*a).is_ok(),
+        Command::SetFocalDistance(f) => limits::focal_distance(*f).is_ok(),
         Command::MoveControlPoint {
             patch,
             index,

@@ -18,6 +18,7 @@ use super::material::{Material, MaterialKind};
 use super::texture::{Mapping, Texture, TextureSource};
 use super::{RenderSettings, RendererKind, Scene, SceneObject};
 use crate::geometry::{load_bpt, BezierPatch, GeometryBuilder, Plane, Quad, Sphere, TriangleMesh};
+use crate::render::limits;
 
 /// A scene file that cannot be used: where, and why.
 #[derive(Debug, thiserror::Error)]
@@ -285,9 +286,7 @@ fn camera(ctx: &Ctx, desc: &Spanned<CameraDesc>) -> Result<Camera> {
         return Err(t.err(format!("'fov' must be between 0 and 180 degrees, got {fov}")));
     }
     for (field, v) in [("width", d.width), ("height", d.height)] {
-        if !(1..=16384).contains(&v) {
-            return Err(t.err(format!("'{field}' must be between 1 and 16384 pixels, got {v}")));
-        }
+        limits::image_side(v).map_err(|e| t.err(format!("'{field}' {e}")))?;
     }
     let aperture = t.non_negative("aperture", d.aperture.map_or(0.0, |r| r.0))?;
     let focal_distance = d
@@ -325,25 +324,16 @@ fn render_settings(ctx: &Ctx, desc: &Spanned<RenderDesc>) -> Result<RenderSettin
             )))
         }
     };
-    let alpha = d.alpha.map_or(defaults.alpha, |r| r.0);
-    if !(alpha > 0.0 && alpha <= 1.0) {
-        return Err(t.err(format!("'alpha' must be in (0, 1], got {alpha}")));
-    }
-    let photons_per_pass = d.photons_per_pass.unwrap_or(defaults.photons_per_pass);
-    if photons_per_pass == 0 {
-        return Err(t.err("'photons_per_pass' must be at least 1"));
-    }
-    let max_depth = d.max_depth.unwrap_or(defaults.max_depth);
-    if !(1..=64).contains(&max_depth) {
-        return Err(t.err(format!("'max_depth' must be between 1 and 64, got {max_depth}")));
-    }
-    let dof_samples = d.dof_samples.unwrap_or(defaults.dof_samples);
-    let light_samples = d.light_samples.unwrap_or(defaults.light_samples);
-    for (field, v) in [("dof_samples", dof_samples), ("light_samples", light_samples)] {
-        if !(1..=4096).contains(&v) {
-            return Err(t.err(format!("'{field}' must be between 1 and 4096, got {v}")));
-        }
-    }
+    let check = |field: &str, e: limits::Invalid| t.err(format!("'{field}' {e}"));
+    let alpha = limits::alpha(d.alpha.map_or(defaults.alpha, |r| r.0)).map_err(|e| check("alpha", e))?;
+    let photons_per_pass = limits::photons_per_pass(d.photons_per_pass.unwrap_or(defaults.photons_per_pass))
+        .map_err(|e| check("photons_per_pass", e))?;
+    let max_depth =
+        limits::max_depth(d.max_depth.unwrap_or(defaults.max_depth)).map_err(|e| check("max_depth", e))?;
+    let dof_samples = limits::samples(d.dof_samples.unwrap_or(defaults.dof_samples))
+        .map_err(|e| check("dof_samples", e))?;
+    let light_samples = limits::samples(d.light_samples.unwrap_or(defaults.light_samples))
+        .map_err(|e| check("light_samples", e))?;
     let ambient = d.ambient.as_ref().map(v3).unwrap_or(DVec3::ZERO);
     if ambient.cmplt(DVec3::ZERO).any() {
         return Err(t.err(format!("'ambient' must not be negative, got {ambient}")));
@@ -354,7 +344,7 @@ fn render_settings(ctx: &Ctx, desc: &Spanned<RenderDesc>) -> Result<RenderSettin
         alpha,
         initial_radius: d
             .initial_radius
-            .map(|r| t.positive("initial_radius", r.0))
+            .map(|r| limits::radius(r.0).map_err(|e| check("initial_radius", e)))
             .transpose()?,
         max_depth,
         seed: d.seed.unwrap_or(defaults.seed),

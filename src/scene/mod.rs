@@ -22,8 +22,8 @@ pub use texture::Texture;
 
 use crate::geometry::{Hit, SceneGeometry};
 
-/// Which renderer a scene asks for.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// Which renderer a scene asks for (`--renderer whitted|ppm` on the command line).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum RendererKind {
     /// The Whitted ray tracer (preview, and the seed report's first renderer).
     Whitted,

@@ -75,13 +75,18 @@ fn compact(deposits: &mut Vec<Deposit>) {
     *deposits = merged;
 }
 
-/// Which spatial index finds the visible points near a photon.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+/// Which spatial index finds the visible points near a photon (`--index grid|kd` on the
+/// command line; stored by name in the viewer's preferences).
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum,
+)]
 pub enum IndexKind {
     /// Hashed uniform grid, rebuilt per pass (default).
     #[default]
+    #[value(name = "grid")]
     HashGrid,
     /// The seed report's kd-tree with per-subtree maximum radius.
+    #[value(name = "kd")]
     KdTree,
 }
 

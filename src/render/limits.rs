@@ -1,0 +1,118 @@
+//! The one table of valid render settings: the scene loader, the command line, the render
+//! session and the viewer's controls all check values here, so a setting's range is stated
+//! once. Each check returns the value, or the end of an error message ("must be …, got …")
+//! that the caller prefixes with the name the user knows (`'alpha'` in a scene file,
+//! `--alpha` on the command line).
+
+use std::ops::RangeInclusive;
+
+/// Photons per pass.
+pub const PHOTONS_PER_PASS: RangeInclusive<u64> = 1..=1_000_000_000;
+/// Mirror/glass bounces followed by eye rays and photons.
+pub const MAX_DEPTH: RangeInclusive<u32> = 1..=64;
+/// Lens and light samples per pixel or shading point.
+pub const SAMPLES: RangeInclusive<u32> = 1..=4096;
+/// Image width and height in pixels.
+pub const IMAGE_SIDE: RangeInclusive<u32> = 1..=16384;
+
+/// A setting's value outside its range: the end of the message.
+pub type Invalid = String;
+
+/// PPM's radius reduction α, in (0, 1] (Hachisuka et al. 2008 use 0.7).
+pub fn alpha(a: f64) -> Result<f64, Invalid> {
+    if a > 0.0 && a <= 1.0 {
+        Ok(a)
+    } else {
+        Err(format!("must be in (0, 1], got {a}"))
+    }
+}
+
+/// Photons per pass.
+pub fn photons_per_pass(n: u64) -> Result<u64, Invalid> {
+    within(n, PHOTONS_PER_PASS, "")
+}
+
+/// Maximum specular depth.
+pub fn max_depth(d: u32) -> Result<u32, Invalid> {
+    within(d, MAX_DEPTH, "")
+}
+
+/// Lens or light samples.
+pub fn samples(n: u32) -> Result<u32, Invalid> {
+    within(n, SAMPLES, "")
+}
+
+/// Image width or height.
+pub fn image_side(n: u32) -> Result<u32, Invalid> {
+    within(n, IMAGE_SIDE, " pixels")
+}
+
+/// A PPM initial search radius.
+pub fn radius(r: f64) -> Result<f64, Invalid> {
+    positive(r, "scene units")
+}
+
+/// The lens radius (0 is a pinhole).
+pub fn aperture(a: f64) -> Result<f64, Invalid> {
+    if a.is_finite() && a >= 0.0 {
+        Ok(a)
+    } else {
+        Err(format!(
+            "must be a finite number of scene units, 0 or more, got {a}"
+        ))
+    }
+}
+
+/// The distance of the plane in focus.
+pub fn focal_distance(f: f64) -> Result<f64, Invalid> {
+    positive(f, "scene units")
+}
+
+fn positive(v: f64, unit: &str) -> Result<f64, Invalid> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(format!("must be a positive number of {unit}, got {v}"))
+    }
+}
+
+fn within<T: PartialOrd + std::fmt::Display + Copy>(
+    v: T,
+    range: RangeInclusive<T>,
+    unit: &str,
+) -> Result<T, Invalid> {
+    if range.contains(&v) {
+        Ok(v)
+    } else {
+        Err(format!(
+            "must be between {} and {}{unit}, got {v}",
+            range.start(),
+            range.end()
+        ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ranges_accept_their_ends_and_reject_what_lies_outside() {
+        assert_eq!(alpha(1.0), Ok(1.0));
+        assert_eq!(alpha(0.0).expect_err("0 is out"), "must be in (0, 1], got 0");
+        assert!(alpha(f64::NAN).is_err());
+        assert_eq!(max_depth(64), Ok(64));
+        assert_eq!(
+            max_depth(65).expect_err("65 is out"),
+            "must be between 1 and 64, got 65"
+        );
+        assert_eq!(
+            image_side(0).expect_err("0 is out"),
+            "must be between 1 and 16384 pixels, got 0"
+        );
+        assert!(photons_per_pass(0).is_err() && photons_per_pass(1_000_000_001).is_err());
+        assert!(radius(f64::INFINITY).is_err() && radius(-1.0).is_err() && radius(1e-9).is_ok());
+        assert_eq!(aperture(0.0), Ok(0.0));
+        assert!(aperture(-0.1).is_err() && focal_distance(0.0).is_err());
+    }
+}
