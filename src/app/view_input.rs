@@ -27,24 +27,40 @@ pub fn view_actions(
     editing: bool,
     out: &mut Vec<Action>,
 ) {
-    let (modifiers, press) = response.ctx.input(|i| (i.modifiers, i.pointer.press_origin()));
-    let pointer = response.interact_pointer_pos().or(response.hover_pos());
-
     // Hover (not while a gesture holds the pointer).
     if editor.gesture.is_none() {
-        let hovered = if editing {
-            response
-                .hover_pos()
-                .and_then(|p| projection.pick(&editor.patches, p))
-        } else {
-            None
-        };
+        let hovered = response
+            .hover_pos()
+            .filter(|_| editing)
+            .and_then(|p| projection.pick(&editor.patches, p));
         if hovered != editor.hovered {
             out.push(Action::Hover(hovered));
         }
     }
+    drag_actions(editor, projection, response, editing, out);
+    // Clicks select.
+    if response.clicked() && editing {
+        let shift = response.ctx.input(|i| i.modifiers.shift);
+        match response
+            .hover_pos()
+            .and_then(|p| projection.pick(&editor.patches, p))
+        {
+            Some(point) => out.push(Action::Select { point, add: shift }),
+            None if !shift && !editor.selection.is_empty() => out.push(Action::ClearSelection),
+            None => {}
+        }
+    }
+}
 
-    // Drags: points with the left button, the camera with the right or middle one.
+/// Drags: points with the left button, the camera with the right or middle one.
+fn drag_actions(
+    editor: &Editor,
+    projection: &OverlayProjection,
+    response: &Response,
+    editing: bool,
+    out: &mut Vec<Action>,
+) {
+    let (modifiers, press) = response.ctx.input(|i| (i.modifiers, i.pointer.press_origin()));
     if response.drag_started_by(PointerButton::Primary) && editing {
         if let (Some(grab), Some(press)) = (grab_at(editor, Some(projection), press), press) {
             out.push(Action::BeginPointDrag { grab, press });
@@ -63,44 +79,28 @@ pub fn view_actions(
     } else {
         None
     };
-    if let Some(how) = camera_move {
-        out.push(Action::BeginCameraDrag(how));
-    }
-    let gesture = match (out.last(), &editor.gesture) {
-        (Some(Action::BeginPointDrag { .. }), _) => Some(true),
-        (Some(Action::BeginCameraDrag(_)), _) => Some(false),
-        (_, Some(Gesture::Points { .. })) => Some(true),
-        (_, Some(Gesture::Camera { .. })) => Some(false),
-        _ => None,
+    out.extend(camera_move.map(Action::BeginCameraDrag));
+    // Whether a points (true) or camera (false) gesture is under way, begun now or before.
+    let gesture = match out.last() {
+        Some(Action::BeginPointDrag { .. }) => Some(true),
+        Some(Action::BeginCameraDrag(_)) => Some(false),
+        _ => editor
+            .gesture
+            .as_ref()
+            .map(|g| matches!(g, Gesture::Points { .. })),
     };
-    if let (Some(points), Some(p)) = (gesture, pointer) {
-        if response.dragged() {
-            out.push(if points {
-                Action::DragPoints {
-                    pointer: p,
-                    along_view: modifiers.command || modifiers.ctrl,
-                }
-            } else {
-                Action::DragCamera(p - press.unwrap_or(p))
-            });
-        }
+    let pointer = response.interact_pointer_pos().or(response.hover_pos());
+    if let (Some(points), Some(p), true) = (gesture, pointer, response.dragged()) {
+        out.push(if points {
+            Action::DragPoints {
+                pointer: p,
+                along_view: modifiers.command || modifiers.ctrl,
+            }
+        } else {
+            Action::DragCamera(p - press.unwrap_or(p))
+        });
     }
     if response.drag_stopped() && gesture.is_some() {
         out.push(Action::EndGesture);
-    }
-
-    // Clicks select.
-    if response.clicked() && editing {
-        match response
-            .hover_pos()
-            .and_then(|p| projection.pick(&editor.patches, p))
-        {
-            Some(point) => out.push(Action::Select {
-                point,
-                add: modifiers.shift,
-            }),
-            None if !modifiers.shift && !editor.selection.is_empty() => out.push(Action::ClearSelection),
-            None => {}
-        }
     }
 }

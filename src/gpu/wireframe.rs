@@ -93,33 +93,7 @@ pub fn install(
         label: Some("caustic wireframe shader"),
         source: wgpu::ShaderSource::Wgsl(SHADER.into()),
     });
-    let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("caustic wireframe uniforms"),
-        size: std::mem::size_of::<Uniforms>() as u64,
-        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("caustic wireframe bind group layout"),
-        entries: &[wgpu::BindGroupLayoutEntry {
-            binding: 0,
-            visibility: wgpu::ShaderStages::VERTEX,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
-                has_dynamic_offset: false,
-                min_binding_size: std::num::NonZeroU64::new(std::mem::size_of::<Uniforms>() as u64),
-            },
-            count: None,
-        }],
-    });
-    let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("caustic wireframe bind group"),
-        layout: &layout,
-        entries: &[wgpu::BindGroupEntry {
-            binding: 0,
-            resource: uniforms.as_entire_binding(),
-        }],
-    });
+    let (uniforms, layout, bind_group) = uniform_binding(device);
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some("caustic wireframe pipeline layout"),
         bind_group_layouts: &[Some(&layout)],
@@ -192,6 +166,38 @@ pub fn install(
             marker_count: 0,
             generation: None,
         });
+}
+
+/// The uniform buffer, its bind group layout and its bind group.
+fn uniform_binding(device: &wgpu::Device) -> (wgpu::Buffer, wgpu::BindGroupLayout, wgpu::BindGroup) {
+    let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("caustic wireframe uniforms"),
+        size: std::mem::size_of::<Uniforms>() as u64,
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("caustic wireframe bind group layout"),
+        entries: &[wgpu::BindGroupLayoutEntry {
+            binding: 0,
+            visibility: wgpu::ShaderStages::VERTEX,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: false,
+                min_binding_size: std::num::NonZeroU64::new(std::mem::size_of::<Uniforms>() as u64),
+            },
+            count: None,
+        }],
+    });
+    let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("caustic wireframe bind group"),
+        layout: &layout,
+        entries: &[wgpu::BindGroupEntry {
+            binding: 0,
+            resource: uniforms.as_entire_binding(),
+        }],
+    });
+    (uniforms, layout, bind_group)
 }
 
 /// One frame's overlay: the projection and view size, and the geometry (uploaded only when
