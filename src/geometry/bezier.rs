@@ -93,6 +93,7 @@ impl BezierPatch {
     }
 
     /// `P(u,v)` with `∂P/∂u` and `∂P/∂v`.
+    #[inline]
     pub fn eval_with_derivs(&self, u: f64, v: f64) -> SurfacePoint {
         let bu = bernstein(u);
         let bv = bernstein(v);
@@ -142,6 +143,7 @@ impl BezierPatch {
     }
 
     /// Splits along `u` at `t`: the patches over `u ∈ [0,t]` and `u ∈ [t,1]`.
+    #[inline]
     pub fn split_u(&self, t: f64) -> (Self, Self) {
         let mut lo = [DVec3::ZERO; 16];
         let mut hi = [DVec3::ZERO; 16];
@@ -162,6 +164,7 @@ impl BezierPatch {
     }
 
     /// Splits along `v` at `t`: the patches over `v ∈ [0,t]` and `v ∈ [t,1]`.
+    #[inline]
     pub fn split_v(&self, t: f64) -> (Self, Self) {
         let mut lo = [DVec3::ZERO; 16];
         let mut hi = [DVec3::ZERO; 16];
@@ -180,6 +183,7 @@ impl BezierPatch {
     }
 
     /// Splits into four at `(0.5, 0.5)`: `[u-low v-low, u-high v-low, u-low v-high, u-high v-high]`.
+    #[inline]
     pub fn split_quad(&self) -> [Self; 4] {
         let (ul, uh) = self.split_u(0.5);
         let (a, c) = ul.split_v(0.5);
@@ -204,8 +208,16 @@ impl BezierPatch {
     }
 
     /// Bounds of the control hull, which contain the patch (convex hull property).
+    #[inline]
     pub fn bounds(&self) -> Aabb {
-        Aabb::from_points(self.points.iter().copied())
+        // From the first point on (not from the empty box): the ray-space hull test of every
+        // leaf a ray reaches runs through here.
+        let (mut min, mut max) = (self.points[0], self.points[0]);
+        for q in &self.points[1..] {
+            min = min.min(*q);
+            max = max.max(*q);
+        }
+        Aabb { min, max }
     }
 
     /// The patch with every control point transformed (Bézier patches are affine invariant).

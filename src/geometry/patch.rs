@@ -35,7 +35,7 @@
 use glam::{DVec2, DVec3};
 
 use super::aabb::Aabb;
-use super::bezier::{bernstein, bernstein_deriv, split_cubic, BezierPatch};
+use super::bezier::BezierPatch;
 use super::ray::Ray;
 
 /// A rectangle `[u0,u1] × [v0,v1]` of a patch's parameter domain.
@@ -196,13 +196,15 @@ impl RayFrame {
         }
     }
 
-    /// Control points in ray space: distances from the ray along `n1`, `n2`, and along it.
+    /// The patch in ray space (control points as distances from the ray along `n1`, `n2`,
+    /// and along it): a Bézier patch too, since Bézier patches are affine invariant, so its
+    /// evaluation, hull and splits are [`BezierPatch`]'s own.
     #[inline]
-    fn project(&self, patch: &BezierPatch) -> [DVec3; 16] {
-        patch.points.map(|p| {
+    fn project(&self, patch: &BezierPatch) -> BezierPatch {
+        BezierPatch::new(patch.points.map(|p| {
             let q = p - self.origin;
             DVec3::new(self.n1.dot(q), self.n2.dot(q), self.dir.dot(q))
-        })
+        }))
     }
 }
 
@@ -224,37 +226,16 @@ struct Problem {
     best: Option<PatchHit>,
 }
 
-/// The ray-space patch and its partial derivatives at `(s,t)`.
-#[inline]
-fn eval_ray_space(p: &[DVec3; 16], s: f64, t: f64) -> (DVec3, DVec3, DVec3) {
-    let bu = bernstein(s);
-    let bv = bernstein(t);
-    let du = bernstein_deriv(s);
-    let dv = bernstein_deriv(t);
-    let mut f = DVec3::ZERO;
-    let mut fs = DVec3::ZERO;
-    let mut ft = DVec3::ZERO;
-    for i in 0..4 {
-        let r = &p[4 * i..4 * i + 4];
-        let row = bv[0] * r[0] + bv[1] * r[1] + bv[2] * r[2] + bv[3] * r[3];
-        let row_dt = dv[0] * r[0] + dv[1] * r[1] + dv[2] * r[2] + dv[3] * r[3];
-        f += bu[i] * row;
-        fs += du[i] * row;
-        ft += bu[i] * row_dt;
-    }
-    (f, fs, ft)
-}
-
 /// Where the ray meets the bilinear patch through the four corners of the ray-space patch `p`
 /// (inverse bilinear interpolation, solved as a quadratic), clamped near `[0,1]²`; the middle
 /// `(0.5, 0.5)` when the quadratic has no usable root. A start this close to the root lets
 /// Newton converge in two or three steps to the root in this window rather than another.
-fn bilinear_start(p: &[DVec3; 16]) -> (f64, f64) {
+fn bilinear_start(p: &BezierPatch) -> (f64, f64) {
     let cross = |a: DVec2, b: DVec2| a.x * b.y - a.y * b.x;
-    let p00 = p[0].truncate();
-    let e = p[12].truncate() - p00; // along s
-    let f = p[3].truncate() - p00; // along t
-    let g = p00 - p[12].truncate() - p[3].truncate() + p[15].truncate();
+    let p00 = p.points[0].truncate();
+    let e = p.points[12].truncate() - p00; // along s
+    let f = p.points[3].truncate() - p00; // along t
+    let g = p00 - p.points[12].truncate() - p.points[3].truncate() + p.points[15].truncate();
     let h = -p00;
     let k2 = cross(g, f);
     let k1 = cross(e, f) + cross(h, g);
@@ -297,7 +278,7 @@ fn bilinear_start(p: &[DVec3; 16]) -> (f64, f64) {
 /// Newton (or Levenberg–Marquardt where the Jacobian is near singular) on the first two
 /// ray-space coordinates, from [`bilinear_start`] and, should that fail (its corners can
 /// coincide at a pole), from the middle. Returns the root `(s, t)` and its ray distance.
-fn newton(p: &[DVec3; 16], tolerance: f64) -> Option<(f64, f64, f64)> {
+fn newton(p: &BezierPatch, tolerance: f64) -> Option<(f64, f64, f64)> {
     let start = bilinear_start(p);
     let clamped = !(0.0..=1.0).contains(&start.0) || !(0.0..=1.0).contains(&start.1);
     newton_from(p, tolerance, start)
@@ -305,10 +286,11 @@ fn newton(p: &[DVec3; 16], tolerance: f64) -> Option<(f64, f64, f64)> {
 }
 
 /// Newton from `(s, t)`, with steps limited to half the sub-patch.
-fn newton_from(p: &[DVec3; 16], tolerance: f64, (mut s, mut t): (f64, f64)) -> Option<(f64, f64, f64)> {
+fn newton_from(p: &BezierPatch, tolerance: f64, (mut s, mut t): (f64, f64)) -> Option<(f64, f64, f64)> {
     let mut previous = f64::INFINITY;
     for iteration in 0..MAX_NEWTON_ITERATIONS {
-        let (f, fs, ft) = eval_ray_space(p, s, t);
+        let sp = p.eval_with_derivs(s, t);
+        let (f, fs, ft) = (sp.position, sp.dp_du, sp.dp_dv);
         let residual = f.x.abs().max(f.y.abs());
         if residual <= tolerance {
             return Some((s, t, f.z));
@@ -363,18 +345,18 @@ const MAX_STEP: f64 = 0.5;
 /// the determinant. Between two crossings of a smooth surface piece the ray would have to be
 /// tangent to it somewhere, where the determinant is zero, so a fixed sign means at most one
 /// root.
-fn jacobian_sign_is_fixed(p: &[DVec3; 16]) -> bool {
+fn jacobian_sign_is_fixed(p: &BezierPatch) -> bool {
     let (mut su_lo, mut su_hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
     let (mut sv_lo, mut sv_hi) = (su_lo, su_hi);
     for i in 0..4 {
         for j in 0..4 {
             if i < 3 {
-                let d = (p[4 * (i + 1) + j] - p[4 * i + j]).truncate();
+                let d = (p.points[4 * (i + 1) + j] - p.points[4 * i + j]).truncate();
                 su_lo = su_lo.min(d);
                 su_hi = su_hi.max(d);
             }
             if j < 3 {
-                let d = (p[4 * i + j + 1] - p[4 * i + j]).truncate();
+                let d = (p.points[4 * i + j + 1] - p.points[4 * i + j]).truncate();
                 sv_lo = sv_lo.min(d);
                 sv_hi = sv_hi.max(d);
             }
@@ -393,42 +375,11 @@ fn jacobian_sign_is_fixed(p: &[DVec3; 16]) -> bool {
     a_lo - b_hi > 0.0 || a_hi - b_lo < 0.0
 }
 
-/// Bounds of the ray-space control points.
+/// Bounds of the ray-space control points: `(lo, hi)`.
 #[inline]
-fn hull(p: &[DVec3; 16]) -> (DVec3, DVec3) {
-    let mut lo = p[0];
-    let mut hi = p[0];
-    for q in &p[1..] {
-        lo = lo.min(*q);
-        hi = hi.max(*q);
-    }
-    (lo, hi)
-}
-
-fn split_ray_space(p: &[DVec3; 16]) -> [[DVec3; 16]; 4] {
-    // Split along s (rows i), then each half along t (columns j).
-    let mut lo = [DVec3::ZERO; 16];
-    let mut hi = [DVec3::ZERO; 16];
-    for j in 0..4 {
-        let (a, b) = split_cubic([p[j], p[4 + j], p[8 + j], p[12 + j]], 0.5);
-        for i in 0..4 {
-            lo[4 * i + j] = a[i];
-            hi[4 * i + j] = b[i];
-        }
-    }
-    let split_t = |q: &[DVec3; 16]| {
-        let mut a = [DVec3::ZERO; 16];
-        let mut b = [DVec3::ZERO; 16];
-        for i in 0..4 {
-            let (x, y) = split_cubic([q[4 * i], q[4 * i + 1], q[4 * i + 2], q[4 * i + 3]], 0.5);
-            a[4 * i..4 * i + 4].copy_from_slice(&x);
-            b[4 * i..4 * i + 4].copy_from_slice(&y);
-        }
-        (a, b)
-    };
-    let (a, c) = split_t(&lo);
-    let (b, d) = split_t(&hi);
-    [a, b, c, d]
+fn hull(p: &BezierPatch) -> (DVec3, DVec3) {
+    let b = p.bounds();
+    (b.min, b.max)
 }
 
 impl Problem {
@@ -446,7 +397,7 @@ impl Problem {
     /// Finds the nearest root of the ray-space patch `p` over `window` (whose hull the caller
     /// has checked with [`Problem::may_hit`]), splitting up to `depth` more times where Newton
     /// fails or a second, nearer root cannot be ruled out.
-    fn solve(&mut self, p: &[DVec3; 16], window: Window, depth: u32, t_max: f64) {
+    fn solve(&mut self, p: &BezierPatch, window: Window, depth: u32, t_max: f64) {
         let t_max = self.t_max(t_max);
         let root = newton(p, self.tolerance);
         self.budget = self.budget.saturating_sub(1);
@@ -472,12 +423,12 @@ impl Problem {
             // ray. Corners lie exactly on the surface, and at a pole one of them is the pole.
             if self.best.is_none() {
                 let corners = [(0, 0.0, 0.0), (3, 0.0, 1.0), (12, 1.0, 0.0), (15, 1.0, 1.0)];
-                let off = |k: usize| p[k].truncate().length();
+                let off = |k: usize| p.points[k].truncate().length();
                 let (k, s, t) = corners
                     .into_iter()
                     .min_by(|a, b| off(a.0).total_cmp(&off(b.0)))
                     .unwrap_or((0, 0.0, 0.0));
-                let dist = p[k].z;
+                let dist = p.points[k].z;
                 if dist > self.t_min && dist < t_max {
                     self.best = Some(PatchHit {
                         t: dist,
@@ -488,7 +439,7 @@ impl Problem {
             return;
         }
         let t_max = self.t_max(t_max);
-        let children = split_ray_space(p);
+        let children = p.split_quad();
         let windows = window.quarters();
         // Quarters that may hold a root, nearest first, so later ones are pruned by t_max.
         let mut live = [(0.0f64, 0usize); 4];
@@ -513,7 +464,7 @@ impl Problem {
     }
 
     /// Culls, then solves the ray-space patch `p`.
-    fn run(&mut self, p: &[DVec3; 16], window: Window, depth: u32, t_max: f64) {
+    fn run(&mut self, p: &BezierPatch, window: Window, depth: u32, t_max: f64) {
         if self.may_hit(hull(p), self.t_max(t_max)) {
             self.solve(p, window, depth, t_max);
         }
@@ -530,8 +481,11 @@ const LEAF_FALLBACK_DEPTH: u32 = 24;
 /// Tolerance for a patch of size `scale` seen from a ray whose origin is `depth` away: the
 /// relative target, or the rounding of the ray-space projection if that is larger.
 #[inline]
-fn tolerance(scale: f64, p: &[DVec3; 16]) -> f64 {
-    let far = p[0].abs().max_element().max(p[15].abs().max_element());
+fn tolerance(scale: f64, p: &BezierPatch) -> f64 {
+    let far = p.points[0]
+        .abs()
+        .max_element()
+        .max(p.points[15].abs().max_element());
     (RELATIVE_TOLERANCE * scale).max(16.0 * f64::EPSILON * far)
 }
 
