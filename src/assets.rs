@@ -8,6 +8,11 @@ use crate::geometry::{parse_bpt, BezierPatch};
 /// The same figures as `assets/teapot.bpt`.
 pub const TEAPOT_BPT: &str = include_str!("../assets/teapot.bpt");
 
+/// smallppm's scene (Hachisuka's 100-line PPM), number for number: the default scene of
+/// `caustic bench ppm` and `bench convergence`, so they run from any directory. The same text
+/// as `scenes/smallppm.toml`.
+pub const SMALLPPM_SCENE: &str = include_str!("../scenes/smallppm.toml");
+
 /// The Utah teapot's 32 patches.
 pub fn teapot() -> Vec<BezierPatch> {
     parse_bpt(TEAPOT_BPT, Path::new("assets/teapot.bpt")).expect("the built-in teapot parses")

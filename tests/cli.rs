@@ -234,3 +234,25 @@ fn view_flags_are_checked_before_a_window_opens() {
         assert!(help.contains(flag), "view --help lacks {flag}: {help}");
     }
 }
+
+#[test]
+fn photon_benches_run_from_any_directory_on_the_built_in_scene() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = Command::new(env!("CARGO_BIN_EXE_caustic"))
+        .args([
+            "bench",
+            "ppm",
+            "--photons",
+            "2000",
+            "--passes",
+            "1",
+            "--threads",
+            "1",
+        ])
+        .current_dir(dir.path())
+        .output()
+        .expect("run caustic");
+    let t = text(&out);
+    assert!(out.status.success(), "{t}");
+    assert!(t.contains("<built-in smallppm>, 1024x768"), "{t}");
+}

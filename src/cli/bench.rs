@@ -7,6 +7,7 @@ use anyhow::{bail, Context, Result};
 use clap::{Subcommand, ValueEnum};
 
 use super::{load_scene, photon_map};
+use caustic::assets::SMALLPPM_SCENE;
 use caustic::bench::{teapot_geometry, teapot_view, time_intersect};
 use caustic::geometry::{PatchMethod, SubdivisionParams};
 use caustic::render::ppm::{IndexKind, PpmOptions};
@@ -42,9 +43,8 @@ pub enum BenchCommand {
     },
     /// Photon mapping: photon paths per core-second at the given thread counts.
     Ppm {
-        /// Scene file.
-        #[arg(default_value = "scenes/smallppm.toml")]
-        scene: PathBuf,
+        /// Scene file; smallppm's scene (built in) when omitted.
+        scene: Option<PathBuf>,
         /// Photons per pass.
         #[arg(long, default_value_t = 500_000)]
         photons: u64,
@@ -58,9 +58,8 @@ pub enum BenchCommand {
     /// Photon mapping: RMSE against a long reference render over time, for the hash grid and
     /// the kd-tree, with and without direct light by shadow rays.
     Convergence {
-        /// Scene file.
-        #[arg(default_value = "scenes/smallppm.toml")]
-        scene: PathBuf,
+        /// Scene file; smallppm's scene (built in) when omitted.
+        scene: Option<PathBuf>,
         /// Image width (height follows the scene's aspect).
         #[arg(long, default_value_t = 256)]
         width: u32,
@@ -126,7 +125,7 @@ pub fn bench(what: BenchCommand) -> Result<()> {
             photons,
             passes,
             threads,
-        } => bench_ppm(&scene, photons, passes, &threads),
+        } => bench_ppm(scene.as_deref(), photons, passes, &threads),
         BenchCommand::Convergence {
             scene,
             width,
@@ -134,15 +133,30 @@ pub fn bench(what: BenchCommand) -> Result<()> {
             passes,
             reference_passes,
             csv,
-        } => bench_convergence(&scene, width, photons, passes, reference_passes, csv.as_deref()),
+        } => bench_convergence(
+            scene.as_deref(),
+            width,
+            photons,
+            passes,
+            reference_passes,
+            csv.as_deref(),
+        ),
     }
 }
 
-fn bench_ppm(scene_path: &Path, photons: u64, passes: u32, threads: &[usize]) -> Result<()> {
+/// The scene a photon-mapping bench measures: the file, or smallppm's built-in scene.
+fn photon_scene(path: Option<&Path>) -> Result<Scene> {
+    Ok(match path {
+        Some(p) => Scene::load(p)?,
+        None => Scene::from_str(SMALLPPM_SCENE, Path::new("<built-in smallppm>"), None)?,
+    })
+}
+
+fn bench_ppm(scene_path: Option<&Path>, photons: u64, passes: u32, threads: &[usize]) -> Result<()> {
     if photons == 0 || passes == 0 {
         bail!("--photons and --passes must be at least 1");
     }
-    let mut scene = Scene::load(scene_path)?;
+    let mut scene = photon_scene(scene_path)?;
     scene.settings.photons_per_pass = photons;
     let (w, h) = (scene.camera.width, scene.camera.height);
     println!(
@@ -187,7 +201,7 @@ fn rmse(a: &[[f32; 3]], b: &[[f32; 3]]) -> f64 {
 }
 
 fn bench_convergence(
-    scene_path: &Path,
+    scene_path: Option<&Path>,
     width: u32,
     photons: u64,
     passes: u32,
@@ -202,7 +216,7 @@ fn bench_convergence(
             bail!("{}: the file exists; choose another name", p.display());
         }
     }
-    let mut scene = Scene::load(scene_path)?;
+    let mut scene = photon_scene(scene_path)?;
     let aspect = scene.camera.height as f64 / scene.camera.width as f64;
     scene.camera.width = width;
     scene.camera.height = ((width as f64 * aspect).round() as u32).max(1);
