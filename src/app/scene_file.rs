@@ -142,11 +142,9 @@ impl Viewer {
     fn write_scene(&mut self, path: PathBuf, overwrite: bool) {
         let mut scene = self.edited_scene();
         match save_scene(&scene, &self.editor.loaded, &path, overwrite) {
-            Ok(()) => {
+            Ok(text) => {
                 // The file now holds the scene as edited: it is what "saved" means from here.
-                if let Ok(text) = std::fs::read_to_string(&path) {
-                    scene.text = text.into();
-                }
+                scene.text = text.into();
                 scene.source = path.clone();
                 scene.base_dir = path.parent().map(|d| d.to_path_buf());
                 self.scene = scene;

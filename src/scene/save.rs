@@ -55,11 +55,8 @@ fn rebase(file: &str, base: &Path) -> String {
         .into_owned()
 }
 
-/// Rewrites the relative `file` key of a table-like item, if any.
-fn rebase_file_key(item: Option<&mut Item>, base: &Path) {
-    let Some(table) = item.and_then(Item::as_table_like_mut) else {
-        return;
-    };
+/// Rewrites the relative `file` key of a table, if it has one.
+fn rebase_file_key(table: &mut dyn toml_edit::TableLike, base: &Path) {
     let Some(file) = table.get("file").and_then(Item::as_str).map(str::to_owned) else {
         return;
     };
@@ -96,15 +93,15 @@ pub fn scene_toml(
         if !same {
             if let Some(materials) = doc.get_mut("materials").and_then(Item::as_table_like_mut) {
                 for (_, m) in materials.iter_mut() {
-                    rebase_file_key(m.as_table_like_mut().and_then(|t| t.get_mut("texture")), base);
+                    let texture = m.as_table_like_mut().and_then(|t| t.get_mut("texture"));
+                    if let Some(t) = texture.and_then(Item::as_table_like_mut) {
+                        rebase_file_key(t, base);
+                    }
                 }
             }
             if let Some(objects) = doc.get_mut("objects").and_then(Item::as_array_of_tables_mut) {
                 for o in objects.iter_mut() {
-                    let file = o.get("file").and_then(Item::as_str).map(|f| rebase(f, base));
-                    if let Some(f) = file {
-                        o.insert("file", toml_edit::value(f));
-                    }
+                    rebase_file_key(o, base);
                 }
             }
         }
@@ -182,18 +179,18 @@ fn write_patches(doc: &mut DocumentMut, scene: &Scene, loaded: &[BezierPatch]) {
 }
 
 /// Saves the scene to `path` (temporary name, then rename); an existing file is replaced only
-/// when `overwrite`.
+/// when `overwrite`. Returns the text written.
 pub fn save_scene(
     scene: &Scene,
     loaded: &[BezierPatch],
     path: &Path,
     overwrite: bool,
-) -> Result<(), SaveError> {
+) -> Result<String, SaveError> {
     let text = scene_toml(scene, loaded, path.parent())?;
     write_atomically(path, overwrite, |tmp| {
         std::fs::write(tmp, &text).map_err(|e| e.to_string())
     })?;
-    Ok(())
+    Ok(text)
 }
 
 #[cfg(test)]
@@ -226,5 +223,20 @@ mod tests {
         // Unedited, the teapot stays a reference to the built-in copy.
         let plain = scene_toml(&Scene::builtin(), &loaded, None).expect("saves");
         assert!(plain.contains("builtin = \"teapot\"") && !plain.contains("patches ="));
+    }
+
+    #[test]
+    fn saved_elsewhere_relative_files_still_resolve() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+        let scene = Scene::load(&dir.join("scroll.toml")).expect("scroll loads");
+        let loaded: Vec<BezierPatch> = scene.geometry.patches().iter().map(|(p, _)| *p).collect();
+        let elsewhere = tempfile::tempdir().expect("temp dir");
+        let text = scene_toml(&scene, &loaded, Some(elsewhere.path())).expect("saves");
+        let back = Scene::from_str(&text, &elsewhere.path().join("s.toml"), Some(elsewhere.path()))
+            .expect("its texture and patch files still resolve");
+        assert_eq!(back.geometry.patches(), scene.geometry.patches());
+        assert_eq!(back.textures.len(), 1);
+        let painting = dir.join("../assets/painting.png").canonicalize().expect("exists");
+        assert!(text.contains(&*painting.to_string_lossy()), "{text}");
     }
 }
