@@ -89,14 +89,14 @@ impl OverlayProjection {
     }
 
     /// Image pixels per point.
-    fn pixels_per_point(&self) -> f64 {
+    fn image_pixels_per_point(&self) -> f64 {
         self.camera.width as f64 / self.image.width() as f64
     }
 
     /// The image position (pixels) under screen point `s`.
     pub fn image_pixel(&self, s: Pos2) -> DVec2 {
         let local = s - self.image.min;
-        DVec2::new(local.x as f64, local.y as f64) * self.pixels_per_point()
+        DVec2::new(local.x as f64, local.y as f64) * self.image_pixels_per_point()
     }
 
     /// The world point under screen point `s` at `depth` along the view axis (the inverse of
@@ -114,7 +114,7 @@ impl OverlayProjection {
     /// World length of one screen point at `depth`.
     pub fn world_per_point(&self, depth: f64) -> f64 {
         let c = &self.camera;
-        2.0 * (0.5 * c.fov_y).tan() * depth / c.height as f64 * self.pixels_per_point()
+        2.0 * (0.5 * c.fov_y).tan() * depth / c.height as f64 * self.image_pixels_per_point()
     }
 
     /// The uniforms for the GPU; `ppp` is physical pixels per point.

@@ -530,7 +530,7 @@ impl SessionState {
             Next::Stop
         } else if !self.pending.is_empty() {
             Next::Restart
-        } else if self.paused || (self.renderer == RendererKind::Whitted && self.passes > 0) {
+        } else if self.waiting() {
             Next::Wait
         } else if self.renderer == RendererKind::Whitted {
             Next::Trace
@@ -543,7 +543,13 @@ impl SessionState {
 
     /// Whether to wait for a command before going on (also between photon batches).
     fn idle(&self) -> bool {
-        !self.must_abort() && (self.paused || (self.renderer == RendererKind::Whitted && self.passes > 0))
+        let limit_reached = self.options.max_passes.is_some_and(|n| self.passes >= n);
+        !self.must_abort() && !limit_reached && self.waiting()
+    }
+
+    /// Paused, or the ray-traced frame of this epoch is done.
+    fn waiting(&self) -> bool {
+        self.paused || (self.renderer == RendererKind::Whitted && self.passes > 0)
     }
 
     /// Opens a new epoch: the gathered commands are applied to `scene`.
@@ -771,5 +777,10 @@ mod tests {
         assert_eq!(s.next(Duration::ZERO), Next::Trace);
         s.passes = 1;
         assert_eq!(s.next(Duration::ZERO), Next::Wait);
+        assert!(s.idle());
+        // ...unless that frame was all it was asked for: then it ends instead of waiting.
+        s.options.max_passes = Some(1);
+        assert!(!s.idle());
+        assert_eq!(s.next(Duration::ZERO), Next::Stop);
     }
 }
