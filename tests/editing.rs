@@ -7,7 +7,7 @@
 
 use std::path::Path;
 
-use caustic::app::overlay::PointRef;
+use caustic::app::overlay::{control_points, PointRef};
 use caustic::app::settings::ViewerSettings;
 use caustic::app::viewer::Status;
 use caustic::app::Viewer;
@@ -81,11 +81,7 @@ fn sent(h: &App<'_>) -> Vec<Command> {
 /// A control point at least 3 pick radii from every other one on screen, and where it is.
 fn isolated_point(v: &Viewer) -> (PointRef, Pos2) {
     let proj = v.projection().expect("the image was placed");
-    let screen: Vec<(PointRef, Pos2)> = v
-        .patches()
-        .iter()
-        .enumerate()
-        .flat_map(|(patch, p)| (0..16).map(move |index| (PointRef { patch, index }, p.points[index])))
+    let screen: Vec<(PointRef, Pos2)> = control_points(v.patches())
         .filter_map(|(r, q)| Some((r, proj.to_screen(q)?)))
         .collect();
     screen
@@ -197,11 +193,7 @@ fn a_seam_point_moves_with_its_twins_so_the_patches_stay_joined() {
     let v = viewer(&h);
     let proj = v.projection().expect("placed").clone();
     let patches = v.patches().to_vec();
-    let all: Vec<(PointRef, DVec3)> = patches
-        .iter()
-        .enumerate()
-        .flat_map(|(patch, p)| (0..16).map(move |index| (PointRef { patch, index }, p.points[index])))
-        .collect();
+    let all: Vec<(PointRef, DVec3)> = control_points(&patches).collect();
     // A point shared by two patches, with no other point near it on screen.
     let (r, s) = all
         .iter()

@@ -10,7 +10,7 @@ use egui::{Pos2, Vec2};
 use glam::DVec3;
 
 use super::navigate;
-use super::overlay::{overlay_geometry, OverlayProjection, PointRef};
+use super::overlay::{control_points, overlay_geometry, OverlayProjection, PointRef};
 use crate::geometry::BezierPatch;
 use crate::gpu::wireframe::WireframeGeometry;
 use crate::scene::{Camera, Scene};
@@ -192,16 +192,8 @@ impl Editor {
         }
         let p = self.point(r);
         let tolerance = 1e-9 * self.patches[r.patch].bounds().diagonal().length();
-        let mut out = vec![r];
-        for (patch, q) in self.patches.iter().enumerate() {
-            for (index, point) in q.points.iter().enumerate() {
-                let other = PointRef { patch, index };
-                if other != r && (*point - p).length() <= tolerance {
-                    out.push(other);
-                }
-            }
-        }
-        out
+        let twins = control_points(&self.patches).filter(|(o, q)| *o != r && (*q - p).length() <= tolerance);
+        std::iter::once(r).chain(twins.map(|(o, _)| o)).collect()
     }
 
     /// Whether `r` names a control point of this scene.

@@ -132,19 +132,27 @@ impl OverlayProjection {
     /// The control point nearest `pointer` within [`PICK_RADIUS`], if any.
     pub fn pick(&self, patches: &[BezierPatch], pointer: Pos2) -> Option<PointRef> {
         let mut best: Option<(f32, PointRef)> = None;
-        for (patch, p) in patches.iter().enumerate() {
-            for (index, q) in p.points.iter().enumerate() {
-                let Some(s) = self.to_screen(*q) else {
-                    continue;
-                };
-                let d = s.distance(pointer);
-                if d <= PICK_RADIUS && best.is_none_or(|(b, _)| d < b) {
-                    best = Some((d, PointRef { patch, index }));
-                }
+        for (r, q) in control_points(patches) {
+            let Some(s) = self.to_screen(q) else {
+                continue;
+            };
+            let d = s.distance(pointer);
+            if d <= PICK_RADIUS && best.is_none_or(|(b, _)| d < b) {
+                best = Some((d, r));
             }
         }
         best.map(|(_, r)| r)
     }
+}
+
+/// Every control point of `patches` with its position, patch by patch.
+pub fn control_points(patches: &[BezierPatch]) -> impl Iterator<Item = (PointRef, DVec3)> + '_ {
+    patches.iter().enumerate().flat_map(|(patch, p)| {
+        p.points
+            .iter()
+            .enumerate()
+            .map(move |(index, q)| (PointRef { patch, index }, *q))
+    })
 }
 
 fn f32x3(p: DVec3) -> [f32; 3] {
