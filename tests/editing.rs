@@ -13,8 +13,8 @@ use caustic::app::viewer::Status;
 use caustic::app::Viewer;
 use caustic::geometry::BezierPatch;
 use caustic::render::ppm::{Control, Ppm, PpmOptions, PpmStats};
-use caustic::render::session::{Command, Frame};
-use caustic::scene::{RendererKind, Scene};
+use caustic::render::session::{Command, Frame, FrameStats};
+use caustic::scene::Scene;
 use egui::{Event, Modifiers, PointerButton, Pos2, Vec2};
 use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
@@ -27,7 +27,7 @@ type App<'a> = Harness<'a, Option<Viewer>>;
 fn teapot() -> Scene {
     let mut scene = Scene::builtin();
     (scene.camera.width, scene.camera.height) = SIZE;
-    scene.settings.photons_per_pass = 20_000;
+    scene.params.photons_per_pass = 20_000;
     scene
 }
 
@@ -36,11 +36,10 @@ fn flat_frame() -> Frame {
     let n = (SIZE.0 * SIZE.1) as usize;
     Frame {
         epoch: 0,
-        renderer: RendererKind::Ppm,
         pass: 1,
         photons: 1,
         elapsed_secs: 0.1,
-        stats: PpmStats::default(),
+        stats: FrameStats::PhotonMapping(PpmStats::default()),
         width: SIZE.0,
         height: SIZE.1,
         radiance: vec![[0.2f32; 3]; n].into(),
@@ -344,8 +343,11 @@ fn teapot_frame() -> Frame {
         ppm.run_pass(&scene, &mut |_| Control::Continue);
     }
     let mut frame = Frame::from_ppm(&ppm, 0, 1.0);
-    frame.stats.elapsed_secs = 1.0;
-    frame.stats.photon_secs = 0.5;
+    frame.stats = FrameStats::PhotonMapping(PpmStats {
+        elapsed_secs: 1.0,
+        photon_secs: 0.5,
+        ..ppm.stats().clone()
+    });
     frame
 }
 

@@ -115,13 +115,10 @@ fn photons_are_not_aimed_away_from_an_infinite_plane() {
 
 #[test]
 fn direct_light_option_is_exact_for_direct_illumination() {
-    let scene = Scene::from_str(PLANE, Path::new("plane.toml"), None).expect("scene");
+    let mut scene = Scene::from_str(PLANE, Path::new("plane.toml"), None).expect("scene");
     let expected = expected_plane(&scene);
-    let options = PpmOptions {
-        direct_light: true,
-        ..Default::default()
-    };
-    let mut ppm = Ppm::new(&scene, options);
+    scene.params.direct_light = true;
+    let mut ppm = Ppm::new(&scene, PpmOptions::default());
     ppm.run_pass(&scene, &mut |_| Control::Continue);
     // Only the plane: photons bounce off it once and leave, so all light is direct.
     let (mean_ratio, rms) = relative_errors(&ppm.radiance(), &expected);
@@ -201,10 +198,10 @@ fn cornell_small(aperture: f64) -> Scene {
     scene.camera.width = 40;
     scene.camera.height = 30;
     scene.camera.aperture = aperture;
-    scene.settings.photons_per_pass = 20_000;
-    scene.settings.antialias = false;
+    scene.params.photons_per_pass = 20_000;
+    scene.params.antialias = false;
     // The file asks for the ray tracer; the session follows the scene's renderer.
-    scene.settings.renderer = caustic::scene::RendererKind::Ppm;
+    scene.params.renderer = caustic::scene::RendererKind::Ppm;
     scene
 }
 
@@ -239,14 +236,9 @@ fn ppm_is_identical_for_one_and_two_threads() {
 fn kd_tree_and_hash_grid_find_the_same_points() {
     let scene = cornell_small(0.0);
     let grid = render_passes(&scene, PpmOptions::default(), 2);
-    let kd = render_passes(
-        &scene,
-        PpmOptions {
-            index: IndexKind::KdTree,
-            ..Default::default()
-        },
-        2,
-    );
+    let mut kd_scene = scene.clone();
+    kd_scene.params.index = IndexKind::KdTree;
+    let kd = render_passes(&kd_scene, PpmOptions::default(), 2);
     for (a, b) in grid.iter().zip(&kd) {
         for c in 0..3 {
             assert!(
@@ -264,6 +256,7 @@ fn next_frame(session: &RenderSession, timeout: Duration) -> Frame {
 #[test]
 fn session_epochs_follow_the_rules_and_never_block() {
     let scene = cornell_small(0.0);
+    let lens = cornell_small(0.1);
     let session = RenderSession::start(scene, PpmOptions::default(), None);
     let first = next_frame(&session, Duration::from_secs(60));
     assert_eq!(first.epoch, 0);
@@ -277,13 +270,16 @@ fn session_epochs_follow_the_rules_and_never_block() {
         later.pass
     );
     // α applies without a restart.
-    session.send(Command::SetAlpha(0.5));
+    let mut params = lens.params.clone();
+    params.alpha = 0.5;
+    session.send(Command::SetParams(params.clone()));
     let f = next_frame(&session, Duration::from_secs(60));
     assert_eq!(f.epoch, 0);
-    session.send(Command::SetPhotonsPerPass(5_000));
+    params.photons_per_pass = 5_000;
+    session.send(Command::SetParams(params));
     assert_eq!(next_frame(&session, Duration::from_secs(60)).epoch, 0);
     // The aperture restarts under a new epoch.
-    session.send(Command::SetAperture(0.1));
+    session.send(Command::SetCamera(lens.camera.clone()));
     let deadline = Instant::now() + Duration::from_secs(60);
     let f = loop {
         let f = next_frame(&session, Duration::from_secs(60));
@@ -313,16 +309,24 @@ fn session_epochs_follow_the_rules_and_never_block() {
 fn session_switches_to_the_ray_tracer_and_reports_a_panic() {
     let scene = cornell_small(0.0);
     let mut whitted_scene = scene.clone();
-    whitted_scene.settings.renderer = caustic::scene::RendererKind::Whitted;
-    let session = RenderSession::start(scene, PpmOptions::default(), None);
+    whitted_scene.params.renderer = caustic::scene::RendererKind::Whitted;
+    // A waker that panics once told to: a failure on the render thread.
+    let fail = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let fail_flag = fail.clone();
+    let waker = Box::new(move || {
+        if fail_flag.load(std::sync::atomic::Ordering::Relaxed) {
+            panic!("boom");
+        }
+    });
+    let session = RenderSession::start(scene, PpmOptions::default(), Some(waker));
     assert_eq!(
-        next_frame(&session, Duration::from_secs(60)).renderer,
+        next_frame(&session, Duration::from_secs(60)).stats.renderer(),
         caustic::scene::RendererKind::Ppm
     );
-    session.send(Command::SetRenderer(caustic::scene::RendererKind::Whitted));
+    session.send(Command::SetParams(whitted_scene.params.clone()));
     let f = loop {
         let f = next_frame(&session, Duration::from_secs(60));
-        if f.renderer == caustic::scene::RendererKind::Whitted {
+        if f.stats.renderer() == caustic::scene::RendererKind::Whitted {
             break f;
         }
     };
@@ -332,7 +336,8 @@ fn session_switches_to_the_ray_tracer_and_reports_a_panic() {
     // One ray-traced frame per epoch; then the thread waits for commands.
     assert!(session.frames().recv_timeout(Duration::from_millis(300)).is_err());
     assert_eq!(session.failure(), None);
-    session.send(Command::Fail("boom".into()));
+    fail.store(true, std::sync::atomic::Ordering::Relaxed);
+    session.send(Command::Restart);
     let start = Instant::now();
     while session.failure().is_none() && start.elapsed() < Duration::from_secs(30) {
         std::thread::sleep(Duration::from_millis(5));
@@ -386,11 +391,13 @@ fn a_new_epoch_starts_with_a_full_size_preview() {
     scene.camera.width = 160;
     scene.camera.height = 120;
     // Full passes much longer than the preview's 16,384 photons, so the preview is seen.
-    scene.settings.photons_per_pass = 4_000_000;
+    scene.params.photons_per_pass = 4_000_000;
     let options = SessionOptions {
         preview_divisor: Some(4),
         ..Default::default()
     };
+    let mut lens = scene.camera.clone();
+    lens.aperture = 0.1;
     let session = RenderSession::start_with(scene, options, None);
     let f = next_frame(&session, Duration::from_secs(60));
     assert!(f.preview, "first frame is not a preview (pass {})", f.pass);
@@ -400,7 +407,7 @@ fn a_new_epoch_starts_with_a_full_size_preview() {
     // 4×4 blocks repeat one low-resolution pixel.
     assert_eq!(f.radiance[0], f.radiance[3 + 3 * 160]);
     // A restart interrupts the long pass at once and previews the new epoch.
-    session.send(Command::SetAperture(0.1));
+    session.send(Command::SetCamera(lens));
     let f = next_frame(&session, Duration::from_secs(60));
     assert!(
         f.preview && f.epoch == 1,
@@ -474,14 +481,9 @@ material = "floor"
 "#;
     let scene = Scene::from_str(text, Path::new("caustic.toml"), None).expect("scene");
     let mean = |direct_light: bool| {
-        let image = render_passes(
-            &scene,
-            PpmOptions {
-                direct_light,
-                ..Default::default()
-            },
-            12,
-        );
+        let mut scene = scene.clone();
+        scene.params.direct_light = direct_light;
+        let image = render_passes(&scene, PpmOptions::default(), 12);
         image.iter().map(|p| p[0] as f64).sum::<f64>() / image.len() as f64
     };
     let (photons_only, with_direct) = (mean(false), mean(true));
@@ -501,7 +503,7 @@ fn automatic_radius_ignores_a_floor_reaching_the_horizon() {
     let mut scene = Scene::load(&path).expect("showcase");
     scene.camera.width = 64;
     scene.camera.height = 48;
-    scene.settings.photons_per_pass = 20_000;
+    scene.params.photons_per_pass = 20_000;
     let mut ppm = Ppm::new(&scene, PpmOptions::default());
     ppm.run_pass(&scene, &mut |_| Control::Continue);
     let r = ppm.stats().mean_radius;
@@ -516,8 +518,8 @@ fn huge_radii_stay_deterministic_and_bounded() {
     let mut scene = cornell_small(0.0);
     scene.camera.width = 32;
     scene.camera.height = 24;
-    scene.settings.initial_radius = Some(50.0);
-    scene.settings.photons_per_pass = 8192;
+    scene.params.initial_radius = Some(50.0);
+    scene.params.photons_per_pass = 8192;
     let one = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
         .build()
@@ -536,8 +538,8 @@ fn huge_radii_stay_deterministic_and_bounded() {
 fn control_point_moves_render_like_the_edited_scene_built_from_scratch() {
     let mut scene = Scene::builtin();
     (scene.camera.width, scene.camera.height) = (64, 48);
-    scene.settings.photons_per_pass = 20_000;
-    scene.settings.renderer = caustic::scene::RendererKind::Ppm;
+    scene.params.photons_per_pass = 20_000;
+    scene.params.renderer = caustic::scene::RendererKind::Ppm;
     let session = RenderSession::start_with(
         scene.clone(),
         SessionOptions {

@@ -46,7 +46,7 @@ fn every_shipped_scene_loads_and_renders() {
         .collect();
     scenes.push(("<built-in>".into(), Scene::builtin()));
     for (name, mut scene) in scenes {
-        scene.settings.dof_samples = scene.settings.dof_samples.min(4);
+        scene.params.dof_samples = scene.params.dof_samples.min(4);
         let image = render_small(scene, 48, 36);
         assert!(
             image.pixels.iter().flatten().all(|c| c.is_finite() && *c >= 0.0),
@@ -446,7 +446,7 @@ fn renders_are_identical_for_one_and_two_threads() {
     let b = two.install(|| render_whitted(&scene, &|_| {}).0);
     assert_eq!(a.pixels, b.pixels);
     scene.camera.aperture = 0.2;
-    scene.settings.dof_samples = 4;
+    scene.params.dof_samples = 4;
     let a = one.install(|| render_whitted(&scene, &|_| {}).0);
     let b = two.install(|| render_whitted(&scene, &|_| {}).0);
     assert_eq!(a.pixels, b.pixels);

@@ -11,8 +11,9 @@ use std::time::{Duration, Instant};
 use caustic::app::settings::ViewerSettings;
 use caustic::app::viewer::Status;
 use caustic::app::Viewer;
-use caustic::render::ppm::{Control, Ppm, PpmOptions};
-use caustic::render::session::{Command, Frame};
+use caustic::render::params::RenderParams;
+use caustic::render::ppm::{Control, Ppm, PpmOptions, PpmStats};
+use caustic::render::session::{Command, Frame, FrameStats, RenderSession, SessionOptions};
 use caustic::scene::{RendererKind, Scene};
 use egui::accesskit::Role;
 use egui_kittest::kittest::Queryable;
@@ -133,26 +134,46 @@ fn set_slider(h: &mut App<'_>, label: &str, value: f64) {
 #[test]
 fn each_slider_sends_its_command() {
     let mut h = harness(ball(), true);
-    let cases: Vec<(&str, f64, Command)> = vec![
-        ("Alpha", 0.5, Command::SetAlpha(0.5)),
-        ("Photons per pass", 50_000.0, Command::SetPhotonsPerPass(50_000)),
-        ("Aperture", 0.05, Command::SetAperture(0.05)),
-        ("Focal distance", 3.0, Command::SetFocalDistance(3.0)),
-        ("Max depth", 3.0, Command::SetMaxDepth(3)),
+    // Render settings go as one parameter set; the lens goes on the camera.
+    type Change = fn(&mut RenderParams);
+    let cases: Vec<(&str, f64, Change)> = vec![
+        ("Alpha", 0.5, |p| p.alpha = 0.5),
+        ("Photons per pass", 50_000.0, |p| p.photons_per_pass = 50_000),
+        ("Max depth", 3.0, |p| p.max_depth = 3),
     ];
-    for (label, value, expected) in cases {
+    for (label, value, change) in cases {
+        let mut expected = viewer(&h).params.render.clone();
+        change(&mut expected);
         set_slider(&mut h, label, value);
-        assert_eq!(sent(&h).last(), Some(&expected), "slider {label}");
+        assert_eq!(
+            sent(&h).last(),
+            Some(&Command::SetParams(expected)),
+            "slider {label}"
+        );
     }
+    set_slider(&mut h, "Aperture", 0.05);
+    assert!(
+        matches!(sent(&h).last(), Some(Command::SetCamera(c)) if c.aperture == 0.05),
+        "slider Aperture"
+    );
+    set_slider(&mut h, "Focal distance", 3.0);
+    assert!(
+        matches!(sent(&h).last(), Some(Command::SetCamera(c)) if c.focal_distance == 3.0 && c.aperture == 0.05),
+        "slider Focal distance"
+    );
+    let initial_radius = |h: &App<'_>| match sent(h).last() {
+        Some(Command::SetParams(p)) => p.initial_radius,
+        other => panic!("expected parameters, got {other:?}"),
+    };
     // The initial radius slider is enabled by unticking "automatic".
     h.get_by_role_and_label(Role::CheckBox, "Automatic initial radius")
         .click();
     h.step();
     h.step();
-    let radius = viewer(&h).params.initial_radius;
-    assert_eq!(sent(&h).last(), Some(&Command::SetInitialRadius(Some(radius))));
+    let radius = viewer(&h).params.manual_radius;
+    assert_eq!(initial_radius(&h), Some(radius));
     set_slider(&mut h, "Initial radius", 0.01);
-    assert_eq!(sent(&h).last(), Some(&Command::SetInitialRadius(Some(0.01))));
+    assert_eq!(initial_radius(&h), Some(0.01));
     // Exposure is the viewer's own: no command.
     let before = sent(&h).len();
     set_slider(&mut h, "Exposure", 1.5);
@@ -161,9 +182,9 @@ fn each_slider_sends_its_command() {
     // The renderer buttons, pause and restart.
     h.get_by_label("Ray tracer").click();
     h.step();
-    assert_eq!(
-        sent(&h).last(),
-        Some(&Command::SetRenderer(RendererKind::Whitted))
+    assert!(
+        matches!(sent(&h).last(), Some(Command::SetParams(p)) if p.renderer == RendererKind::Whitted),
+        "renderer button"
     );
     h.get_by_label("Resume").click();
     h.step();
@@ -308,7 +329,19 @@ fn bad_scene_shows_its_error_and_the_old_scene_keeps_rendering() {
 fn a_render_thread_panic_is_shown_and_the_renderer_can_restart() {
     let mut h = harness(ball(), false);
     step_until(&mut h, "the first frame", |v| v.frame().is_some());
-    viewer_mut(&mut h).send(Command::Fail("injected failure".into()));
+    // A session whose waker panics on the render thread after its second frame: a failure
+    // the way a real one arrives.
+    let calls = std::sync::atomic::AtomicU32::new(0);
+    let failing = RenderSession::start_with(
+        viewer(&h).edited_scene(),
+        SessionOptions::default(),
+        Some(Box::new(move || {
+            if calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed) == 1 {
+                panic!("injected failure");
+            }
+        })),
+    );
+    viewer_mut(&mut h).attach_session(failing);
     step_until(&mut h, "the failure", |v| v.render_failure().is_some());
     h.step();
     assert!(
@@ -329,8 +362,11 @@ fn fixed_frames() -> Vec<Frame> {
     for pass in 1..=4u32 {
         ppm.run_pass(&scene, &mut |_| Control::Continue);
         let mut frame = Frame::from_ppm(&ppm, 0, pass as f64 * 0.25);
-        frame.stats.elapsed_secs = pass as f64 * 0.25;
-        frame.stats.photon_secs = pass as f64 * 0.2;
+        frame.stats = FrameStats::PhotonMapping(PpmStats {
+            elapsed_secs: pass as f64 * 0.25,
+            photon_secs: pass as f64 * 0.2,
+            ..ppm.stats().clone()
+        });
         frames.push(frame);
     }
     frames
@@ -379,14 +415,11 @@ impl eframe::Storage for MemoryStorage {
 #[test]
 fn settings_survive_storage_and_bad_stored_values_are_repaired() {
     use caustic::app::settings::{DisplayMode, Zoom, STORAGE_KEY};
-    use caustic::render::ppm::IndexKind;
     let settings = ViewerSettings {
         exposure_stops: 1.5,
         zoom: Zoom::Scale(2.0),
         display: DisplayMode::Radius,
         show_side_panel: false,
-        direct_light: true,
-        index: IndexKind::KdTree,
         last_directory: Some(PathBuf::from("/some/where")),
         show_wireframe: false,
     };

@@ -10,10 +10,9 @@ use glam::DVec3;
 
 use super::editor::{CameraMove, Edit, Gesture};
 use super::overlay::PointRef;
-use super::params::RenderParams;
+use super::params::PanelParams;
 use super::settings::{DisplayMode, Zoom, EXPOSURE_LIMIT};
 use super::viewer::{Status, Viewer};
-use crate::render::ppm::IndexKind;
 use crate::render::session::Command;
 use crate::scene::Camera;
 
@@ -53,17 +52,13 @@ pub enum Action {
     /// Close the window (asks first when there are unsaved edits).
     Close,
     /// New parameter values (the differences become session commands).
-    SetParams(RenderParams),
+    SetParams(PanelParams),
     /// Discard the accumulation and render again.
     Restart,
     /// Start a fresh render session (after a failure).
     RestartRenderer,
     /// Close the "could not open scene" window.
     DismissSceneError,
-    /// Direct light by shadow rays on or off (restarts the session).
-    SetDirectLight(bool),
-    /// The spatial index (restarts the session).
-    SetIndex(IndexKind),
     /// Exposure in stops.
     SetExposure(f32),
     /// Image placement; `recentre` also clears the pan.
@@ -144,14 +139,6 @@ impl Viewer {
             Action::Restart => self.send(Command::Restart),
             Action::RestartRenderer => self.restart_renderer(),
             Action::DismissSceneError => self.scene_error = None,
-            Action::SetDirectLight(on) => {
-                self.settings.direct_light = on;
-                self.restart_renderer();
-            }
-            Action::SetIndex(index) => {
-                self.settings.index = index;
-                self.restart_renderer();
-            }
             Action::SetExposure(stops) => {
                 self.settings.exposure_stops = stops.clamp(-EXPOSURE_LIMIT, EXPOSURE_LIMIT);
                 self.image_view.invalidate();
@@ -363,11 +350,7 @@ impl Viewer {
     /// Places the camera (pose from `camera`, lens from the panel's parameters) and the
     /// orbit pivot, and tells the render session.
     fn set_camera(&mut self, camera: Camera, pivot: DVec3) {
-        let camera = Camera {
-            aperture: self.params.aperture,
-            focal_distance: self.params.focal_distance,
-            ..camera
-        };
+        let camera = self.params.lens_on(&camera);
         if !(camera.position.is_finite() && camera.forward.is_finite() && pivot.is_finite()) {
             self.status = Some(Status::Error(
                 "camera move ignored: it left the scene's numbers".into(),

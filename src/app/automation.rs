@@ -305,7 +305,7 @@ impl Automation {
         let passes = viewer.frame().map_or(0, |f| f.pass);
         let whitted = viewer
             .frame()
-            .is_some_and(|f| f.renderer == crate::scene::RendererKind::Whitted);
+            .is_some_and(|f| f.stats.renderer() == crate::scene::RendererKind::Whitted);
         if !*requested && (passes >= self.options.screenshot_after_passes || whitted) {
             *requested = true;
             let result = self.screenshot_result.clone();

@@ -189,14 +189,14 @@ pub fn status_ui(viewer: &Viewer, ui: &mut egui::Ui) {
 pub fn side_panel_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) {
     let mut p = viewer.params.clone();
     let ranges = viewer.ranges;
-    let photon_mapping = p.renderer == RendererKind::Ppm;
+    let photon_mapping = p.render.renderer == RendererKind::Ppm;
 
     ui.heading("Render");
     ui.horizontal(|ui| {
         ui.label("Renderer");
-        ui.selectable_value(&mut p.renderer, RendererKind::Ppm, "Photon mapping")
+        ui.selectable_value(&mut p.render.renderer, RendererKind::Ppm, "Photon mapping")
             .on_hover_text("Progressive photon mapping: converges to caustics and indirect light");
-        ui.selectable_value(&mut p.renderer, RendererKind::Whitted, "Ray tracer")
+        ui.selectable_value(&mut p.render.renderer, RendererKind::Whitted, "Ray tracer")
             .on_hover_text("Whitted ray tracer: one fast frame, direct light, mirrors and glass only");
     });
     ui.horizontal(|ui| {
@@ -240,42 +240,43 @@ pub fn side_panel_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) 
     ui.separator();
     ui.heading("Photon mapping");
     ui.add_enabled_ui(photon_mapping, |ui| {
-        ui.add(egui::Slider::new(&mut p.alpha, ALPHA_RANGE.0..=ALPHA_RANGE.1).text("Alpha"))
+        ui.add(egui::Slider::new(&mut p.render.alpha, ALPHA_RANGE.0..=ALPHA_RANGE.1).text("Alpha"))
             .on_hover_text("Fraction of new photons kept per pass (Hachisuka 2008); radius shrinks faster when smaller. 0.7 is the paper's choice. Applies from the next pass, without restarting.");
         ui.add(
-            egui::Slider::new(&mut p.photons_per_pass, PHOTONS_RANGE.0..=PHOTONS_RANGE.1)
+            egui::Slider::new(&mut p.render.photons_per_pass, PHOTONS_RANGE.0..=PHOTONS_RANGE.1)
                 .logarithmic(true)
                 .text("Photons per pass"),
         )
         .on_hover_text("Photons traced per pass. Applies from the next pass, without restarting.");
-        ui.checkbox(&mut p.auto_radius, "Automatic initial radius")
-            .on_hover_text("Start from twice a pixel's footprint at the median visible distance. Changing it restarts.");
-        ui.add_enabled(
-            !p.auto_radius,
-            egui::Slider::new(&mut p.initial_radius, ranges.radius.0..=ranges.radius.1)
-                .logarithmic(true)
-                .text("Initial radius"),
-        )
-        .on_hover_text("Starting search radius in scene units. Changing it restarts.");
-        let mut direct = viewer.settings.direct_light;
+        let mut auto = p.auto_radius();
         if ui
-            .checkbox(&mut direct, "Direct light by shadow rays")
-            .on_hover_text("Point and spot lights lit exactly with shadow rays; their photons count only after the first bounce (caustics kept). Restarts.")
+            .checkbox(&mut auto, "Automatic initial radius")
+            .on_hover_text("Start from twice a pixel's footprint at the median visible distance. Changing it restarts.")
             .changed()
         {
-            out.push(Action::SetDirectLight(direct));
+            p.set_auto_radius(auto);
         }
-        let mut index = viewer.settings.index;
+        if ui
+            .add_enabled(
+                !auto,
+                egui::Slider::new(&mut p.manual_radius, ranges.radius.0..=ranges.radius.1)
+                    .logarithmic(true)
+                    .text("Initial radius"),
+            )
+            .on_hover_text("Starting search radius in scene units. Changing it restarts.")
+            .changed()
+        {
+            p.set_auto_radius(false);
+        }
+        ui.checkbox(&mut p.render.direct_light, "Direct light by shadow rays")
+            .on_hover_text("Point and spot lights lit exactly with shadow rays; their photons count only after the first bounce (caustics kept). Restarts.");
         ui.horizontal(|ui| {
             ui.label("Index").on_hover_text("Spatial index over visible points; the image is the same, the speed differs");
-            ui.selectable_value(&mut index, IndexKind::HashGrid, "Hash grid")
+            ui.selectable_value(&mut p.render.index, IndexKind::HashGrid, "Hash grid")
                 .on_hover_text("Hashed uniform grid (fastest here)");
-            ui.selectable_value(&mut index, IndexKind::KdTree, "kd-tree")
+            ui.selectable_value(&mut p.render.index, IndexKind::KdTree, "kd-tree")
                 .on_hover_text("The seed report's kd-tree");
         });
-        if index != viewer.settings.index {
-            out.push(Action::SetIndex(index));
-        }
     });
 
     ui.separator();
@@ -294,7 +295,7 @@ pub fn side_panel_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) 
             .text("Focal distance"),
     )
     .on_hover_text("Distance from the lens to the plane in focus. Restarts.");
-    ui.add(egui::Slider::new(&mut p.max_depth, DEPTH_RANGE.0..=DEPTH_RANGE.1).text("Max depth"))
+    ui.add(egui::Slider::new(&mut p.render.max_depth, DEPTH_RANGE.0..=DEPTH_RANGE.1).text("Max depth"))
         .on_hover_text("Most mirror/glass bounces followed by eye rays and photons. Restarts.");
 
     if p != viewer.params {
@@ -312,7 +313,7 @@ pub fn side_panel_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) 
 fn statistics_ui(viewer: &Viewer, ui: &mut egui::Ui) {
     ui.heading("Statistics");
     if viewer.restart_pending() {
-        let what = match viewer.params.renderer {
+        let what = match viewer.params.render.renderer {
             RendererKind::Ppm => "Restarting: first pass of the new settings...",
             RendererKind::Whitted => "Ray tracing the frame...",
         };
@@ -346,9 +347,9 @@ fn statistics_ui(viewer: &Viewer, ui: &mut egui::Ui) {
                 pass,
                 "Completed passes in this epoch; a new epoch first shows a quick low-resolution preview",
             );
-            if frame.renderer == RendererKind::Ppm {
+            if let Some(stats) = frame.stats.photon_mapping() {
                 row("Photons", count(frame.photons), "Photons emitted in this epoch");
-                let rate = frame.photons as f64 / frame.stats.elapsed_secs.max(1e-9);
+                let rate = frame.photons as f64 / stats.elapsed_secs.max(1e-9);
                 row(
                     "Photons/s",
                     count(rate as u64),
@@ -356,12 +357,12 @@ fn statistics_ui(viewer: &Viewer, ui: &mut egui::Ui) {
                 );
                 row(
                     "Mean radius",
-                    format!("{:.4e}", frame.stats.mean_radius),
+                    format!("{:.4e}", stats.mean_radius),
                     "Mean search radius of points that have gathered photons (scene units)",
                 );
                 row(
                     "Visible points",
-                    count(frame.stats.visible_points as u64),
+                    count(stats.visible_points as u64),
                     "Gathering points of the last eye pass",
                 );
             }
@@ -378,14 +379,15 @@ fn statistics_ui(viewer: &Viewer, ui: &mut egui::Ui) {
                 );
             }
         });
-    if !frame.stats.skipped.is_empty() {
+    let skipped = frame.stats.photon_mapping().map_or(&[][..], |s| &s.skipped[..]);
+    if !skipped.is_empty() {
         ui.label("Skipped work:")
             .on_hover_text("Work this scene does not need, left out");
-        for s in &frame.stats.skipped {
+        for s in skipped {
             ui.label(RichText::new(format!("- {s}")).small());
         }
     }
-    if frame.renderer == RendererKind::Ppm {
+    if frame.stats.renderer() == RendererKind::Ppm {
         ui.label("Estimated error")
             .on_hover_text("Relative RMS noise estimated from successive frames (log scale) against seconds; falls as the image converges");
         let points: Vec<[f64; 2]> = viewer

@@ -1,28 +1,21 @@
-//! The render parameters the side panel edits, their ranges, and the command each change
-//! sends to the render session.
+//! What the side panel edits — the render parameters, the lens, pause — their slider
+//! ranges, and the commands a change sends to the render session.
 
+use crate::render::params::RenderParams;
 use crate::render::session::Command;
-use crate::scene::{RendererKind, Scene};
+use crate::scene::{Camera, Scene};
 
 /// Values shown by the side panel (start from the scene file).
 #[derive(Clone, Debug, PartialEq)]
-pub struct RenderParams {
-    /// PPM radius reduction α.
-    pub alpha: f64,
-    /// Photons per pass.
-    pub photons_per_pass: u64,
-    /// Initial radius from the pixel footprint.
-    pub auto_radius: bool,
-    /// Initial radius when not automatic (scene units).
-    pub initial_radius: f64,
+pub struct PanelParams {
+    /// The render parameters the session receives whole ([`Command::SetParams`]).
+    pub render: RenderParams,
+    /// The initial radius the slider shows (used when the automatic radius is off).
+    pub manual_radius: f64,
     /// Lens radius (0 = pinhole).
     pub aperture: f64,
     /// Distance to the plane in focus.
     pub focal_distance: f64,
-    /// Maximum specular depth.
-    pub max_depth: u32,
-    /// Photon mapping or ray tracing.
-    pub renderer: RendererKind,
     /// Rendering paused.
     pub paused: bool,
 }
@@ -48,64 +41,55 @@ pub const DEPTH_RANGE: (u32, u32) = (
     *crate::render::limits::MAX_DEPTH.end(),
 );
 
-impl RenderParams {
+impl PanelParams {
     /// The scene file's values.
     pub fn from_scene(scene: &Scene) -> Self {
-        let s = &scene.settings;
         Self {
-            alpha: s.alpha,
-            photons_per_pass: s.photons_per_pass,
-            auto_radius: s.initial_radius.is_none(),
-            initial_radius: s
+            render: scene.params.clone(),
+            manual_radius: scene
+                .params
                 .initial_radius
                 .unwrap_or(Ranges::for_scene(scene).default_radius()),
             aperture: scene.camera.aperture,
             focal_distance: scene.camera.focal_distance,
-            max_depth: s.max_depth,
-            renderer: s.renderer,
             paused: false,
         }
     }
 
-    /// The initial radius as the session takes it.
-    pub fn initial_radius(&self) -> Option<f64> {
-        (!self.auto_radius).then_some(self.initial_radius)
+    /// Whether the initial radius comes from the pixel footprint.
+    pub fn auto_radius(&self) -> bool {
+        self.render.initial_radius.is_none()
+    }
+
+    /// Switches the automatic initial radius on or off (off: the slider's value).
+    pub fn set_auto_radius(&mut self, auto: bool) {
+        self.render.initial_radius = (!auto).then_some(self.manual_radius);
+    }
+
+    /// `camera` with this lens.
+    pub fn lens_on(&self, camera: &Camera) -> Camera {
+        Camera {
+            aperture: self.aperture,
+            focal_distance: self.focal_distance,
+            ..camera.clone()
+        }
     }
 
     /// Writes these values into a scene (for restarting the renderer with them).
     pub fn apply_to(&self, scene: &mut Scene) {
-        scene.settings.alpha = self.alpha;
-        scene.settings.photons_per_pass = self.photons_per_pass;
-        scene.settings.initial_radius = self.initial_radius();
-        scene.settings.max_depth = self.max_depth;
-        scene.settings.renderer = self.renderer;
-        scene.camera.aperture = self.aperture;
-        scene.camera.focal_distance = self.focal_distance;
+        scene.params = self.render.clone();
+        scene.camera = self.lens_on(&scene.camera);
     }
 
-    /// The commands that take the session from `old` to `self`, in a fixed order.
-    pub fn commands_from(&self, old: &RenderParams) -> Vec<Command> {
+    /// The commands that take the session from `old` to `self` (`camera` is the pose the
+    /// lens goes on), in a fixed order.
+    pub fn commands_from(&self, old: &PanelParams, camera: &Camera) -> Vec<Command> {
         let mut out = Vec::new();
-        if self.alpha != old.alpha {
-            out.push(Command::SetAlpha(self.alpha));
+        if self.render != old.render {
+            out.push(Command::SetParams(self.render.clone()));
         }
-        if self.photons_per_pass != old.photons_per_pass {
-            out.push(Command::SetPhotonsPerPass(self.photons_per_pass));
-        }
-        if self.initial_radius() != old.initial_radius() {
-            out.push(Command::SetInitialRadius(self.initial_radius()));
-        }
-        if self.aperture != old.aperture {
-            out.push(Command::SetAperture(self.aperture));
-        }
-        if self.focal_distance != old.focal_distance {
-            out.push(Command::SetFocalDistance(self.focal_distance));
-        }
-        if self.max_depth != old.max_depth {
-            out.push(Command::SetMaxDepth(self.max_depth));
-        }
-        if self.renderer != old.renderer {
-            out.push(Command::SetRenderer(self.renderer));
+        if (self.aperture, self.focal_distance) != (old.aperture, old.focal_distance) {
+            out.push(Command::SetCamera(self.lens_on(camera)));
         }
         if self.paused != old.paused {
             out.push(if self.paused {

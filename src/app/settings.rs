@@ -1,11 +1,10 @@
 //! What the viewer remembers between runs (eframe storage): view preferences, not the scene's
-//! own parameters, which start from the scene file each time it is opened.
+//! own render parameters (index and direct light included), which start from the scene file
+//! each time it is opened.
 
 use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
-
-use crate::render::ppm::IndexKind;
 
 /// Largest exposure, in stops either way, the viewer keeps.
 pub const EXPOSURE_LIMIT: f32 = 20.0;
@@ -63,10 +62,6 @@ pub struct ViewerSettings {
     pub display: DisplayMode,
     /// Side panel shown.
     pub show_side_panel: bool,
-    /// Direct light from point/spot lights by shadow rays.
-    pub direct_light: bool,
-    /// Spatial index over visible points.
-    pub index: IndexKind,
     /// Folder the last scene was opened from or frame saved to (file dialogs start there).
     pub last_directory: Option<PathBuf>,
     /// The control-net overlay is drawn (and can be edited).
@@ -80,8 +75,6 @@ impl Default for ViewerSettings {
             zoom: Zoom::Fit,
             display: DisplayMode::Radiance,
             show_side_panel: true,
-            direct_light: false,
-            index: IndexKind::HashGrid,
             last_directory: None,
             show_wireframe: true,
         }

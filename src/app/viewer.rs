@@ -14,7 +14,7 @@ use super::image_view::{frame_image, ImageView, Probe};
 use super::job::{Job, Poll};
 use super::keys;
 use super::overlay::OverlayProjection;
-use super::params::{Ranges, RenderParams};
+use super::params::{PanelParams, Ranges};
 use super::save::{default_file_name, SaveEvent, SaveFlow, Snapshot};
 use super::settings::{ViewerSettings, Zoom};
 use super::view_input;
@@ -54,7 +54,7 @@ pub struct Viewer {
     /// Slider ranges for the scene.
     pub(super) ranges: Ranges,
     /// Current parameter values.
-    pub params: RenderParams,
+    pub params: PanelParams,
     session: RenderSession,
     /// Newest frame of the newest epoch seen.
     pub(super) frame: Option<Frame>,
@@ -96,11 +96,9 @@ pub struct Viewer {
     pub(super) allow_close: bool,
 }
 
-fn session_options(settings: &ViewerSettings, start_paused: bool) -> SessionOptions {
+fn session_options(start_paused: bool) -> SessionOptions {
     SessionOptions {
         ppm: PpmOptions {
-            index: settings.index,
-            direct_light: settings.direct_light,
             batch_photons: VIEWER_BATCH_PHOTONS,
             ..Default::default()
         },
@@ -114,20 +112,15 @@ fn session_options(settings: &ViewerSettings, start_paused: bool) -> SessionOpti
 /// The viewer always opens a scene with photon mapping (the image converges from the first
 /// second); the ray tracer a scene file may ask for is one click away.
 fn photon_mapped(mut scene: Scene) -> Scene {
-    scene.settings.renderer = RendererKind::Ppm;
+    scene.params.renderer = RendererKind::Ppm;
     scene
 }
 
-fn start_session(
-    ctx: &egui::Context,
-    scene: Scene,
-    settings: &ViewerSettings,
-    paused: bool,
-) -> RenderSession {
+fn start_session(ctx: &egui::Context, scene: Scene, paused: bool) -> RenderSession {
     let waker_ctx = ctx.clone();
     RenderSession::start_with(
         scene,
-        session_options(settings, paused),
+        session_options(paused),
         Some(Box::new(move || waker_ctx.request_repaint())),
     )
 }
@@ -142,10 +135,10 @@ impl Viewer {
     pub fn with_pause(ctx: &egui::Context, scene: Scene, settings: ViewerSettings, paused: bool) -> Self {
         let scene = photon_mapped(scene);
         let settings = settings.sanitized();
-        let mut params = RenderParams::from_scene(&scene);
+        let mut params = PanelParams::from_scene(&scene);
         params.paused = paused;
         let ranges = Ranges::for_scene(&scene);
-        let session = start_session(ctx, scene.clone(), &settings, paused);
+        let session = start_session(ctx, scene.clone(), paused);
         let editor = Editor::new(&scene);
         Self {
             ctx: ctx.clone(),
@@ -244,7 +237,7 @@ impl Viewer {
 
     /// Sends a command to the render session, remembering it (and when a restart was asked).
     pub fn send(&mut self, command: Command) {
-        if command.restarts() {
+        if command.restarts(&self.params.render) {
             let epoch = self.frame.as_ref().map_or(0, |f| f.epoch);
             self.pending_restart = Some((Instant::now(), epoch));
         }
@@ -256,23 +249,33 @@ impl Viewer {
     }
 
     /// Sets parameters, sending the commands their changes need.
-    pub fn set_params(&mut self, params: RenderParams) {
-        for command in params.commands_from(&self.params) {
+    pub fn set_params(&mut self, params: PanelParams) {
+        for command in params.commands_from(&self.params, &self.scene.camera) {
             self.send(command);
         }
+        self.scene.camera = params.lens_on(&self.scene.camera);
         self.params = params;
     }
 
     /// Starts a new render session for the current scene and parameters (after a renderer
-    /// failure, or when index/direct-light options change).
+    /// failure, or on another scene).
     pub fn restart_renderer(&mut self) {
         let scene = self.edited_scene();
-        self.session = start_session(&self.ctx, scene, &self.settings, self.params.paused);
+        self.session = start_session(&self.ctx, scene, self.params.paused);
         self.render_failure = None;
         self.frame = None;
         self.convergence.reset();
         self.image_view.invalidate();
         self.pending_restart = Some((Instant::now(), 0));
+    }
+
+    /// Renders with `session` from now on: one started elsewhere, with options or a waker of
+    /// its own (a test's, for example). The old session's frames are dropped.
+    pub fn attach_session(&mut self, session: RenderSession) {
+        self.session = session;
+        self.frame = None;
+        self.convergence.reset();
+        self.image_view.invalidate();
     }
 
     /// The scene as edited: the panel's parameters, the camera and the control points.
@@ -317,7 +320,7 @@ impl Viewer {
     /// Replaces the scene (a successful open).
     fn replace_scene(&mut self, scene: Scene) {
         let scene = photon_mapped(scene);
-        self.params = RenderParams::from_scene(&scene);
+        self.params = PanelParams::from_scene(&scene);
         self.ranges = Ranges::for_scene(&scene);
         self.editor = Editor::new(&scene);
         self.projection = None;
@@ -357,7 +360,7 @@ impl Viewer {
     /// The current frame as something to save, with its metadata.
     fn snapshot(&self) -> Option<Snapshot> {
         let frame = self.frame.as_ref()?;
-        let renderer = match frame.renderer {
+        let renderer = match frame.stats.renderer() {
             RendererKind::Ppm => "ppm",
             RendererKind::Whitted => "whitted",
         };
@@ -366,7 +369,7 @@ impl Viewer {
         let mut metadata = image_metadata(&self.scene, renderer);
         metadata.push(("caustic:passes".into(), frame.pass.to_string()));
         metadata.push(("caustic:photons".into(), frame.photons.to_string()));
-        metadata.push(("caustic:alpha".into(), self.params.alpha.to_string()));
+        metadata.push(("caustic:alpha".into(), self.params.render.alpha.to_string()));
         metadata.push(("caustic:aperture".into(), self.params.aperture.to_string()));
         metadata.push((
             "caustic:focal_distance".into(),
@@ -507,7 +510,7 @@ impl Viewer {
                 self.pending_restart = None;
             }
         }
-        if frame.renderer == RendererKind::Ppm && !frame.preview {
+        if frame.stats.renderer() == RendererKind::Ppm && !frame.preview {
             self.convergence
                 .add(frame.photons, frame.elapsed_secs, &frame.radiance);
         }

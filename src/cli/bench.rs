@@ -6,11 +6,11 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use clap::{Subcommand, ValueEnum};
 
-use super::{load_scene, photon_map};
+use super::{load_scene, photon_map, ppm_stats};
 use caustic::assets::SMALLPPM_SCENE;
 use caustic::bench::{teapot_geometry, teapot_view, time_intersect};
 use caustic::geometry::{PatchMethod, SubdivisionParams};
-use caustic::render::ppm::{IndexKind, PpmOptions};
+use caustic::render::ppm::IndexKind;
 use caustic::render::render_whitted;
 use caustic::render::session::SessionOptions;
 use caustic::scene::{RendererKind, Scene};
@@ -157,7 +157,7 @@ fn bench_ppm(scene_path: Option<&Path>, photons: u64, passes: u32, threads: &[us
         bail!("--photons and --passes must be at least 1");
     }
     let mut scene = photon_scene(scene_path)?;
-    scene.settings.photons_per_pass = photons;
+    scene.params.photons_per_pass = photons;
     let (w, h) = (scene.camera.width, scene.camera.height);
     println!(
         "Photon mapping on {}, {w}x{h}, {passes} passes of {photons} photons",
@@ -167,7 +167,7 @@ fn bench_ppm(scene_path: Option<&Path>, photons: u64, passes: u32, threads: &[us
         "{:>8} {:>12} {:>16} {:>22} {:>10}",
         "threads", "photon s", "photon paths/s", "paths per core-second", "scaling"
     );
-    scene.settings.renderer = RendererKind::Ppm;
+    scene.params.renderer = RendererKind::Ppm;
     let mut base = None;
     for &n in threads {
         if n == 0 {
@@ -178,7 +178,8 @@ fn bench_ppm(scene_path: Option<&Path>, photons: u64, passes: u32, threads: &[us
             threads: Some(n),
             ..Default::default()
         };
-        let stats = photon_map(scene.clone(), session, |_| {})?.stats;
+        let frame = photon_map(scene.clone(), session, |_| {})?;
+        let stats = ppm_stats(&frame)?;
         let rate = stats.photons as f64 / stats.photon_secs;
         let scaling = base.map_or(1.0, |b: f64| rate / b);
         base.get_or_insert(rate);
@@ -220,16 +221,16 @@ fn bench_convergence(
     let aspect = scene.camera.height as f64 / scene.camera.width as f64;
     scene.camera.width = width;
     scene.camera.height = ((width as f64 * aspect).round() as u32).max(1);
-    scene.settings.photons_per_pass = photons;
+    scene.params.photons_per_pass = photons;
     println!(
         "Convergence on {}, {}x{}, {photons} photons per pass; reference: {reference_passes} passes",
         scene.source.display(),
         scene.camera.width,
         scene.camera.height
     );
-    scene.settings.renderer = RendererKind::Ppm;
+    scene.params.renderer = RendererKind::Ppm;
     let mut reference_scene = scene.clone();
-    reference_scene.settings.seed ^= 0x5eed;
+    reference_scene.params.seed ^= 0x5eed;
     let bar = indicatif::ProgressBar::new(reference_passes as u64);
     let limit = |passes| SessionOptions {
         max_passes: Some(passes),
@@ -246,18 +247,14 @@ fn bench_convergence(
     let mut rows = Vec::new();
     let mut curves = Vec::new();
     for (name, index, direct_light) in configs {
-        let options = PpmOptions {
-            index,
-            direct_light,
-            ..Default::default()
-        };
         let mut curve = Vec::new();
-        let session = SessionOptions {
-            ppm: options,
-            ..limit(passes)
-        };
-        photon_map(scene.clone(), session, |f| {
-            let s = &f.stats;
+        let mut configured = scene.clone();
+        configured.params.index = index;
+        configured.params.direct_light = direct_light;
+        photon_map(configured, limit(passes), |f| {
+            let Some(s) = f.stats.photon_mapping() else {
+                return;
+            };
             let e = rmse(&f.radiance, &reference);
             rows.push(format!("{name},{},{:.4},{e:.6e}", s.passes, s.elapsed_secs));
             curve.push((s.elapsed_secs, e));

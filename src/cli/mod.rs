@@ -11,6 +11,7 @@ use std::path::Path;
 use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand};
 
+use caustic::render::ppm::PpmStats;
 use caustic::render::session::{Frame, RenderSession, SessionOptions};
 use caustic::scene::Scene;
 
@@ -92,4 +93,12 @@ fn photon_map(scene: Scene, options: SessionOptions, mut on_frame: impl FnMut(&F
         bail!("the renderer failed: {failure}");
     }
     last.context("the renderer stopped before completing a pass")
+}
+
+/// A photon-mapped frame's statistics (an error for a frame of another renderer).
+fn ppm_stats(frame: &Frame) -> Result<&PpmStats> {
+    frame
+        .stats
+        .photon_mapping()
+        .context("the renderer returned a frame that was not photon mapped")
 }

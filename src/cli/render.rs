@@ -6,9 +6,10 @@ use std::time::Duration;
 
 use anyhow::{bail, Result};
 
-use super::{load_scene, photon_map, progress_bar};
+use super::{load_scene, photon_map, ppm_stats, progress_bar};
 use caustic::render::limits;
-use caustic::render::ppm::{IndexKind, PpmOptions};
+use caustic::render::params::RenderParams;
+use caustic::render::ppm::IndexKind;
 use caustic::render::session::SessionOptions;
 use caustic::render::{image_metadata, render_whitted};
 use caustic::scene::{RendererKind, Scene};
@@ -61,12 +62,42 @@ pub struct PpmArgs {
     /// Photon mapping: initial radius in scene units (default: the scene's, or automatic).
     #[arg(long, allow_negative_numbers = true)]
     radius: Option<f64>,
-    /// Photon mapping: spatial index over visible points.
-    #[arg(long, value_enum, default_value_t = IndexKind::HashGrid)]
-    index: IndexKind,
-    /// Photon mapping: direct light from point/spot lights by shadow rays.
+    /// Photon mapping: spatial index over visible points (default: the scene's, or grid).
+    #[arg(long, value_enum)]
+    index: Option<IndexKind>,
+    /// Photon mapping: direct light from point/spot lights by shadow rays (default: the
+    /// scene's `direct_light`).
     #[arg(long)]
     direct_light: bool,
+}
+
+impl PpmArgs {
+    /// Lays the photon-mapping flags given over the scene's parameters and checks the result
+    /// with [`RenderParams::validate`]; an error names the flag.
+    fn overlay(&self, params: &mut RenderParams) -> Result<()> {
+        if let Some(p) = self.photons {
+            params.photons_per_pass = p;
+        }
+        if let Some(a) = self.alpha {
+            params.alpha = a;
+        }
+        if let Some(r) = self.radius {
+            params.initial_radius = Some(r);
+        }
+        if let Some(index) = self.index {
+            params.index = index;
+        }
+        params.direct_light |= self.direct_light;
+        params.validate().map_err(|e| {
+            let flag = match e.field {
+                "photons_per_pass" => "--photons",
+                "alpha" => "--alpha",
+                "initial_radius" => "--radius",
+                field => field,
+            };
+            anyhow::anyhow!("{flag} {}", e.problem)
+        })
+    }
 }
 
 /// Renders a scene to an image with the ray tracer or photon mapping.
@@ -108,11 +139,11 @@ pub fn render(args: RenderArgs) -> Result<()> {
         scene.camera.height = h;
     }
     if let Some(s) = seed {
-        scene.settings.seed = s;
+        scene.params.seed = s;
     }
     let kind = match renderer {
         Some(kind) => kind,
-        None => scene.settings.renderer,
+        None => scene.params.renderer,
     };
     if kind == RendererKind::Ppm {
         return render_ppm(scene, out, exposure, force, &ppm);
@@ -152,35 +183,23 @@ fn render_ppm(mut scene: Scene, out: &Path, exposure: f32, force: bool, args: &P
             bail!("--time-limit must be a positive number of seconds, got {t}");
         }
     }
-    if let Some(p) = args.photons {
-        scene.settings.photons_per_pass = flag_check("--photons", limits::photons_per_pass(p))?;
-    }
-    if let Some(a) = args.alpha {
-        scene.settings.alpha = flag_check("--alpha", limits::alpha(a))?;
-    }
-    if let Some(r) = args.radius {
-        scene.settings.initial_radius = Some(flag_check("--radius", limits::radius(r))?);
-    }
-    let options = PpmOptions {
-        index: args.index,
-        direct_light: args.direct_light,
-        ..Default::default()
-    };
+    args.overlay(&mut scene.params)?;
     let (w, h) = (scene.camera.width, scene.camera.height);
     let bar = progress_bar(
         args.passes as u64,
         "{msg} [{bar:40}] pass {pos}/{len}, {elapsed} (eta {eta})",
         format!("photon mapping {w}x{h}"),
     )?;
-    scene.settings.renderer = RendererKind::Ppm;
+    scene.params.renderer = RendererKind::Ppm;
     let session = SessionOptions {
-        ppm: options,
         max_passes: Some(args.passes),
         time_limit: args.time_limit.map(Duration::from_secs_f64),
         ..Default::default()
     };
     let frame = photon_map(scene.clone(), session, |f| {
-        let s = &f.stats;
+        let Some(s) = f.stats.photon_mapping() else {
+            return;
+        };
         bar.set_message(format!(
             "photon mapping {w}x{h}, {:.2} M photons/s",
             s.photons as f64 / s.photon_secs.max(1e-9) / 1e6
@@ -188,7 +207,7 @@ fn render_ppm(mut scene: Scene, out: &Path, exposure: f32, force: bool, args: &P
         bar.set_position(s.passes as u64);
     })?;
     bar.finish_and_clear();
-    let s = frame.stats.clone();
+    let s = ppm_stats(&frame)?.clone();
     let image = caustic::render::Image {
         width: w,
         height: h,
@@ -198,7 +217,7 @@ fn render_ppm(mut scene: Scene, out: &Path, exposure: f32, force: bool, args: &P
     metadata.extend([
         ("caustic:passes".into(), s.passes.to_string()),
         ("caustic:photons".into(), s.photons.to_string()),
-        ("caustic:alpha".into(), scene.settings.alpha.to_string()),
+        ("caustic:alpha".into(), scene.params.alpha.to_string()),
         ("caustic:mean_radius".into(), format!("{:.6}", s.mean_radius)),
         ("caustic:elapsed_secs".into(), format!("{:.3}", s.elapsed_secs)),
     ]);

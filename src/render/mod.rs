@@ -3,6 +3,7 @@
 
 pub mod film;
 pub mod limits;
+pub mod params;
 pub mod ppm;
 pub mod rng;
 pub mod session;
@@ -21,7 +22,7 @@ pub fn image_metadata(scene: &crate::scene::Scene, renderer: &str) -> Metadata {
         ),
         ("caustic:scene".into(), scene.source.display().to_string()),
         ("caustic:renderer".into(), renderer.into()),
-        ("caustic:seed".into(), scene.settings.seed.to_string()),
+        ("caustic:seed".into(), scene.params.seed.to_string()),
         (
             "caustic:size".into(),
             format!("{}x{}", scene.camera.width, scene.camera.height),

@@ -3,11 +3,15 @@
 //! [`Frame`] after each pass over a `bounded(1)` channel with `try_send` — the renderer never
 //! waits for whoever watches; a frame nobody took is simply replaced by a newer one.
 //!
-//! Commands are looked at between photon batches, so a slider takes effect within one batch.
-//! α and photons per pass change the coming update/pass without discarding anything; the
-//! camera, aperture, focal distance, initial radius, depth, renderer and geometry restart
-//! accumulation under a new `epoch`; pause and resume lose nothing (a paused pass continues
-//! where it stopped, so the image is the one an uninterrupted run gives).
+//! The render parameters arrive whole ([`Command::SetParams`]). Commands are looked at between
+//! photon batches, so a slider takes effect within one batch. α and photons per pass change
+//! the coming update/pass without discarding anything; every other parameter, the camera and
+//! the geometry restart accumulation under a new `epoch`; pause and resume lose nothing (a
+//! paused pass continues where it stopped, so the image is the one an uninterrupted run gives).
+//!
+//! The rules live in [`SessionState`], free of threads (`apply(Command) -> Effect`, `next`);
+//! the thread's loop only carries out what it says. The command line's `render` and `bench`
+//! run on this session too (headless, [`SessionOptions::every_frame`]).
 //!
 //! A panic on the render thread is caught and kept as [`RenderSession::failure`], so a viewer
 //! can show it and stay up.
@@ -22,30 +26,21 @@ use crossbeam_channel::{bounded, unbounded, Receiver, Sender, TryRecvError};
 use glam::DVec3;
 
 use super::limits;
+use super::params::RenderParams;
 use super::ppm::{Control, Interrupt, PassOutcome, Ppm, PpmOptions, PpmStats};
-use super::whitted::render_whitted_until;
+use super::whitted::{render_whitted_until, WhittedStats};
 use crate::geometry::BezierPatch;
 use crate::scene::{Camera, RendererKind, Scene};
 
 /// What the UI (or a test) asks of the renderer.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Command {
-    /// Radius reduction α for future updates (no restart).
-    SetAlpha(f64),
-    /// Photons per pass from the next pass on (no restart).
-    SetPhotonsPerPass(u64),
-    /// Initial radius (`None`: automatic); restarts.
-    SetInitialRadius(Option<f64>),
-    /// Maximum specular depth; restarts.
-    SetMaxDepth(u32),
-    /// A new camera; restarts.
+    /// Every render setting at once. α and photons per pass apply from the next batch and
+    /// pass; any other change restarts ([`RenderParams::restarts_from`]). Ignored when
+    /// [`RenderParams::validate`] rejects it.
+    SetParams(RenderParams),
+    /// A new camera (pose, lens, image size); restarts.
     SetCamera(Camera),
-    /// Lens radius; restarts.
-    SetAperture(f64),
-    /// Distance of the focal plane; restarts.
-    SetFocalDistance(f64),
-    /// Photon mapping or the ray tracer; restarts.
-    SetRenderer(RendererKind),
     /// Moves control point `index` of patch `patch`; restarts.
     MoveControlPoint {
         /// Patch index in the scene geometry.
@@ -63,29 +58,58 @@ pub enum Command {
     Restart,
     /// End the session's thread.
     Shutdown,
-    /// Makes the render thread panic with this message. It exists to exercise the error path
-    /// of whoever watches the session (the viewer's tests).
-    Fail(String),
 }
 
 impl Command {
-    /// Whether the command discards the accumulation (starts a new epoch) when valid.
-    pub fn restarts(&self) -> bool {
-        !matches!(
-            self,
-            Command::SetAlpha(_)
-                | Command::SetPhotonsPerPass(_)
-                | Command::Pause
-                | Command::Resume
-                | Command::Shutdown
-                | Command::Fail(_)
-        )
+    /// Whether the command discards the accumulation (starts a new epoch) when valid, for a
+    /// session whose parameters are `current`.
+    pub fn restarts(&self, current: &RenderParams) -> bool {
+        match self {
+            Command::SetParams(p) => p.restarts_from(current),
+            Command::SetCamera(_) | Command::MoveControlPoint { .. } | Command::Restart => true,
+            Command::Pause | Command::Resume | Command::Shutdown => false,
+        }
     }
 
-    /// Whether the render thread should drop the pass in progress at once for it: restarts,
-    /// shutdown and failure do; α, photons and pause wait for the next batch.
-    fn interrupts(&self) -> bool {
-        self.restarts() || matches!(self, Command::Shutdown | Command::Fail(_))
+    /// Whether the render thread should drop the pass in progress at once for it: restarts
+    /// and shutdown do; α, photons and pause wait for the next batch.
+    fn interrupts(&self, current: &RenderParams) -> bool {
+        self.restarts(current) || matches!(self, Command::Shutdown)
+    }
+}
+
+/// What a frame's renderer measured.
+#[derive(Clone, Debug, PartialEq)]
+pub enum FrameStats {
+    /// Progressive photon mapping's statistics of the epoch so far.
+    PhotonMapping(PpmStats),
+    /// The ray tracer's statistics of its frame.
+    RayTracing(WhittedStats),
+}
+
+impl FrameStats {
+    /// Seconds the renderer spent on the frame (all passes of the epoch for photon mapping).
+    pub fn elapsed_secs(&self) -> f64 {
+        match self {
+            FrameStats::PhotonMapping(s) => s.elapsed_secs,
+            FrameStats::RayTracing(s) => s.elapsed_secs,
+        }
+    }
+
+    /// Photon mapping's statistics, if the frame was photon mapped.
+    pub fn photon_mapping(&self) -> Option<&PpmStats> {
+        match self {
+            FrameStats::PhotonMapping(s) => Some(s),
+            FrameStats::RayTracing(_) => None,
+        }
+    }
+
+    /// Which renderer made the frame.
+    pub fn renderer(&self) -> RendererKind {
+        match self {
+            FrameStats::PhotonMapping(_) => RendererKind::Ppm,
+            FrameStats::RayTracing(_) => RendererKind::Whitted,
+        }
     }
 }
 
@@ -94,16 +118,14 @@ impl Command {
 pub struct Frame {
     /// Increases whenever accumulated statistics are discarded.
     pub epoch: u64,
-    /// Which renderer made it.
-    pub renderer: RendererKind,
     /// Passes completed in this epoch (1 for a ray-traced frame).
     pub pass: u32,
     /// Photons emitted in this epoch.
     pub photons: u64,
     /// Seconds since this epoch started.
     pub elapsed_secs: f64,
-    /// Statistics of the render (photon mapping; only `elapsed_secs` for the ray tracer).
-    pub stats: PpmStats,
+    /// What the renderer measured (and so which renderer made it).
+    pub stats: FrameStats,
     /// Image width.
     pub width: u32,
     /// Image height.
@@ -149,6 +171,8 @@ pub struct SessionOptions {
 /// A render running on its own thread.
 pub struct RenderSession {
     commands: Sender<Command>,
+    /// The newest valid parameters sent, to tell which commands interrupt the pass.
+    params: Mutex<RenderParams>,
     /// Set by [`RenderSession::send`] for commands that interrupt the pass in progress.
     interrupt: Arc<AtomicBool>,
     frames: Receiver<Frame>,
@@ -183,6 +207,7 @@ impl RenderSession {
         let failed = failure.clone();
         let interrupt = Arc::new(AtomicBool::new(false));
         let interrupt_flag = interrupt.clone();
+        let params = Mutex::new(scene.params.clone());
         let thread = std::thread::Builder::new()
             .name("caustic-render".into())
             .spawn(move || {
@@ -217,6 +242,7 @@ impl RenderSession {
             .expect("spawn the render thread");
         Self {
             commands,
+            params,
             interrupt,
             frames,
             failure,
@@ -224,10 +250,21 @@ impl RenderSession {
         }
     }
 
-    /// Sends a command (ignored once the thread has ended). Restarts, shutdown and failure
-    /// also abandon the pass in progress, even mid-way through an eye pass.
+    /// Sends a command (ignored once the thread has ended). Restarts and shutdown also
+    /// abandon the pass in progress, even mid-way through an eye pass.
     pub fn send(&self, command: Command) {
-        let interrupts = command.interrupts();
+        let interrupts = match self.params.lock() {
+            Ok(mut params) => {
+                let interrupts = command.interrupts(&params);
+                if let Command::SetParams(p) = &command {
+                    if p.validate().is_ok() {
+                        *params = p.clone();
+                    }
+                }
+                interrupts
+            }
+            Err(_) => true,
+        };
         let _ = self.commands.send(command);
         if interrupts {
             self.interrupt.store(true, Ordering::Release);
@@ -266,35 +303,31 @@ impl Drop for RenderSession {
 /// Whether a command's values are valid for a scene with `patches` patches.
 fn valid(command: &Command, patches: usize) -> bool {
     match command {
-        Command::SetAlpha(a) => limits::alpha(*a).is_ok(),
-        Command::SetPhotonsPerPass(n) => limits::photons_per_pass(*n).is_ok(),
-        Command::Pause | Command::Resume | Command::Shutdown | Command::Fail(_) => true,
-        Command::SetInitialRadius(r) => r.is_none_or(|r| limits::radius(r).is_ok()),
-        Command::SetMaxDepth(d) => limits::max_depth(*d).is_ok(),
-        Command::SetCamera(_) | Command::Restart | Command::SetRenderer(_) => true,
-        Command::SetAperture(a) => limits::aperture(*a).is_ok(),
-        Command::SetFocalDistance(f) => limits::focal_distance(*f).is_ok(),
+        Command::SetParams(p) => p.validate().is_ok(),
+        Command::SetCamera(c) => {
+            limits::aperture(c.aperture).is_ok()
+                && limits::focal_distance(c.focal_distance).is_ok()
+                && c.position.is_finite()
+                && c.forward.is_finite()
+        }
         Command::MoveControlPoint {
             patch,
             index,
             position,
         } => *patch < patches && *index < 16 && position.is_finite(),
+        Command::Pause | Command::Resume | Command::Restart | Command::Shutdown => true,
     }
 }
 
-/// Applies the commands that restart the accumulation to the scene, in order. Control-point
-/// moves are gathered so that each edited patch is re-prepared once, however many steps of a
-/// drag arrived together (the latest position of each point wins).
+/// Applies the camera and control points of the commands that restart the accumulation to
+/// the scene, in order. Control-point moves are gathered so that each edited patch is
+/// re-prepared once, however many steps of a drag arrived together (the latest position of
+/// each point wins).
 fn apply_to_scene(scene: &mut Scene, commands: Vec<Command>) {
     let mut edited: std::collections::BTreeMap<usize, BezierPatch> = Default::default();
     for command in commands {
         match command {
-            Command::SetInitialRadius(r) => scene.settings.initial_radius = r,
-            Command::SetMaxDepth(d) => scene.settings.max_depth = d,
             Command::SetCamera(c) => scene.camera = c,
-            Command::SetAperture(a) => scene.camera.aperture = a,
-            Command::SetFocalDistance(f) => scene.camera.focal_distance = f,
-            Command::SetRenderer(r) => scene.settings.renderer = r,
             Command::MoveControlPoint {
                 patch,
                 index,
@@ -320,11 +353,10 @@ impl Frame {
         let (radius, gathered) = pixel_statistics(ppm);
         Frame {
             epoch,
-            renderer: RendererKind::Ppm,
             pass: stats.passes,
             photons: stats.photons,
             elapsed_secs,
-            stats,
+            stats: FrameStats::PhotonMapping(stats),
             width,
             height,
             radiance: ppm.radiance().into(),
@@ -393,7 +425,7 @@ fn preview(
     ppm.photons_per_pass = options
         .first_pass_photons
         .unwrap_or(16_384)
-        .min(scene.settings.photons_per_pass);
+        .min(scene.params.photons_per_pass);
     ppm.set_interrupt(Some(interrupted.clone()));
     let outcome = ppm.run_pass(scene, &mut |_| Control::Continue);
     (scene.camera.width, scene.camera.height) = (w, h);
@@ -440,16 +472,17 @@ pub struct SessionState {
     pub epoch: u64,
     /// Paused by [`Command::Pause`].
     pub paused: bool,
-    /// α for the coming updates.
-    pub alpha: f64,
-    /// Photons per full pass.
-    pub photons_per_pass: u64,
-    renderer: RendererKind,
+    /// The newest valid parameters: α and photons per pass for the coming batches and passes,
+    /// the rest for the next epoch.
+    pub params: RenderParams,
     patches: usize,
     /// Passes completed in this epoch (the ray-traced frame counts as one).
     pub passes: u32,
     preview_due: bool,
+    /// Camera and control-point commands for the next epoch.
     pending: Vec<Command>,
+    /// A restart is waiting.
+    restart_due: bool,
     shutdown: bool,
 }
 
@@ -464,8 +497,6 @@ pub enum Effect {
     Restarts,
     /// The session ends.
     Shutdown,
-    /// The render thread must fail with this message.
-    Fail(String),
 }
 
 impl SessionState {
@@ -475,13 +506,12 @@ impl SessionState {
             options,
             epoch: 0,
             paused: options.start_paused,
-            alpha: scene.settings.alpha,
-            photons_per_pass: scene.settings.photons_per_pass,
-            renderer: scene.settings.renderer,
+            params: scene.params.clone(),
             patches: scene.geometry.patches().len(),
             passes: 0,
             preview_due: options.preview_divisor.is_some(),
             pending: Vec::new(),
+            restart_due: false,
             shutdown: false,
         }
     }
@@ -491,36 +521,37 @@ impl SessionState {
         if !valid(&command, self.patches) {
             return Effect::Ignored;
         }
-        if command.restarts() {
-            if let Command::SetRenderer(r) = command {
-                self.renderer = r;
-            }
-            self.pending.push(command);
-            return Effect::Restarts;
-        }
+        let restarts = command.restarts(&self.params);
         match command {
-            Command::SetAlpha(a) => self.alpha = a,
-            Command::SetPhotonsPerPass(n) => self.photons_per_pass = n,
+            // The restart takes the newest set: parameters need no replaying.
+            Command::SetParams(p) => self.params = p,
             Command::Pause => self.paused = true,
             Command::Resume => self.paused = false,
-            Command::Fail(message) => return Effect::Fail(message),
-            _ => {
+            Command::Shutdown => {
                 self.shutdown = true;
                 return Effect::Shutdown;
             }
+            Command::SetCamera(_) | Command::MoveControlPoint { .. } | Command::Restart => {
+                self.pending.push(command)
+            }
         }
-        Effect::Applied
+        if restarts {
+            self.restart_due = true;
+            Effect::Restarts
+        } else {
+            Effect::Applied
+        }
     }
 
     /// Whether the pass in progress must be dropped (a restart or the end waits).
     pub fn must_abort(&self) -> bool {
-        self.shutdown || !self.pending.is_empty()
+        self.shutdown || self.restart_due
     }
 
     /// Whether the session's limits are reached.
     fn finished(&self, epoch_secs: Duration) -> bool {
         self.options.max_passes.is_some_and(|n| self.passes >= n)
-            || (self.renderer == RendererKind::Ppm
+            || (self.params.renderer == RendererKind::Ppm
                 && self.options.time_limit.is_some_and(|t| epoch_secs >= t))
     }
 
@@ -528,11 +559,11 @@ impl SessionState {
     pub fn next(&self, epoch_secs: Duration) -> Next {
         if self.shutdown || self.finished(epoch_secs) {
             Next::Stop
-        } else if !self.pending.is_empty() {
+        } else if self.restart_due {
             Next::Restart
         } else if self.waiting() {
             Next::Wait
-        } else if self.renderer == RendererKind::Whitted {
+        } else if self.params.renderer == RendererKind::Whitted {
             Next::Trace
         } else if self.preview_due {
             Next::Preview
@@ -549,15 +580,14 @@ impl SessionState {
 
     /// Paused, or the ray-traced frame of this epoch is done.
     fn waiting(&self) -> bool {
-        self.paused || (self.renderer == RendererKind::Whitted && self.passes > 0)
+        self.paused || (self.params.renderer == RendererKind::Whitted && self.passes > 0)
     }
 
     /// Opens a new epoch: the gathered commands are applied to `scene`.
     pub fn restart(&mut self, scene: &mut Scene) {
         apply_to_scene(scene, std::mem::take(&mut self.pending));
-        scene.settings.alpha = self.alpha;
-        scene.settings.photons_per_pass = self.photons_per_pass;
-        self.renderer = scene.settings.renderer;
+        self.restart_due = false;
+        scene.params = self.params.clone();
         self.epoch += 1;
         self.passes = 0;
         self.preview_due = self.options.preview_divisor.is_some();
@@ -568,9 +598,10 @@ impl SessionState {
     pub fn pass_photons(&self, completed: u32) -> u64 {
         match self.options.first_pass_photons {
             Some(first) => self
+                .params
                 .photons_per_pass
                 .min(first.saturating_mul(1 << completed.min(40))),
-            None => self.photons_per_pass,
+            None => self.params.photons_per_pass,
         }
     }
 }
@@ -586,9 +617,7 @@ fn drain(state: &mut SessionState, commands: &Receiver<Command>) -> bool {
         };
         match next {
             Ok(command) => {
-                if let Effect::Fail(message) = state.apply(command) {
-                    panic!("{message}");
-                }
+                state.apply(command);
             }
             Err(TryRecvError::Empty) => return true,
             Err(TryRecvError::Disconnected) => {
@@ -605,15 +634,10 @@ fn trace(scene: &Scene, epoch: u64, epoch_start: Instant, interrupted: &Interrup
     let pixels = image.pixels.len();
     Some(Frame {
         epoch,
-        renderer: RendererKind::Whitted,
         pass: 1,
         photons: 0,
         elapsed_secs: epoch_start.elapsed().as_secs_f64(),
-        stats: PpmStats {
-            passes: 1,
-            elapsed_secs: stats.elapsed_secs,
-            ..Default::default()
-        },
+        stats: FrameStats::RayTracing(stats),
         width: image.width,
         height: image.height,
         radiance: image.pixels.into(),
@@ -678,13 +702,13 @@ fn run(
                 }
             }
             Next::Pass => {
-                ppm.alpha = state.alpha;
+                ppm.alpha = state.params.alpha;
                 ppm.photons_per_pass = state.pass_photons(ppm.stats().passes);
                 // Between batches: commands apply; a restart or the end drops the pass.
                 let mut control = |alpha: &mut f64| {
                     interrupt.store(false, Ordering::Release);
                     drain(&mut state, &commands);
-                    *alpha = state.alpha;
+                    *alpha = state.params.alpha;
                     if state.must_abort() {
                         Control::Abort
                     } else {
@@ -707,7 +731,7 @@ mod tests {
 
     fn state() -> SessionState {
         let mut scene = Scene::builtin();
-        scene.settings.renderer = RendererKind::Ppm;
+        scene.params.renderer = RendererKind::Ppm;
         SessionState::new(
             &scene,
             SessionOptions {
@@ -723,20 +747,31 @@ mod tests {
         let mut s = state();
         let now = Duration::ZERO;
         assert_eq!(s.next(now), Next::Preview);
-        assert_eq!(s.apply(Command::SetAlpha(0.5)), Effect::Applied);
-        assert_eq!(s.apply(Command::SetAlpha(1.5)), Effect::Ignored);
-        assert_eq!(s.alpha, 0.5);
+        let with_alpha = |s: &SessionState, alpha| {
+            Command::SetParams(RenderParams {
+                alpha,
+                ..s.params.clone()
+            })
+        };
+        assert_eq!(s.apply(with_alpha(&s, 0.5)), Effect::Applied);
+        assert_eq!(s.apply(with_alpha(&s, 1.5)), Effect::Ignored);
+        assert_eq!(s.params.alpha, 0.5);
         assert_eq!(s.apply(Command::Pause), Effect::Applied);
         assert_eq!(s.next(now), Next::Wait);
         assert!(s.idle());
-        assert_eq!(s.apply(Command::SetAperture(0.1)), Effect::Restarts);
+        let mut lens = Scene::builtin().camera;
+        lens.aperture = 0.1;
+        let mut bad_lens = lens.clone();
+        bad_lens.focal_distance = f64::NAN;
+        assert_eq!(s.apply(Command::SetCamera(bad_lens)), Effect::Ignored);
+        assert_eq!(s.apply(Command::SetCamera(lens)), Effect::Restarts);
         assert!(s.must_abort() && !s.idle());
         assert_eq!(s.next(now), Next::Restart);
         let mut scene = Scene::builtin();
-        scene.settings.renderer = RendererKind::Ppm;
+        scene.params.renderer = RendererKind::Ppm;
         s.restart(&mut scene);
         assert_eq!(
-            (s.epoch, scene.camera.aperture, scene.settings.alpha),
+            (s.epoch, scene.camera.aperture, scene.params.alpha),
             (1, 0.1, 0.5)
         );
         assert_eq!(s.next(now), Next::Wait, "still paused");
@@ -750,7 +785,6 @@ mod tests {
             }),
             Effect::Ignored
         );
-        assert_eq!(s.apply(Command::Fail("x".into())), Effect::Fail("x".into()));
         assert_eq!(s.apply(Command::Shutdown), Effect::Shutdown);
         assert_eq!(s.next(now), Next::Stop);
     }
@@ -758,7 +792,7 @@ mod tests {
     #[test]
     fn passes_ramp_up_and_limits_end_the_session() {
         let mut s = state();
-        s.photons_per_pass = 5000;
+        s.params.photons_per_pass = 5000;
         assert_eq!([0, 1, 2, 3].map(|k| s.pass_photons(k)), [1000, 2000, 4000, 5000]);
         s.options.max_passes = Some(3);
         s.preview_due = false;
@@ -772,7 +806,11 @@ mod tests {
         assert_eq!(s.next(Duration::from_secs(2)), Next::Stop);
         // The ray tracer makes one frame, then waits.
         s.options.time_limit = None;
-        s.apply(Command::SetRenderer(RendererKind::Whitted));
+        let whitted = RenderParams {
+            renderer: RendererKind::Whitted,
+            ..s.params.clone()
+        };
+        assert_eq!(s.apply(Command::SetParams(whitted)), Effect::Restarts);
         s.restart(&mut Scene::builtin());
         assert_eq!(s.next(Duration::ZERO), Next::Trace);
         s.passes = 1;

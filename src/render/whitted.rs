@@ -57,9 +57,9 @@ impl Tracer<'_> {
     fn first_sample(&self, x: u32, y: u32, rays: &AtomicUsize) -> (DVec3, u64) {
         let (scene, camera) = (self.scene, &self.scene.camera);
         let index = (y as u64) * camera.width as u64 + x as u64;
-        let mut rng = stream_rng(scene.settings.seed, streams::WHITTED_PIXEL, index);
+        let mut rng = stream_rng(scene.params.seed, streams::WHITTED_PIXEL, index);
         if camera.aperture > 0.0 {
-            let n = scene.settings.dof_samples;
+            let n = scene.params.dof_samples;
             let grid = (n as f64).sqrt().ceil() as u32;
             let mut sum = DVec3::ZERO;
             for s in 0..n {
@@ -83,7 +83,7 @@ impl Tracer<'_> {
     /// The mean of a 4×4 grid of rays over pixel `i` = `(x, y)` (edge anti-aliasing).
     fn edge_samples(&self, i: usize, x: i64, y: i64) -> DVec3 {
         let camera = &self.scene.camera;
-        let mut rng = stream_rng(self.scene.settings.seed, streams::WHITTED_EDGE, i as u64);
+        let mut rng = stream_rng(self.scene.params.seed, streams::WHITTED_EDGE, i as u64);
         let mut sum = DVec3::ZERO;
         for sy in 0..4 {
             for sx in 0..4 {
@@ -107,7 +107,7 @@ impl Tracer<'_> {
         };
         state.touch(hit.object as u64);
         let emitted = scene.emission(&hit, ray.dir);
-        if scene.objects[hit.object as usize].emission.is_some() || depth >= scene.settings.max_depth {
+        if scene.objects[hit.object as usize].emission.is_some() || depth >= scene.params.max_depth {
             return emitted;
         }
         let surface = scene.surface(&hit, ray.dir);
@@ -115,10 +115,10 @@ impl Tracer<'_> {
         match surface.material.kind {
             MaterialKind::Diffuse { specular, shininess } => {
                 let wo = -ray.dir;
-                let mut radiance = emitted + scene.settings.ambient * color;
+                let mut radiance = emitted + scene.params.ambient * color;
                 for (k, light) in scene.lights.iter().enumerate() {
                     let samples = if light.is_area() {
-                        scene.settings.light_samples
+                        scene.params.light_samples
                     } else {
                         1
                     };
@@ -218,7 +218,7 @@ pub fn render_whitted_until(
     }
 
     // Pass 2: re-sample pixels on an edge of object ids or shadow states with a 4×4 grid.
-    let antialias = scene.settings.antialias && !dof;
+    let antialias = scene.params.antialias && !dof;
     let id = |x: i64, y: i64| first[(y * w as i64 + x) as usize].1;
     let edge_pixels = AtomicUsize::new(0);
     let pixels: Vec<[f32; 3]> = (0..(w as usize * h as usize))

@@ -80,9 +80,9 @@ pub type Vec3 = [Real; 3];
 pub struct SceneFile {
     /// `[camera]`.
     pub camera: Spanned<CameraDesc>,
-    /// `[render]`.
+    /// `[render]`: the render parameters themselves (defaults for what it leaves out).
     #[serde(default)]
-    pub render: Option<Spanned<RenderDesc>>,
+    pub render: Option<Spanned<crate::render::params::RenderParams>>,
     /// Radiance of rays that leave the scene (default black).
     #[serde(default)]
     pub background: Option<Vec3>,
@@ -119,32 +119,6 @@ pub struct CameraDesc {
     pub height: u32,
     /// Eye rays start on the plane this far along the view axis (a near clip plane).
     pub near: Option<Real>,
-}
-
-/// `[render]`.
-#[derive(Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct RenderDesc {
-    /// `"whitted"` or `"ppm"`.
-    pub renderer: Option<String>,
-    /// Photons emitted per PPM pass.
-    pub photons_per_pass: Option<u64>,
-    /// PPM radius reduction α in (0, 1].
-    pub alpha: Option<Real>,
-    /// PPM initial radius in scene units (default: from the pixel footprint).
-    pub initial_radius: Option<Real>,
-    /// Maximum specular bounces.
-    pub max_depth: Option<u32>,
-    /// Seed of every random number.
-    pub seed: Option<u64>,
-    /// Edge-adaptive anti-aliasing in the ray tracer (default on).
-    pub antialias: Option<bool>,
-    /// Lens samples per pixel when the aperture is open.
-    pub dof_samples: Option<u32>,
-    /// Shadow samples per area light per shading point.
-    pub light_samples: Option<u32>,
-    /// Ambient radiance added at diffuse surfaces by the ray tracer (default none).
-    pub ambient: Option<Vec3>,
 }
 
 /// A texture reference inside a material.

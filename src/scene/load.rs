@@ -10,13 +10,12 @@ use toml::Spanned;
 
 use super::camera::Camera;
 use super::format::{
-    CameraDesc, LightDesc, MaterialDesc, ObjectDesc, RenderDesc, ScaleDesc, SceneFile, TextureDesc,
-    TransformDesc, Vec3,
+    CameraDesc, LightDesc, MaterialDesc, ObjectDesc, ScaleDesc, SceneFile, TextureDesc, TransformDesc, Vec3,
 };
 use super::light::Light;
 use super::material::{Material, MaterialKind};
 use super::texture::{Mapping, Texture, TextureSource};
-use super::{RenderSettings, RendererKind, Scene, SceneObject};
+use super::{RenderParams, Scene, SceneObject};
 use crate::geometry::{load_bpt, BezierPatch, GeometryBuilder, Plane, Quad, Sphere, TriangleMesh};
 use crate::render::limits;
 
@@ -154,9 +153,9 @@ pub(super) fn load_str(text: &str, path: &Path, base_dir: Option<&Path>) -> Resu
     })?;
 
     let camera = camera(&ctx, &file.camera)?;
-    let settings = match &file.render {
-        Some(r) => render_settings(&ctx, r)?,
-        None => RenderSettings::default(),
+    let params = match &file.render {
+        Some(r) => render_params(&ctx, r)?,
+        None => RenderParams::default(),
     };
     let background = file.background.as_ref().map(v3).unwrap_or(DVec3::ZERO);
     if background.cmplt(DVec3::ZERO).any() {
@@ -252,7 +251,7 @@ pub(super) fn load_str(text: &str, path: &Path, base_dir: Option<&Path>) -> Resu
     Ok(Scene {
         source: path.to_owned(),
         camera,
-        settings,
+        params,
         background,
         materials,
         textures,
@@ -307,52 +306,16 @@ fn camera(ctx: &Ctx, desc: &Spanned<CameraDesc>) -> Result<Camera> {
     Ok(camera)
 }
 
-fn render_settings(ctx: &Ctx, desc: &Spanned<RenderDesc>) -> Result<RenderSettings> {
+/// The `[render]` table (read straight into [`RenderParams`]), checked by its one `validate`.
+fn render_params(ctx: &Ctx, desc: &Spanned<RenderParams>) -> Result<RenderParams> {
     let t = Table {
         ctx,
         span: desc.span(),
         name: "[render]".into(),
     };
-    let d = desc.get_ref();
-    let defaults = RenderSettings::default();
-    let renderer = match d.renderer.as_deref() {
-        None | Some("whitted") => RendererKind::Whitted,
-        Some("ppm") => RendererKind::Ppm,
-        Some(other) => {
-            return Err(t.err(format!(
-                "'renderer' must be \"whitted\" or \"ppm\", got \"{other}\""
-            )))
-        }
-    };
-    let check = |field: &str, e: limits::Invalid| t.err(format!("'{field}' {e}"));
-    let alpha = limits::alpha(d.alpha.map_or(defaults.alpha, |r| r.0)).map_err(|e| check("alpha", e))?;
-    let photons_per_pass = limits::photons_per_pass(d.photons_per_pass.unwrap_or(defaults.photons_per_pass))
-        .map_err(|e| check("photons_per_pass", e))?;
-    let max_depth =
-        limits::max_depth(d.max_depth.unwrap_or(defaults.max_depth)).map_err(|e| check("max_depth", e))?;
-    let dof_samples = limits::samples(d.dof_samples.unwrap_or(defaults.dof_samples))
-        .map_err(|e| check("dof_samples", e))?;
-    let light_samples = limits::samples(d.light_samples.unwrap_or(defaults.light_samples))
-        .map_err(|e| check("light_samples", e))?;
-    let ambient = d.ambient.as_ref().map(v3).unwrap_or(DVec3::ZERO);
-    if ambient.cmplt(DVec3::ZERO).any() {
-        return Err(t.err(format!("'ambient' must not be negative, got {ambient}")));
-    }
-    Ok(RenderSettings {
-        renderer,
-        photons_per_pass,
-        alpha,
-        initial_radius: d
-            .initial_radius
-            .map(|r| limits::radius(r.0).map_err(|e| check("initial_radius", e)))
-            .transpose()?,
-        max_depth,
-        seed: d.seed.unwrap_or(defaults.seed),
-        antialias: d.antialias.unwrap_or(defaults.antialias),
-        dof_samples,
-        light_samples,
-        ambient,
-    })
+    let params = desc.get_ref().clone();
+    params.validate().map_err(|e| t.err(e))?;
+    Ok(params)
 }
 
 fn material(

@@ -14,6 +14,8 @@ use std::path::PathBuf;
 
 use glam::{DVec2, DVec3};
 
+pub use crate::render::params::{RenderParams, RendererKind};
+
 pub use camera::Camera;
 pub use light::Light;
 pub use load::SceneError;
@@ -21,57 +23,6 @@ pub use material::{Material, MaterialKind};
 pub use texture::Texture;
 
 use crate::geometry::{Hit, SceneGeometry};
-
-/// Which renderer a scene asks for (`--renderer whitted|ppm` on the command line).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum RendererKind {
-    /// The Whitted ray tracer (preview, and the seed report's first renderer).
-    Whitted,
-    /// Progressive photon mapping.
-    Ppm,
-}
-
-/// `[render]` settings with defaults filled in.
-#[derive(Clone, Debug, PartialEq)]
-pub struct RenderSettings {
-    /// Renderer.
-    pub renderer: RendererKind,
-    /// Photons per PPM pass.
-    pub photons_per_pass: u64,
-    /// PPM α.
-    pub alpha: f64,
-    /// PPM initial radius (`None`: from the pixel footprint).
-    pub initial_radius: Option<f64>,
-    /// Maximum specular bounces.
-    pub max_depth: u32,
-    /// Seed.
-    pub seed: u64,
-    /// Edge-adaptive anti-aliasing in the ray tracer.
-    pub antialias: bool,
-    /// Lens samples per pixel with an open aperture.
-    pub dof_samples: u32,
-    /// Shadow samples per area light.
-    pub light_samples: u32,
-    /// Ambient radiance for the ray tracer.
-    pub ambient: DVec3,
-}
-
-impl Default for RenderSettings {
-    fn default() -> Self {
-        Self {
-            renderer: RendererKind::Whitted,
-            photons_per_pass: 200_000,
-            alpha: 0.7,
-            initial_radius: None,
-            max_depth: 8,
-            seed: 1,
-            antialias: true,
-            dof_samples: 16,
-            light_samples: 16,
-            ambient: DVec3::ZERO,
-        }
-    }
-}
 
 /// One `[[objects]]` entry (or an area light's visible surface) at run time.
 #[derive(Clone, Debug, PartialEq)]
@@ -91,8 +42,8 @@ pub struct Scene {
     pub source: PathBuf,
     /// The camera.
     pub camera: Camera,
-    /// Render settings.
-    pub settings: RenderSettings,
+    /// Render parameters (the `[render]` table, defaults filled in).
+    pub params: RenderParams,
     /// Radiance of rays leaving the scene.
     pub background: DVec3,
     /// Materials; objects refer to them by index.

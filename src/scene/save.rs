@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use glam::DVec3;
 use toml_edit::{Array, DocumentMut, Item, Table, Value};
 
-use super::{RendererKind, Scene};
+use super::{RenderParams, Scene};
 use crate::files::{write_atomically, WriteError};
 use crate::geometry::BezierPatch;
 
@@ -131,25 +131,34 @@ fn write_camera(doc: &mut DocumentMut, scene: &Scene) {
     t.insert("focal_distance", toml_edit::value(c.focal_distance));
 }
 
+/// Writes the render parameters into `[render]`: every key the table already has, and every
+/// value that differs from the default (so a file that never named a setting stays lean).
 fn write_render(doc: &mut DocumentMut, scene: &Scene) {
-    let s = &scene.settings;
+    let values = params_table(&scene.params);
+    let defaults = params_table(&RenderParams::default());
     let t = table(doc, "render");
-    let renderer = match s.renderer {
-        RendererKind::Ppm => "ppm",
-        RendererKind::Whitted => "whitted",
-    };
-    t.insert("renderer", toml_edit::value(renderer));
-    t.insert("alpha", toml_edit::value(s.alpha));
-    t.insert("photons_per_pass", toml_edit::value(s.photons_per_pass as i64));
-    t.insert("max_depth", toml_edit::value(s.max_depth as i64));
-    match s.initial_radius {
-        Some(r) => {
-            t.insert("initial_radius", toml_edit::value(r));
-        }
-        None => {
-            t.remove("initial_radius");
+    for (key, item) in values.iter() {
+        let default = defaults.get(key).map(|d| d.to_string());
+        if t.contains_key(key) || default != Some(item.to_string()) {
+            t.insert(key, item.clone());
         }
     }
+    // Absent values (an automatic initial radius) are absent from the file too.
+    let absent: Vec<String> = t
+        .iter()
+        .map(|(k, _)| k.to_owned())
+        .filter(|k| !values.contains_key(k))
+        .collect();
+    for key in absent {
+        t.remove(&key);
+    }
+}
+
+/// Render parameters as a TOML table, through their serde form.
+fn params_table(params: &RenderParams) -> toml_edit::Table {
+    let text = toml::to_string(params).expect("render parameters serialize to TOML");
+    let doc: DocumentMut = text.parse().expect("toml writes TOML that toml_edit reads");
+    doc.as_table().clone()
 }
 
 fn write_patches(doc: &mut DocumentMut, scene: &Scene, loaded: &[BezierPatch]) {
@@ -206,7 +215,7 @@ mod tests {
             .set_control_point(3, 5, DVec3::new(0.1, -2.0 / 3.0, 1e-17)));
         scene.camera.position += DVec3::new(0.5, 0.25, -0.125);
         scene.camera.aperture = 0.05;
-        scene.settings.alpha = 0.6;
+        scene.params.alpha = 0.6;
         let text = scene_toml(&scene, &loaded, None).expect("saves");
         assert!(text.contains("# The Utah teapot"), "comments lost");
         let back = Scene::from_str(&text, Path::new("saved.toml"), None).expect("loads back");
@@ -214,7 +223,7 @@ mod tests {
         assert_eq!(patches(&back), patches(&scene));
         assert_eq!(back.materials, scene.materials);
         assert_eq!(back.lights, scene.lights);
-        assert_eq!(back.settings, scene.settings);
+        assert_eq!(back.params, scene.params);
         let (a, b) = (&back.camera, &scene.camera);
         assert!((a.position - b.position).length() < 1e-12);
         assert!((a.forward - b.forward).length() < 1e-12 && (a.up - b.up).length() < 1e-12);

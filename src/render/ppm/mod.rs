@@ -84,20 +84,18 @@ pub enum IndexKind {
     /// Hashed uniform grid, rebuilt per pass (default).
     #[default]
     #[value(name = "grid")]
+    #[serde(rename = "grid")]
     HashGrid,
     /// The seed report's kd-tree with per-subtree maximum radius.
     #[value(name = "kd")]
+    #[serde(rename = "kd")]
     KdTree,
 }
 
-/// Photon-mapping options beyond the scene's `[render]` settings.
+/// How photon mapping runs, beyond the scene's render parameters (which hold every setting
+/// that changes the image or its speed a user chooses: α, photons, index, direct light, …).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PpmOptions {
-    /// The spatial index.
-    pub index: IndexKind,
-    /// Direct light from point/spot lights by shadow rays at visible points, photons from them
-    /// deposited only after their first bounce.
-    pub direct_light: bool,
     /// Force stochastic PPM (a new eye pass every pass) even for a pinhole camera.
     pub force_stochastic: bool,
     /// Photons traced between two calls of the control callback (rounded up to whole
@@ -109,8 +107,6 @@ pub struct PpmOptions {
 impl Default for PpmOptions {
     fn default() -> Self {
         Self {
-            index: IndexKind::default(),
-            direct_light: false,
             force_stochastic: false,
             batch_photons: DEFAULT_BATCH_PHOTONS,
         }
@@ -219,6 +215,10 @@ pub enum Control {
 /// A progressive photon mapping render in progress.
 pub struct Ppm {
     options: PpmOptions,
+    /// Direct light by shadow rays (from the render parameters).
+    direct_light: bool,
+    /// The spatial index (from the render parameters).
+    index: IndexKind,
     stochastic: bool,
     /// α for the next update.
     pub alpha: f64,
@@ -242,10 +242,11 @@ pub struct Ppm {
 pub type Interrupt = Arc<dyn Fn() -> bool + Send + Sync>;
 
 impl Ppm {
-    /// A new render of `scene` (its `[render]` settings give α, photons per pass, radius, seed).
+    /// A new render of `scene`; its render parameters give α, photons per pass, radius, seed,
+    /// index and direct light.
     pub fn new(scene: &Scene, options: PpmOptions) -> Self {
         let cam = &scene.camera;
-        let stochastic = options.force_stochastic || cam.aperture > 0.0 || scene.settings.antialias;
+        let stochastic = options.force_stochastic || cam.aperture > 0.0 || scene.params.antialias;
         let features = scene.features();
         let mut skipped = Vec::new();
         if !stochastic {
@@ -260,7 +261,7 @@ impl Ppm {
         if !features.textures {
             skipped.push("no textures: constant colours, no lookups".to_owned());
         }
-        if options.direct_light {
+        if scene.params.direct_light {
             skipped
                 .push("first photon bounce from point/spot lights: direct light by shadow rays".to_owned());
         }
@@ -272,10 +273,12 @@ impl Ppm {
         let pixels = cam.width as usize * cam.height as usize;
         Self {
             options,
+            direct_light: scene.params.direct_light,
+            index: scene.params.index,
             stochastic,
-            alpha: scene.settings.alpha,
-            photons_per_pass: scene.settings.photons_per_pass,
-            initial_radius: scene.settings.initial_radius,
+            alpha: scene.params.alpha,
+            photons_per_pass: scene.params.photons_per_pass,
+            initial_radius: scene.params.initial_radius,
             slots: Vec::new(),
             points: Vec::new(),
             direct: vec![DVec3::ZERO; pixels],
@@ -286,7 +289,7 @@ impl Ppm {
             },
             width: cam.width,
             height: cam.height,
-            seed: scene.settings.seed,
+            seed: scene.params.seed,
             interrupt: None,
         }
     }
@@ -321,7 +324,7 @@ impl Ppm {
     fn trace_eye_pass(&self, scene: &Scene) -> Option<Vec<visible::EyeResult>> {
         let (w, h) = (self.width as u64, self.height as u64);
         let pass = self.stats.passes as u64;
-        let (stochastic, direct_light, seed) = (self.stochastic, self.options.direct_light, self.seed);
+        let (stochastic, direct_light, seed) = (self.stochastic, self.direct_light, self.seed);
         let interrupt = self.interrupt.as_deref();
         let skipped = std::sync::atomic::AtomicBool::new(false);
         let results: Vec<visible::EyeResult> = (0..w * h)
@@ -443,7 +446,7 @@ impl Ppm {
         }
         let index_start = Instant::now();
         self.stats.eye_secs += (index_start - start).as_secs_f64();
-        let index = match self.options.index {
+        let index = match self.index {
             IndexKind::HashGrid => SpatialIndex::Grid(HashGrid::build(&self.points)),
             IndexKind::KdTree => SpatialIndex::Kd(KdTree::build(&self.points)),
         };
@@ -469,7 +472,7 @@ impl Ppm {
         index: &SpatialIndex,
         control: &mut dyn FnMut(&mut f64) -> Control,
     ) -> Option<Gathered> {
-        let source = PhotonSource::new(scene, self.options.direct_light);
+        let source = PhotonSource::new(scene, self.direct_light);
         // Positions and radii packed tightly: the candidate test reads nothing else.
         let reach: Vec<[f64; 4]> = self
             .points

@@ -102,7 +102,7 @@ impl<'a> PhotonSource<'a> {
         let skip_first = self.skip_first_from_point_lights && !light.is_area();
         counts.paths += 1;
         let mut first_interaction = true;
-        for _depth in 0..scene.settings.max_depth.max(1) * 4 {
+        for _depth in 0..scene.params.max_depth.max(1) * 4 {
             let Some(hit) = scene.geometry.intersect(&ray, f64::INFINITY) else {
                 return;
             };

@@ -94,7 +94,7 @@ impl EyeWalk<'_> {
             return;
         };
         out.direct += throughput * scene.emission(&hit, ray.dir);
-        if scene.objects[hit.object as usize].emission.is_some() || depth >= scene.settings.max_depth {
+        if scene.objects[hit.object as usize].emission.is_some() || depth >= scene.params.max_depth {
             return;
         }
         let surface = scene.surface(&hit, ray.dir);

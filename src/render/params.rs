@@ -1,0 +1,216 @@
+//! The one set of render parameters. The scene file's `[render]` table, the command line's
+//! flags and the viewer's controls overlay their values onto a [`RenderParams`]; the render
+//! session receives the whole set ([`crate::render::session::Command::SetParams`]), checks it
+//! with [`RenderParams::validate`] (over the ranges in [`super::limits`]) and asks
+//! [`RenderParams::restarts_from`] whether the change discards the accumulation; the
+//! integrators read it each pass.
+//!
+//! Adding a setting means a field here (with its default and its check in `validate`), the
+//! control that shows it and the code that uses it.
+
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+
+use super::limits;
+use super::ppm::IndexKind;
+
+/// Which renderer makes the image (`--renderer whitted|ppm` on the command line,
+/// `renderer = "whitted"|"ppm"` in a scene file).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum RendererKind {
+    /// The Whitted ray tracer (preview, and the seed report's first renderer).
+    Whitted,
+    /// Progressive photon mapping.
+    Ppm,
+}
+
+impl<'de> Deserialize<'de> for RendererKind {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        match String::deserialize(d)?.as_str() {
+            "whitted" => Ok(RendererKind::Whitted),
+            "ppm" => Ok(RendererKind::Ppm),
+            other => Err(serde::de::Error::custom(format!(
+                "'renderer' must be \"whitted\" or \"ppm\", got \"{other}\""
+            ))),
+        }
+    }
+}
+
+/// Every render setting, with the defaults a scene file's `[render]` table starts from.
+/// Camera settings (pose, lens, image size) belong to [`crate::scene::Camera`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RenderParams {
+    /// Renderer.
+    pub renderer: RendererKind,
+    /// Photons per photon-mapping pass (applies from the next pass, no restart).
+    pub photons_per_pass: u64,
+    /// PPM radius reduction α in (0, 1] (applies from the next update, no restart).
+    pub alpha: f64,
+    /// PPM initial radius in scene units (`None`: from the pixel footprint).
+    pub initial_radius: Option<f64>,
+    /// Maximum specular bounces of eye rays and photons.
+    pub max_depth: u32,
+    /// Seed of every random number.
+    pub seed: u64,
+    /// Edge-adaptive anti-aliasing in the ray tracer; jittered pixels (stochastic PPM) in
+    /// photon mapping.
+    pub antialias: bool,
+    /// Lens samples per pixel with an open aperture (ray tracer).
+    pub dof_samples: u32,
+    /// Shadow samples per area light per shading point (ray tracer).
+    pub light_samples: u32,
+    /// Ambient radiance added at diffuse surfaces by the ray tracer.
+    pub ambient: DVec3,
+    /// Photon mapping: direct light from point and spot lights by shadow rays at visible
+    /// points; their photons deposit only after the first bounce.
+    pub direct_light: bool,
+    /// Photon mapping: the spatial index over visible points (the image does not depend on it).
+    pub index: IndexKind,
+}
+
+impl Default for RenderParams {
+    fn default() -> Self {
+        Self {
+            renderer: RendererKind::Whitted,
+            photons_per_pass: 200_000,
+            alpha: 0.7,
+            initial_radius: None,
+            max_depth: 8,
+            seed: 1,
+            antialias: true,
+            dof_samples: 16,
+            light_samples: 16,
+            ambient: DVec3::ZERO,
+            direct_light: false,
+            index: IndexKind::HashGrid,
+        }
+    }
+}
+
+/// A parameter out of its range: the field's name (as the scene file spells it) and what is
+/// wrong ("must be …, got …").
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("'{field}' {problem}")]
+pub struct InvalidParam {
+    /// The field, as in a scene file's `[render]` table.
+    pub field: &'static str,
+    /// The end of the message.
+    pub problem: limits::Invalid,
+}
+
+impl RenderParams {
+    /// Checks every value against [`super::limits`]; the first one out of range is named.
+    pub fn validate(&self) -> Result<(), InvalidParam> {
+        let check = |field: &'static str, result: Result<(), limits::Invalid>| {
+            result.map_err(|problem| InvalidParam { field, problem })
+        };
+        check("alpha", limits::alpha(self.alpha).map(drop))?;
+        check(
+            "photons_per_pass",
+            limits::photons_per_pass(self.photons_per_pass).map(drop),
+        )?;
+        if let Some(r) = self.initial_radius {
+            check("initial_radius", limits::radius(r).map(drop))?;
+        }
+        check("max_depth", limits::max_depth(self.max_depth).map(drop))?;
+        check("dof_samples", limits::samples(self.dof_samples).map(drop))?;
+        check("light_samples", limits::samples(self.light_samples).map(drop))?;
+        let ambient = self.ambient;
+        if !(ambient.is_finite() && ambient.cmpge(DVec3::ZERO).all()) {
+            check(
+                "ambient",
+                Err(format!("must be finite and not negative, got {ambient}")),
+            )?;
+        }
+        Ok(())
+    }
+
+    /// Whether going from `old` to these values discards the accumulated image: every change
+    /// does except α and photons per pass, which apply from the next pass.
+    pub fn restarts_from(&self, old: &RenderParams) -> bool {
+        let kept = RenderParams {
+            alpha: old.alpha,
+            photons_per_pass: old.photons_per_pass,
+            ..self.clone()
+        };
+        kept != *old
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn validate_names_the_first_field_out_of_range() {
+        assert_eq!(RenderParams::default().validate(), Ok(()));
+        let bad = RenderParams {
+            alpha: 1.5,
+            ..Default::default()
+        };
+        assert_eq!(
+            bad.validate().expect_err("α 1.5").to_string(),
+            "'alpha' must be in (0, 1], got 1.5"
+        );
+        let bad = RenderParams {
+            initial_radius: Some(f64::NAN),
+            ..Default::default()
+        };
+        assert_eq!(bad.validate().expect_err("NaN").field, "initial_radius");
+        let bad = RenderParams {
+            ambient: DVec3::new(0.0, -1.0, 0.0),
+            ..Default::default()
+        };
+        assert_eq!(bad.validate().expect_err("negative").field, "ambient");
+    }
+
+    #[test]
+    fn only_alpha_and_photons_apply_without_restarting() {
+        let old = RenderParams::default();
+        let gentle = RenderParams {
+            alpha: 0.5,
+            photons_per_pass: 1000,
+            ..old.clone()
+        };
+        assert!(!gentle.restarts_from(&old));
+        for changed in [
+            RenderParams {
+                max_depth: 3,
+                ..gentle.clone()
+            },
+            RenderParams {
+                direct_light: true,
+                ..gentle.clone()
+            },
+            RenderParams {
+                renderer: RendererKind::Ppm,
+                ..gentle.clone()
+            },
+        ] {
+            assert!(changed.restarts_from(&old), "{changed:?}");
+        }
+    }
+
+    #[test]
+    fn serde_round_trip_with_defaults_for_missing_fields() {
+        let p: RenderParams =
+            toml::from_str("renderer = \"ppm\"\nalpha = 0.6\nindex = \"kd\"").expect("parses");
+        assert_eq!(
+            p,
+            RenderParams {
+                renderer: RendererKind::Ppm,
+                alpha: 0.6,
+                index: IndexKind::KdTree,
+                ..Default::default()
+            }
+        );
+        let text = toml::to_string(&p).expect("serializes");
+        assert_eq!(toml::from_str::<RenderParams>(&text).expect("round trip"), p);
+        assert!(
+            toml::from_str::<RenderParams>("alpah = 0.6").is_err(),
+            "unknown field"
+        );
+    }
+}
