@@ -25,6 +25,7 @@ height = 18
 antialias = false
 photons_per_pass = 100000
 alpha = 0.7
+direct_light = false
 
 [materials.floor]
 type = "diffuse"
@@ -225,6 +226,8 @@ fn ppm_is_identical_for_one_and_two_threads() {
         .expect("pool");
     for aperture in [0.0, 0.2] {
         let scene = cornell_small(aperture);
+        // Its quad light is sampled at the visible points (the default) as well as photon mapped.
+        assert!(scene.params.direct_light);
         let a = one.install(|| render_passes(&scene, PpmOptions::default(), 3));
         let b = two.install(|| render_passes(&scene, PpmOptions::default(), 3));
         assert_eq!(a, b, "aperture {aperture}");
@@ -438,9 +441,10 @@ fn pause_and_resume_lose_nothing() {
 
 #[test]
 fn direct_light_option_keeps_caustics() {
-    // A point light above a glass ball above a floor: under the ball all light is caustic (the
-    // shadow ray is blocked), so computing direct light by shadow rays must not lose it.
-    let text = r#"
+    // A light above a glass ball above a floor: under the ball all light is caustic (the
+    // shadow ray is blocked), so computing direct light by light sampling must not lose it —
+    // for a point light and for area lights alike.
+    let template = r#"
 [camera]
 position = [2.5, 0.4, 0.0]
 look_at = [0, 0, 0]
@@ -463,9 +467,7 @@ color = [1, 1, 1]
 ior = 1.5
 
 [[lights]]
-type = "point"
-position = [0, 6, 0]
-power = 500
+LIGHT
 
 [[objects]]
 type = "sphere"
@@ -479,20 +481,28 @@ point = [0, 0, 0]
 normal = [0, 1, 0]
 material = "floor"
 "#;
-    let scene = Scene::from_str(text, Path::new("caustic.toml"), None).expect("scene");
-    let mean = |direct_light: bool| {
-        let mut scene = scene.clone();
-        scene.params.direct_light = direct_light;
-        let image = render_passes(&scene, PpmOptions::default(), 12);
-        image.iter().map(|p| p[0] as f64).sum::<f64>() / image.len() as f64
-    };
-    let (photons_only, with_direct) = (mean(false), mean(true));
-    assert!(photons_only > 0.0);
-    let ratio = with_direct / photons_only;
-    assert!(
-        (ratio - 1.0).abs() < 0.1,
-        "direct-light option changes the caustic: ratio {ratio}"
-    );
+    let lights = [
+        "type = \"point\"\nposition = [0, 6, 0]\npower = 500",
+        "type = \"sphere\"\ncenter = [0, 6, 0]\nradius = 0.3\npower = 500",
+        "type = \"quad\"\ncorner = [-0.3, 6, -0.3]\nedge_u = [0.6, 0, 0]\nedge_v = [0, 0, 0.6]\npower = 500",
+    ];
+    for light in lights {
+        let text = template.replace("LIGHT", light);
+        let scene = Scene::from_str(&text, Path::new("caustic.toml"), None).expect("scene");
+        let mean = |direct_light: bool| {
+            let mut scene = scene.clone();
+            scene.params.direct_light = direct_light;
+            let image = render_passes(&scene, PpmOptions::default(), 12);
+            image.iter().map(|p| p[0] as f64).sum::<f64>() / image.len() as f64
+        };
+        let (photons_only, with_direct) = (mean(false), mean(true));
+        assert!(photons_only > 0.0);
+        let ratio = with_direct / photons_only;
+        assert!(
+            (ratio - 1.0).abs() < 0.1,
+            "direct light by light sampling changes the caustic of {light}: ratio {ratio}"
+        );
+    }
 }
 
 #[test]
@@ -588,4 +598,144 @@ fn control_point_moves_render_like_the_edited_scene_built_from_scratch() {
         ppm.radiance().as_slice(),
         "the session's edited render differs"
     );
+}
+
+/// The plane scene lit by `light` (a `[[lights]]` table's body) instead of its point light,
+/// with direct light by light sampling on or off.
+fn plane_lit_by(light: &str, direct_light: bool) -> Scene {
+    let text = PLANE
+        .replace(
+            "[[lights]]\ntype = \"point\"\nposition = [0.5, 3.0, 0.2]\npower = 400\n",
+            &format!("[[lights]]\n{light}\n"),
+        )
+        .replace("direct_light = false", &format!("direct_light = {direct_light}"));
+    assert!(text.contains(light), "the light was not replaced");
+    Scene::from_str(&text, Path::new("plane_lit.toml"), None).expect("scene")
+}
+
+fn mean_red(image: &[[f32; 3]]) -> f64 {
+    image.iter().map(|p| p[0] as f64).sum::<f64>() / image.len() as f64
+}
+
+/// A uniformly emitting sphere lights every receiver that sees all of it exactly as a point
+/// light of the same power at its centre does. (Photons once started on the sphere's own
+/// surface and half of them hit it again at once: the sphere gave about half the light.)
+#[test]
+fn a_sphere_light_lights_like_a_point_light_of_equal_power() {
+    // Out of the camera's view, so only the light it casts is seen.
+    let point = plane_lit_by("type = \"point\"\nposition = [2.0, 2.0, 0.0]\npower = 400", false);
+    let sphere = plane_lit_by(
+        "type = \"sphere\"\ncenter = [2.0, 2.0, 0.0]\nradius = 0.3\npower = 400",
+        false,
+    );
+    let [a, b] = [point, sphere].map(|scene| mean_red(&render_passes(&scene, PpmOptions::default(), 8)));
+    assert!((b / a - 1.0).abs() < 0.01, "sphere / point = {}", b / a);
+}
+
+/// Irradiance at `x` (normal `n`) from a uniformly emitting parallelogram of radiance `l`, by
+/// Lambert's formula for polygons: `E = L/2 · Σ Θᵢ (n · Γᵢ)`.
+fn quad_irradiance(x: DVec3, n: DVec3, corner: DVec3, eu: DVec3, ev: DVec3, l: DVec3) -> DVec3 {
+    let vertices = [corner, corner + eu, corner + eu + ev, corner + ev];
+    let mut sum = 0.0;
+    for i in 0..4 {
+        let a = (vertices[i] - x).normalize();
+        let b = (vertices[(i + 1) % 4] - x).normalize();
+        sum += a.dot(b).clamp(-1.0, 1.0).acos() * n.dot(a.cross(b).normalize());
+    }
+    l * 0.5 * sum.abs()
+}
+
+/// The closed form of the direct light the plane reflects to each pixel.
+fn closed_form(scene: &Scene) -> Vec<DVec3> {
+    use caustic::scene::light::spot_falloff;
+    use caustic::scene::Light;
+    let rho = DVec3::new(0.8, 0.6, 0.4);
+    let n = DVec3::Y;
+    let irradiance = |p: DVec3| -> DVec3 {
+        let point_like = |position: DVec3, intensity: DVec3, falloff: f64| {
+            let d = position - p;
+            intensity * falloff * n.dot(d.normalize()) / d.length_squared()
+        };
+        match scene.lights[0] {
+            Light::Point { position, intensity } => point_like(position, intensity, 1.0),
+            // Seen whole from every receiver: a point light of equal power (I = L·πR²).
+            Light::Sphere {
+                center,
+                radius,
+                radiance,
+            } => point_like(center, radiance * PI * radius * radius, 1.0),
+            Light::Spot {
+                position,
+                direction,
+                intensity,
+                cos_inner,
+                cos_outer,
+            } => {
+                let wi = (position - p).normalize();
+                point_like(
+                    position,
+                    intensity,
+                    spot_falloff(-wi.dot(direction), cos_inner, cos_outer),
+                )
+            }
+            Light::Quad {
+                corner,
+                edge_u,
+                edge_v,
+                radiance,
+            } => quad_irradiance(p, n, corner, edge_u, edge_v, radiance),
+        }
+    };
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .map(|(x, y)| {
+            let ray = scene.camera.ray(Scene::pixel_center(x, y), DVec2::ZERO);
+            rho / PI * irradiance(ray.at(-ray.origin.y / ray.dir.y))
+        })
+        .collect()
+}
+
+/// Every light kind, out of the camera's view above the diffuse plane.
+const LIGHT_KINDS: [(&str, &str); 4] = [
+    ("point", "type = \"point\"\nposition = [2.0, 2.0, 0.0]\npower = 400"),
+    (
+        "spot",
+        "type = \"spot\"\nposition = [2.0, 2.0, 0.0]\ndirection = [-1, -1, 0]\ncone_angle = 70\ncone_falloff = 20\npower = 400",
+    ),
+    (
+        "sphere",
+        "type = \"sphere\"\ncenter = [2.0, 2.0, 0.0]\nradius = 0.3\npower = 400",
+    ),
+    (
+        "quad",
+        "type = \"quad\"\ncorner = [1.7, 2.0, -0.3]\nedge_u = [0.6, 0, 0]\nedge_v = [0, 0, 0.6]\npower = 400",
+    ),
+];
+
+/// For every light kind, direct light by light sampling agrees with photon mapping and with the
+/// closed form (image means within 1 %).
+#[test]
+fn light_sampling_agrees_with_photons_and_the_closed_form_for_every_light() {
+    for (kind, light) in LIGHT_KINDS {
+        let photons = plane_lit_by(light, false);
+        let sampled = plane_lit_by(light, true);
+        let expected = closed_form(&sampled);
+        let expected_mean = expected.iter().map(|e| e.x).sum::<f64>() / expected.len() as f64;
+        let by_photons = mean_red(&render_passes(&photons, PpmOptions::default(), 8));
+        let by_sampling = mean_red(&render_passes(&sampled, PpmOptions::default(), 8));
+        eprintln!(
+            "{kind}: photons {by_photons:.5}, sampling {by_sampling:.5}, closed form {expected_mean:.5}"
+        );
+        assert!(
+            (by_sampling / expected_mean - 1.0).abs() < 0.01,
+            "{kind}: light sampling / closed form = {}",
+            by_sampling / expected_mean
+        );
+        assert!(
+            (by_photons / by_sampling - 1.0).abs() < 0.01,
+            "{kind}: photons / light sampling = {}",
+            by_photons / by_sampling
+        );
+    }
 }

@@ -268,8 +268,8 @@ pub fn side_panel_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) 
         {
             p.set_auto_radius(false);
         }
-        ui.checkbox(&mut p.render.direct_light, "Direct light by shadow rays")
-            .on_hover_text("Point and spot lights lit exactly with shadow rays; their photons count only after the first bounce (caustics kept). Restarts.");
+        ui.checkbox(&mut p.render.direct_light, "Direct light by light sampling")
+            .on_hover_text("Direct light from every light by shadow rays at the visible points (area lights: one sample per pass); photons carry only caustics and indirect light. Off: photons carry everything. Restarts.");
         ui.horizontal(|ui| {
             ui.label("Index").on_hover_text("Spatial index over visible points; the image is the same, the speed differs");
             ui.selectable_value(&mut p.render.index, IndexKind::HashGrid, "Hash grid")

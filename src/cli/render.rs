@@ -65,10 +65,11 @@ pub struct PpmArgs {
     /// Photon mapping: spatial index over visible points (default: the scene's, or grid).
     #[arg(long, value_enum)]
     index: Option<IndexKind>,
-    /// Photon mapping: direct light from point/spot lights by shadow rays (default: the
-    /// scene's `direct_light`).
-    #[arg(long)]
-    direct_light: bool,
+    /// Photon mapping: direct light by light sampling, photons for caustics and indirect
+    /// light only (default: the scene's `direct_light`, on unless it says otherwise).
+    #[arg(long, value_name = "on|off", action = clap::ArgAction::Set,
+          value_parser = clap::builder::BoolishValueParser::new())]
+    direct_light: Option<bool>,
 }
 
 impl PpmArgs {
@@ -87,7 +88,9 @@ impl PpmArgs {
         if let Some(index) = self.index {
             params.index = index;
         }
-        params.direct_light |= self.direct_light;
+        if let Some(on) = self.direct_light {
+            params.direct_light = on;
+        }
         params.validate().map_err(|e| {
             let flag = match e.field {
                 "photons_per_pass" => "--photons",

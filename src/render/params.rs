@@ -63,8 +63,10 @@ pub struct RenderParams {
     pub light_samples: u32,
     /// Ambient radiance added at diffuse surfaces by the ray tracer.
     pub ambient: DVec3,
-    /// Photon mapping: direct light from point and spot lights by shadow rays at visible
-    /// points; their photons deposit only after the first bounce.
+    /// Photon mapping: direct light by light sampling at the visible points — exact shadow
+    /// rays for point and spot lights, one stratified sample per area light per pass — with
+    /// photons deposited only after their first bounce (caustics and indirect light). On by
+    /// default; off, photons carry all the light (classic PPM).
     pub direct_light: bool,
     /// Photon mapping: the spatial index over visible points (the image does not depend on it).
     pub index: IndexKind,
@@ -83,7 +85,7 @@ impl Default for RenderParams {
             dof_samples: 16,
             light_samples: 16,
             ambient: DVec3::ZERO,
-            direct_light: false,
+            direct_light: true,
             index: IndexKind::HashGrid,
         }
     }
@@ -181,7 +183,7 @@ mod tests {
                 ..gentle.clone()
             },
             RenderParams {
-                direct_light: true,
+                direct_light: false,
                 ..gentle.clone()
             },
             RenderParams {

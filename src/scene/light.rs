@@ -186,6 +186,19 @@ pub struct Emission {
     /// Flux carried, as a multiple of the light's power divided by the photons emitted from it
     /// (1 for uniform emission; a spot's falloff, or aiming at the scene, changes it).
     pub weight: f64,
+    /// The light's surface normal at `origin` (area lights): the photon's ray must leave that
+    /// surface, or it meets the light itself at once and is lost.
+    pub surface_normal: Option<DVec3>,
+}
+
+impl Emission {
+    /// The photon's first ray, pushed off the light's own surface for area lights.
+    pub fn ray(&self) -> crate::geometry::Ray {
+        match self.surface_normal {
+            Some(n) => crate::geometry::ray::spawn_ray(self.origin, n, self.dir),
+            None => crate::geometry::Ray::new(self.origin, self.dir),
+        }
+    }
 }
 
 /// A uniformly distributed unit vector.
@@ -239,12 +252,14 @@ impl Light {
                         origin: *position,
                         dir,
                         weight,
+                        surface_normal: None,
                     };
                 }
                 Emission {
                     origin: *position,
                     dir: uniform_sphere(u1),
                     weight: 1.0,
+                    surface_normal: None,
                 }
             }
             Light::Spot {
@@ -264,6 +279,7 @@ impl Light {
                     origin: *position,
                     dir,
                     weight: falloff * cone / effective,
+                    surface_normal: None,
                 }
             }
             Light::Sphere { center, radius, .. } => {
@@ -272,6 +288,7 @@ impl Light {
                     origin: *center + n * *radius,
                     dir: cosine_hemisphere(n, u2),
                     weight: 1.0,
+                    surface_normal: Some(n),
                 }
             }
             Light::Quad {
@@ -285,6 +302,7 @@ impl Light {
                     origin: *corner + u1.x * *edge_u + u1.y * *edge_v,
                     dir: cosine_hemisphere(n, u2),
                     weight: 1.0,
+                    surface_normal: Some(n),
                 }
             }
         }

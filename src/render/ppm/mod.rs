@@ -17,6 +17,7 @@
 //! `(seed, pass, pixel)`; photons are traced in fixed chunks whose deposits are applied in
 //! chunk order, so the image is bit-identical for any number of threads.
 
+pub mod direct;
 pub mod hash_grid;
 pub mod kd_tree;
 pub mod photon;
@@ -187,6 +188,8 @@ pub struct PpmStats {
     pub eye_secs: f64,
     /// Seconds spent building the spatial index over visible points.
     pub index_secs: f64,
+    /// Seconds spent sampling area lights at the visible points.
+    pub direct_secs: f64,
     /// Eye passes run.
     pub eye_passes: u32,
     /// Work the scene did not need, in words.
@@ -215,7 +218,7 @@ pub enum Control {
 /// A progressive photon mapping render in progress.
 pub struct Ppm {
     options: PpmOptions,
-    /// Direct light by shadow rays (from the render parameters).
+    /// Direct light by light sampling (from the render parameters).
     direct_light: bool,
     /// The spatial index (from the render parameters).
     index: IndexKind,
@@ -230,6 +233,9 @@ pub struct Ppm {
     direct: Vec<DVec3>,
     /// This stochastic pass's directly seen light, added to `direct` when the pass completes.
     pass_direct: Vec<DVec3>,
+    /// Area light sampled at the visible points, summed over completed passes, per pixel
+    /// (empty unless direct light is on and the scene has area lights).
+    area_direct: Vec<DVec3>,
     stats: PpmStats,
     width: u32,
     height: u32,
@@ -262,8 +268,7 @@ impl Ppm {
             skipped.push("no textures: constant colours, no lookups".to_owned());
         }
         if scene.params.direct_light {
-            skipped
-                .push("first photon bounce from point/spot lights: direct light by shadow rays".to_owned());
+            skipped.push("photons' first diffuse bounce: direct light by light sampling".to_owned());
         }
         if let Some(target) = scene.geometry.bounding_sphere() {
             if scene.lights.iter().any(|l| l.aims_at(target)) {
@@ -283,6 +288,11 @@ impl Ppm {
             points: Vec::new(),
             direct: vec![DVec3::ZERO; pixels],
             pass_direct: Vec::new(),
+            area_direct: if scene.params.direct_light && direct::has_area_lights(scene) {
+                vec![DVec3::ZERO; pixels]
+            } else {
+                Vec::new()
+            },
             stats: PpmStats {
                 skipped,
                 ..Default::default()
@@ -459,6 +469,7 @@ impl Ppm {
             return PassOutcome::Aborted;
         };
         self.stats.photon_secs += photon_start.elapsed().as_secs_f64();
+        self.sample_area_lights(scene);
         self.update(gathered);
         self.stats.elapsed_secs += start.elapsed().as_secs_f64();
         PassOutcome::Completed
@@ -579,6 +590,27 @@ impl Ppm {
         self.stats.mean_radius = gathered.iter().sum::<f64>() / gathered.len().max(1) as f64;
     }
 
+    /// Adds one light sample of every area light at each visible point of this pass to the
+    /// per-pixel sums (when direct light is on; see [`direct`]).
+    fn sample_area_lights(&mut self, scene: &Scene) {
+        if self.area_direct.is_empty() {
+            return;
+        }
+        let start = Instant::now();
+        let slots = &self.slots;
+        let light = direct::area_light_pass(
+            scene,
+            &self.points,
+            |k| self.points[k].slot as u64,
+            self.stats.passes as u64,
+            self.seed,
+        );
+        for (vp, l) in self.points.iter().zip(light) {
+            self.area_direct[slots[vp.slot as usize].pixel as usize] += l;
+        }
+        self.stats.direct_secs += start.elapsed().as_secs_f64();
+    }
+
     /// Linear RGB radiance per pixel: `τ/(π R² N_emitted)` of every slot of the pixel plus the
     /// mean of the light seen directly.
     pub fn radiance(&self) -> Vec<[f32; 3]> {
@@ -592,6 +624,10 @@ impl Ppm {
             }
         }
         let eye = self.stats.eye_passes.max(1) as f64;
+        let passes = self.stats.passes.max(1) as f64;
+        for (o, a) in out.iter_mut().zip(&self.area_direct) {
+            *o += *a / passes;
+        }
         out.iter()
             .zip(&self.direct)
             .map(|(l, d)| {

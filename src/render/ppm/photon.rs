@@ -9,7 +9,6 @@ use glam::{DVec2, DVec3};
 use rand::Rng;
 use rand_pcg::Pcg64Mcg;
 
-use crate::geometry::Ray;
 use crate::scene::light::cosine_hemisphere;
 use crate::scene::material::{dielectric, reflect};
 use crate::scene::{MaterialKind, Scene};
@@ -37,11 +36,11 @@ pub struct PhotonSource<'a> {
     pub flux: Vec<DVec3>,
     /// The scene's bounding sphere, for aiming lights outside it.
     pub target: Option<(DVec3, f64)>,
-    /// Skip the deposit where a photon from a point/spot light first meets anything, when that
-    /// is a diffuse surface: that is direct light, computed exactly by shadow rays at the
-    /// visible points. Photons that reached the surface through mirrors or glass (caustics) are
-    /// still gathered — a shadow ray cannot see them.
-    pub skip_first_from_point_lights: bool,
+    /// Skip the deposit where a photon first meets anything, when that is a diffuse surface:
+    /// that is direct light, computed by light sampling at the visible points. Photons that
+    /// reached the surface through mirrors or glass (caustics) are still gathered — a shadow
+    /// ray cannot see them.
+    pub skip_direct: bool,
 }
 
 impl<'a> PhotonSource<'a> {
@@ -72,12 +71,12 @@ impl<'a> PhotonSource<'a> {
             cdf,
             flux,
             target: scene.geometry.bounding_sphere(),
-            skip_first_from_point_lights: direct_light,
+            skip_direct: direct_light,
         }
     }
 
     /// Traces one photon path with `rng`. At every diffuse hit whose flux should be gathered
-    /// (all but direct hits from point/spot lights when direct light is computed separately),
+    /// (all but direct hits when direct light is computed by light sampling),
     /// calls `gather(point, normal facing the photon, flux)`.
     pub fn trace(
         &self,
@@ -98,8 +97,8 @@ impl<'a> PhotonSource<'a> {
             self.target,
         );
         let mut flux = self.flux[light_index] * e.weight;
-        let mut ray = Ray::new(e.origin, e.dir);
-        let skip_first = self.skip_first_from_point_lights && !light.is_area();
+        let mut ray = e.ray();
+        let skip_first = self.skip_direct;
         counts.paths += 1;
         let mut first_interaction = true;
         for _depth in 0..scene.params.max_depth.max(1) * 4 {

@@ -152,8 +152,8 @@ impl EyeWalk<'_> {
     }
 }
 
-/// Whether direct light from this light is computed by shadow rays when that option is on
-/// (point and spot lights; area lights are left to photons).
+/// Whether the eye pass computes this light's direct light by one exact shadow ray when direct
+/// light is on (point and spot lights); area lights are sampled each pass by [`super::direct`].
 pub fn direct_by_shadow_rays(light: &Light) -> bool {
     !light.is_area()
 }
