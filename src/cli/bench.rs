@@ -56,7 +56,7 @@ pub enum BenchCommand {
         threads: Vec<usize>,
     },
     /// Photon mapping: RMSE against a long reference render over time, for the hash grid and
-    /// the kd-tree, with and without direct light by shadow rays.
+    /// the kd-tree, with and without direct light by light sampling.
     Convergence {
         /// Scene file; smallppm's scene (built in) when omitted.
         scene: Option<PathBuf>,
@@ -69,7 +69,7 @@ pub enum BenchCommand {
         /// Passes of each measured configuration.
         #[arg(long, default_value_t = 32)]
         passes: u32,
-        /// Passes of the reference render (grid, no direct light, another seed).
+        /// Passes of the reference render (the scene's own settings, another seed).
         #[arg(long, default_value_t = 400)]
         reference_passes: u32,
         /// Write every (configuration, pass, seconds, RMSE) row to this CSV file.

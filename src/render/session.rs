@@ -410,14 +410,12 @@ fn enlarge<T: Copy>(src: &[T], (sw, sh): (u32, u32), (w, h): (u32, u32)) -> Arc<
 
 /// One photon-mapping pass at 1/`divisor` of the resolution, enlarged: the first picture of a
 /// new epoch. `None` when interrupted.
-fn preview(
-    scene: &mut Scene,
-    options: &SessionOptions,
-    divisor: u32,
-    interrupted: &Interrupt,
-    epoch: u64,
-    epoch_start: Instant,
-) -> Option<Frame> {
+fn preview(scene: &mut Scene, options: &SessionOptions, divisor: u32, step: Step) -> Option<Frame> {
+    let Step {
+        epoch,
+        epoch_start,
+        interrupted,
+    } = step;
     let (w, h) = (scene.camera.width, scene.camera.height);
     let small = ((w / divisor.max(1)).max(1), (h / divisor.max(1)).max(1));
     (scene.camera.width, scene.camera.height) = small;
@@ -647,7 +645,74 @@ fn trace(scene: &Scene, epoch: u64, epoch_start: Instant, interrupted: &Interrup
     })
 }
 
-/// The render thread: a loop over [`SessionState::next`].
+/// The renderer of an epoch, made from the scene's parameters when the epoch opens.
+enum Integrator {
+    /// Progressive photon mapping: a pass at a time.
+    PhotonMapping(Box<Ppm>),
+    /// The Whitted ray tracer: one frame per epoch.
+    RayTracer,
+}
+
+/// What a pass or frame needs from the session's loop.
+struct Step<'a> {
+    epoch: u64,
+    epoch_start: Instant,
+    interrupted: &'a Interrupt,
+}
+
+impl Integrator {
+    /// The integrator `scene.params.renderer` names.
+    fn new(scene: &Scene, options: PpmOptions, interrupted: &Interrupt) -> Self {
+        match scene.params.renderer {
+            RendererKind::Ppm => {
+                let mut ppm = Ppm::new(scene, options);
+                ppm.set_interrupt(Some(interrupted.clone()));
+                Integrator::PhotonMapping(Box::new(ppm))
+            }
+            RendererKind::Whitted => Integrator::RayTracer,
+        }
+    }
+
+    /// Renders the next pass (or the frame) with the state's α and photon ramp; `control` is
+    /// asked between photon batches. `None` when the pass was abandoned; the state's pass count
+    /// is updated otherwise.
+    fn render(
+        &mut self,
+        scene: &Scene,
+        state: &mut SessionState,
+        step: Step,
+        control: &mut dyn FnMut(&mut SessionState) -> Control,
+    ) -> Option<Frame> {
+        match self {
+            Integrator::RayTracer => {
+                let frame = trace(scene, step.epoch, step.epoch_start, step.interrupted)?;
+                state.passes = 1;
+                Some(frame)
+            }
+            Integrator::PhotonMapping(ppm) => {
+                ppm.alpha = state.params.alpha;
+                ppm.photons_per_pass = state.pass_photons(ppm.stats().passes);
+                let mut between_batches = |alpha: &mut f64| {
+                    let c = control(state);
+                    *alpha = state.params.alpha;
+                    c
+                };
+                if ppm.run_pass(scene, &mut between_batches) != PassOutcome::Completed {
+                    return None;
+                }
+                state.passes = ppm.stats().passes;
+                Some(Frame::from_ppm(
+                    ppm,
+                    step.epoch,
+                    step.epoch_start.elapsed().as_secs_f64(),
+                ))
+            }
+        }
+    }
+}
+
+/// The render thread: a loop over [`SessionState::next`], carried out by the epoch's
+/// [`Integrator`].
 fn run(
     mut scene: Scene,
     options: SessionOptions,
@@ -659,13 +724,8 @@ fn run(
         let flag = interrupt.clone();
         Arc::new(move || flag.load(Ordering::Acquire))
     };
-    let new_ppm = |scene: &Scene| {
-        let mut ppm = Ppm::new(scene, options.ppm);
-        ppm.set_interrupt(Some(interrupted.clone()));
-        ppm
-    };
     let mut state = SessionState::new(&scene, options);
-    let mut ppm = new_ppm(&scene);
+    let mut integrator = Integrator::new(&scene, options.ppm, &interrupted);
     let mut epoch_start = Instant::now();
     loop {
         // Whatever interrupted a pass is among the commands drained here.
@@ -673,54 +733,41 @@ fn run(
         if !drain(&mut state, &commands) {
             return;
         }
-        match state.next(epoch_start.elapsed()) {
+        let step = Step {
+            epoch: state.epoch,
+            epoch_start,
+            interrupted: &interrupted,
+        };
+        let frame = match state.next(epoch_start.elapsed()) {
             Next::Stop => return,
-            Next::Wait => {}
+            Next::Wait => None,
             Next::Restart => {
                 state.restart(&mut scene);
-                ppm = new_ppm(&scene);
+                integrator = Integrator::new(&scene, options.ppm, &interrupted);
                 epoch_start = Instant::now();
+                None
             }
             Next::Preview => {
                 state.preview_due = false;
                 let divisor = options.preview_divisor.unwrap_or(4);
-                if let Some(frame) = preview(
-                    &mut scene,
-                    &options,
-                    divisor,
-                    &interrupted,
-                    state.epoch,
-                    epoch_start,
-                ) {
-                    offer(frame, output, options.every_frame);
-                }
+                preview(&mut scene, &options, divisor, step)
             }
-            Next::Trace => {
-                if let Some(frame) = trace(&scene, state.epoch, epoch_start, &interrupted) {
-                    state.passes = 1;
-                    offer(frame, output, options.every_frame);
-                }
-            }
-            Next::Pass => {
-                ppm.alpha = state.params.alpha;
-                ppm.photons_per_pass = state.pass_photons(ppm.stats().passes);
+            Next::Pass | Next::Trace => {
                 // Between batches: commands apply; a restart or the end drops the pass.
-                let mut control = |alpha: &mut f64| {
+                let mut control = |state: &mut SessionState| {
                     interrupt.store(false, Ordering::Release);
-                    drain(&mut state, &commands);
-                    *alpha = state.params.alpha;
+                    drain(state, &commands);
                     if state.must_abort() {
                         Control::Abort
                     } else {
                         Control::Continue
                     }
                 };
-                if ppm.run_pass(&scene, &mut control) == PassOutcome::Completed {
-                    state.passes = ppm.stats().passes;
-                    let frame = Frame::from_ppm(&ppm, state.epoch, epoch_start.elapsed().as_secs_f64());
-                    offer(frame, output, options.every_frame);
-                }
+                integrator.render(&scene, &mut state, step, &mut control)
             }
+        };
+        if let Some(frame) = frame {
+            offer(frame, output, options.every_frame);
         }
     }
 }
