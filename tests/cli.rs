@@ -256,3 +256,61 @@ fn photon_benches_run_from_any_directory_on_the_built_in_scene() {
     assert!(out.status.success(), "{t}");
     assert!(t.contains("<built-in smallppm>, 1024x768"), "{t}");
 }
+
+/// `bench convergence` on a tiny configuration: a table, a CSV with the expected columns, a
+/// readable PNG plot, and a cached reference reused on the second run.
+#[test]
+fn convergence_bench_writes_its_csv_and_plot_and_reuses_the_reference() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let csv = dir.path().join("curves.csv");
+    let plot = dir.path().join("curves.png");
+    let refs = dir.path().join("references");
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "bench",
+            "convergence",
+            "scenes/cornell.toml",
+            "--width",
+            "16",
+            "--photons",
+            "2000",
+            "--seconds",
+            "0.3",
+            "--reference-passes",
+            "4",
+            "--configs",
+            "photons-only,default",
+            "--reference-dir",
+            refs.to_str().expect("utf-8"),
+        ];
+        args.extend_from_slice(extra);
+        caustic(&args)
+    };
+    let out = run(&[
+        "--csv",
+        csv.to_str().expect("utf-8"),
+        "--plot",
+        plot.to_str().expect("utf-8"),
+    ]);
+    assert!(out.status.success(), "{}", text(&out));
+    assert!(text(&out).contains("speed-up"), "{}", text(&out));
+    let rows = std::fs::read_to_string(&csv).expect("CSV");
+    let mut lines = rows.lines();
+    assert_eq!(lines.next(), Some("configuration,pass,seconds,rmse,rel_mse"));
+    let body: Vec<&str> = lines.collect();
+    assert!(body.iter().all(|l| l.split(',').count() == 5), "{rows}");
+    for name in ["photons only (old default)", "default (light sampling)"] {
+        assert!(
+            body.iter().any(|l| l.starts_with(name)),
+            "no rows of {name}: {rows}"
+        );
+    }
+    let png = image::open(&plot).expect("readable PNG");
+    assert_eq!((png.width(), png.height()), caustic::bench::plot::SIZE);
+    // The second run finds the reference it cached; existing outputs are not replaced.
+    let again = run(&["--csv", csv.to_str().expect("utf-8")]);
+    assert!(!again.status.success(), "overwrote the CSV");
+    let again = run(&[]);
+    assert!(again.status.success(), "{}", text(&again));
+    assert!(text(&again).contains("(cached)"), "{}", text(&again));
+}

@@ -3,14 +3,13 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use clap::{Subcommand, ValueEnum};
 
 use super::{load_scene, photon_map, ppm_stats};
 use caustic::assets::SMALLPPM_SCENE;
 use caustic::bench::{teapot_geometry, teapot_view, time_intersect};
 use caustic::geometry::{PatchMethod, SubdivisionParams};
-use caustic::render::ppm::IndexKind;
 use caustic::render::render_whitted;
 use caustic::render::session::SessionOptions;
 use caustic::scene::{RendererKind, Scene};
@@ -55,26 +54,48 @@ pub enum BenchCommand {
         #[arg(long, value_delimiter = ',', default_value = "1,2")]
         threads: Vec<usize>,
     },
-    /// Photon mapping: RMSE against a long reference render over time, for the hash grid and
-    /// the kd-tree, with and without direct light by light sampling.
+    /// Photon mapping: error against wall time for several configurations (old and new
+    /// defaults, α, initial radius, index) against a long reference render, cached on disk.
+    /// Prints a table; writes a CSV and a log-log plot on request.
     Convergence {
         /// Scene file; smallppm's scene (built in) when omitted.
         scene: Option<PathBuf>,
         /// Image width (height follows the scene's aspect).
         #[arg(long, default_value_t = 256)]
         width: u32,
-        /// Photons per pass.
-        #[arg(long, default_value_t = 100_000)]
-        photons: u64,
-        /// Passes of each measured configuration.
-        #[arg(long, default_value_t = 32)]
-        passes: u32,
-        /// Passes of the reference render (the scene's own settings, another seed).
-        #[arg(long, default_value_t = 400)]
+        /// Photons per pass (default: the scene's).
+        #[arg(long)]
+        photons: Option<u64>,
+        /// Seconds each configuration renders.
+        #[arg(long, default_value_t = 10.0)]
+        seconds: f64,
+        /// Seconds the first configuration (the baseline) renders, when not --seconds: its
+        /// final error is the target the others are timed to.
+        #[arg(long)]
+        baseline_seconds: Option<f64>,
+        /// Passes of the reference render (the scene's settings, another seed).
+        #[arg(long, default_value_t = 1000)]
         reference_passes: u32,
-        /// Write every (configuration, pass, seconds, RMSE) row to this CSV file.
+        /// Where reference renders are cached (default: ~/.cache/caustic/references).
+        #[arg(long)]
+        reference_dir: Option<PathBuf>,
+        /// Configurations to measure, the first being the baseline.
+        #[arg(
+            long,
+            value_enum,
+            value_delimiter = ',',
+            default_value = "photons-only,default,alpha-0.5,alpha-0.667,alpha-0.9,radius-x4,kd-tree"
+        )]
+        configs: Vec<super::convergence::Config>,
+        /// Write every (configuration, pass, seconds, RMSE, relMSE) row to this CSV file.
         #[arg(long)]
         csv: Option<PathBuf>,
+        /// Write the log-log plot of RMSE against seconds to this PNG file.
+        #[arg(long)]
+        plot: Option<PathBuf>,
+        /// Replace existing CSV and plot files.
+        #[arg(long)]
+        force: bool,
     },
     /// Whitted ray tracer: rays per second on a scene, at the given thread counts.
     Whitted {
@@ -130,17 +151,27 @@ pub fn bench(what: BenchCommand) -> Result<()> {
             scene,
             width,
             photons,
-            passes,
+            seconds,
+            baseline_seconds,
             reference_passes,
+            reference_dir,
+            configs,
             csv,
-        } => bench_convergence(
-            scene.as_deref(),
+            plot,
+            force,
+        } => super::convergence::bench_convergence(super::convergence::ConvergenceArgs {
+            scene: photon_scene(scene.as_deref())?,
             width,
             photons,
-            passes,
+            seconds,
+            baseline_seconds,
             reference_passes,
-            csv.as_deref(),
-        ),
+            reference_dir,
+            configs,
+            csv,
+            plot,
+            force,
+        }),
     }
 }
 
@@ -188,105 +219,6 @@ fn bench_ppm(scene_path: Option<&Path>, photons: u64, passes: u32, threads: &[us
             stats.photon_secs,
             rate / n as f64
         );
-    }
-    Ok(())
-}
-
-fn rmse(a: &[[f32; 3]], b: &[[f32; 3]]) -> f64 {
-    let sum: f64 = a
-        .iter()
-        .zip(b)
-        .map(|(x, y)| (0..3).map(|c| (x[c] as f64 - y[c] as f64).powi(2)).sum::<f64>())
-        .sum();
-    (sum / (3 * a.len()) as f64).sqrt()
-}
-
-fn bench_convergence(
-    scene_path: Option<&Path>,
-    width: u32,
-    photons: u64,
-    passes: u32,
-    reference_passes: u32,
-    csv: Option<&Path>,
-) -> Result<()> {
-    if photons == 0 || passes == 0 || reference_passes == 0 || width == 0 {
-        bail!("--width, --photons, --passes and --reference-passes must be at least 1");
-    }
-    if let Some(p) = csv {
-        if p.exists() {
-            bail!("{}: the file exists; choose another name", p.display());
-        }
-    }
-    let mut scene = photon_scene(scene_path)?;
-    let aspect = scene.camera.height as f64 / scene.camera.width as f64;
-    scene.camera.width = width;
-    scene.camera.height = ((width as f64 * aspect).round() as u32).max(1);
-    scene.params.photons_per_pass = photons;
-    println!(
-        "Convergence on {}, {}x{}, {photons} photons per pass; reference: {reference_passes} passes",
-        scene.source.display(),
-        scene.camera.width,
-        scene.camera.height
-    );
-    scene.params.renderer = RendererKind::Ppm;
-    let mut reference_scene = scene.clone();
-    reference_scene.params.seed ^= 0x5eed;
-    let bar = indicatif::ProgressBar::new(reference_passes as u64);
-    let limit = |passes| SessionOptions {
-        max_passes: Some(passes),
-        ..Default::default()
-    };
-    let reference = photon_map(reference_scene, limit(reference_passes), |_| bar.inc(1))?.radiance;
-    bar.finish_and_clear();
-    let configs = [
-        ("hash grid", IndexKind::HashGrid, false),
-        ("kd-tree", IndexKind::KdTree, false),
-        ("hash grid + direct", IndexKind::HashGrid, true),
-        ("kd-tree + direct", IndexKind::KdTree, true),
-    ];
-    let mut rows = Vec::new();
-    let mut curves = Vec::new();
-    for (name, index, direct_light) in configs {
-        let mut curve = Vec::new();
-        let mut configured = scene.clone();
-        configured.params.index = index;
-        configured.params.direct_light = direct_light;
-        photon_map(configured, limit(passes), |f| {
-            let Some(s) = f.stats.photon_mapping() else {
-                return;
-            };
-            let e = rmse(&f.radiance, &reference);
-            rows.push(format!("{name},{},{:.4},{e:.6e}", s.passes, s.elapsed_secs));
-            curve.push((s.elapsed_secs, e));
-        })?;
-        curves.push((name, curve));
-    }
-    // Target: the error the plain hash grid reaches after half its passes.
-    let target = curves[0].1[(passes as usize / 2).saturating_sub(1)].1;
-    println!(
-        "{:<22} {:>12} {:>14} {:>22}",
-        "configuration", "final RMSE", "seconds", "seconds to RMSE target"
-    );
-    for (name, curve) in &curves {
-        let (secs, err) = curve[curve.len() - 1];
-        let reach = curve
-            .iter()
-            .find(|(_, e)| *e <= target)
-            .map_or("not reached".to_owned(), |(t, _)| format!("{t:.2}"));
-        println!("{name:<22} {err:>12.4e} {secs:>14.2} {reach:>22}");
-    }
-    println!(
-        "RMSE target {target:.4e} (the hash grid's error after {} passes)",
-        passes / 2
-    );
-    if let Some(p) = csv {
-        let mut text = String::from("configuration,pass,seconds,rmse\n");
-        for r in rows {
-            text.push_str(&r);
-            text.push('\n');
-        }
-        std::fs::write(p, text).with_context(|| format!("{}: cannot write the CSV file", p.display()))?;
-        println!("rows written to {}", p.display());
     }
     Ok(())
 }

@@ -1,7 +1,8 @@
 //! The `caustic` command line: argument parsing and dispatch; each command lives in a file of
-//! its own ([`view`], [`render`], [`export`], [`bench`]).
+//! its own ([`view`], [`render`], [`export`], [`bench`], [`convergence`]).
 
 mod bench;
+mod convergence;
 mod export;
 mod render;
 mod view;

@@ -419,6 +419,18 @@ impl Ppm {
         true
     }
 
+    /// The initial radius photon mapping would choose for `scene` by itself (its own
+    /// `initial_radius` ignored): see [`Ppm::automatic_radius`]. Traces one eye pass.
+    pub fn automatic_initial_radius(scene: &Scene) -> f64 {
+        let mut scene = scene.clone();
+        scene.params.initial_radius = None;
+        let mut ppm = Ppm::new(&scene, PpmOptions::default());
+        if !ppm.eye_pass(&scene) {
+            return 1e-3;
+        }
+        ppm.slots.first().map_or(1e-3, |s| s.radius2.sqrt())
+    }
+
     /// The automatic initial radius: twice the footprint of one pixel at the median distance
     /// of the visible points from the eye. (smallppm's rule — the visible points' bounding
     /// box over the image size — explodes for an infinite floor reaching the horizon.)

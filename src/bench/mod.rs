@@ -1,5 +1,11 @@
 //! Measurement harnesses behind `caustic bench`: deterministic inputs, figures printed, never
-//! asserted (tests assert correctness; benches report speed).
+//! asserted (tests assert correctness; benches report speed). Error against time lives in
+//! [`convergence`] (curves, CSV), [`plot`] (log-log PNG) and [`reference`] (the cached
+//! reference render).
+
+pub mod convergence;
+pub mod plot;
+pub mod reference;
 
 use std::time::Instant;
 

@@ -1,0 +1,269 @@
+//! `caustic bench convergence`: error against wall time for a set of photon-mapping
+//! configurations, measured against a long reference render (cached), printed as a table and
+//! optionally written as CSV and a log-log PNG plot.
+
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use anyhow::{bail, Context, Result};
+use clap::ValueEnum;
+
+use super::photon_map;
+use caustic::bench::convergence::{errors, write_csv, Checkpoint, Curve};
+use caustic::bench::plot::write_plot;
+use caustic::bench::reference::{default_cache_dir, ReferenceRecord};
+use caustic::render::params::RenderParams;
+use caustic::render::ppm::{IndexKind, Ppm};
+use caustic::render::session::SessionOptions;
+use caustic::scene::{RendererKind, Scene};
+
+/// A configuration measured: the scene's parameters with one thing changed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Config {
+    /// The defaults before light sampling: photons carry all light (the baseline).
+    PhotonsOnly,
+    /// The defaults: direct light by light sampling, α 0.7, automatic radius, hash grid.
+    Default,
+    /// α = 0.5.
+    #[value(name = "alpha-0.5")]
+    Alpha05,
+    /// α = 2/3 (Knaus & Zwicker's asymptotically best choice).
+    #[value(name = "alpha-0.667")]
+    Alpha067,
+    /// α = 0.9.
+    #[value(name = "alpha-0.9")]
+    Alpha09,
+    /// An initial radius four times the automatic one.
+    #[value(name = "radius-x4")]
+    RadiusX4,
+    /// The seed report's kd-tree instead of the hash grid.
+    KdTree,
+}
+
+impl Config {
+    /// Name in tables, the CSV and the plot's legend.
+    fn label(self) -> &'static str {
+        match self {
+            Config::PhotonsOnly => "photons only (old default)",
+            Config::Default => "default (light sampling)",
+            Config::Alpha05 => "alpha 0.5",
+            Config::Alpha067 => "alpha 2/3",
+            Config::Alpha09 => "alpha 0.9",
+            Config::RadiusX4 => "initial radius x4",
+            Config::KdTree => "kd-tree",
+        }
+    }
+
+    /// The scene's parameters with this configuration's change; `auto_radius` is the radius
+    /// photon mapping picks by itself.
+    fn params(self, base: &RenderParams, auto_radius: f64) -> RenderParams {
+        let mut p = RenderParams {
+            direct_light: true,
+            ..base.clone()
+        };
+        match self {
+            Config::PhotonsOnly => p.direct_light = false,
+            Config::Default => {}
+            Config::Alpha05 => p.alpha = 0.5,
+            Config::Alpha067 => p.alpha = 2.0 / 3.0,
+            Config::Alpha09 => p.alpha = 0.9,
+            Config::RadiusX4 => p.initial_radius = Some(4.0 * auto_radius),
+            Config::KdTree => p.index = IndexKind::KdTree,
+        }
+        p
+    }
+}
+
+/// `bench convergence`'s settings.
+pub struct ConvergenceArgs {
+    /// Scene (already loaded).
+    pub scene: Scene,
+    /// Image width (height follows the aspect).
+    pub width: u32,
+    /// Photons per pass (`None`: the scene's).
+    pub photons: Option<u64>,
+    /// Seconds each configuration renders.
+    pub seconds: f64,
+    /// Seconds the baseline (the first configuration) renders; its final error is the target.
+    pub baseline_seconds: Option<f64>,
+    /// Passes of the reference.
+    pub reference_passes: u32,
+    /// Where references are cached.
+    pub reference_dir: Option<PathBuf>,
+    /// Configurations, the first being the baseline.
+    pub configs: Vec<Config>,
+    /// CSV output.
+    pub csv: Option<PathBuf>,
+    /// PNG plot output.
+    pub plot: Option<PathBuf>,
+    /// Replace existing CSV and plot files.
+    pub force: bool,
+}
+
+/// Runs the measurement and prints the table.
+pub fn bench_convergence(args: ConvergenceArgs) -> Result<()> {
+    let ConvergenceArgs { mut scene, .. } = args;
+    check(
+        &args.width,
+        args.seconds,
+        args.baseline_seconds,
+        args.reference_passes,
+    )?;
+    for out in [&args.csv, &args.plot].into_iter().flatten() {
+        if out.exists() && !args.force {
+            bail!(
+                "{}: the file exists; choose another name or pass --force",
+                out.display()
+            );
+        }
+    }
+    let aspect = scene.camera.height as f64 / scene.camera.width as f64;
+    scene.camera.width = args.width;
+    scene.camera.height = ((args.width as f64 * aspect).round() as u32).max(1);
+    if let Some(n) = args.photons {
+        scene.params.photons_per_pass = n;
+    }
+    scene.params.renderer = RendererKind::Ppm;
+    scene.params.validate().map_err(|e| anyhow::anyhow!("{e}"))?;
+    let reference = reference(&scene, args.reference_passes, args.reference_dir.as_deref())?;
+    let auto_radius = Ppm::automatic_initial_radius(&scene);
+    println!(
+        "Error against time on {}, {}x{}, {} photons per pass, {} s per configuration",
+        scene.source.display(),
+        scene.camera.width,
+        scene.camera.height,
+        scene.params.photons_per_pass,
+        args.seconds
+    );
+    let mut curves = Vec::new();
+    for (k, config) in args.configs.iter().enumerate() {
+        let seconds = match (k, args.baseline_seconds) {
+            (0, Some(s)) => s,
+            _ => args.seconds,
+        };
+        let mut configured = scene.clone();
+        configured.params = config.params(&scene.params, auto_radius);
+        eprintln!("  {} ({seconds} s)...", config.label());
+        curves.push(measure(configured, config.label(), seconds, &reference)?);
+    }
+    print_table(&curves);
+    if let Some(path) = &args.csv {
+        write_csv(&curves, path, args.force)?;
+        println!("rows written to {}", path.display());
+    }
+    if let Some(path) = &args.plot {
+        let title = format!(
+            "{}: RMSE against time ({}x{})",
+            scene
+                .source
+                .file_name()
+                .map_or("scene".into(), |n| n.to_string_lossy()),
+            scene.camera.width,
+            scene.camera.height
+        );
+        write_plot(&curves, &title, path, args.force)?;
+        println!("plot written to {}", path.display());
+    }
+    Ok(())
+}
+
+fn check(width: &u32, seconds: f64, baseline: Option<f64>, passes: u32) -> Result<()> {
+    caustic::render::limits::image_side(*width).map_err(|e| anyhow::anyhow!("--width {e}"))?;
+    for (flag, s) in [("--seconds", Some(seconds)), ("--baseline-seconds", baseline)] {
+        if let Some(s) = s {
+            if !(s.is_finite() && s > 0.0 && s <= 86_400.0) {
+                bail!("{flag} must be a positive number of seconds up to a day, got {s}");
+            }
+        }
+    }
+    if passes == 0 {
+        bail!("--reference-passes must be at least 1");
+    }
+    Ok(())
+}
+
+/// The reference: from the cache when its record matches, else rendered (another seed, the
+/// scene's own parameters) and cached.
+fn reference(scene: &Scene, passes: u32, dir: Option<&Path>) -> Result<Vec<[f32; 3]>> {
+    let dir = dir.map_or_else(default_cache_dir, Path::to_path_buf);
+    let mut reference_scene = scene.clone();
+    reference_scene.params.seed ^= 0x5eed;
+    let record = ReferenceRecord::new(&reference_scene, passes);
+    if let Some(pixels) = record.load(&dir) {
+        println!("reference: {} (cached)", record.path_in(&dir).display());
+        return Ok(pixels);
+    }
+    let bar = super::progress_bar(
+        passes as u64,
+        "{msg} [{bar:40}] pass {pos}/{len}, {elapsed} (eta {eta})",
+        "reference".into(),
+    )?;
+    let options = SessionOptions {
+        max_passes: Some(passes),
+        ..Default::default()
+    };
+    let frame = photon_map(reference_scene, options, |_| bar.inc(1))?;
+    bar.finish_and_clear();
+    let path = record
+        .store(&dir, &frame.radiance)
+        .map_err(|e| anyhow::anyhow!(e))
+        .context("cannot cache the reference render")?;
+    println!("reference: {} ({passes} passes, cached)", path.display());
+    Ok(frame.radiance.to_vec())
+}
+
+/// Renders `scene` for `seconds`, the error against `reference` after every pass.
+fn measure(scene: Scene, name: &str, seconds: f64, reference: &[[f32; 3]]) -> Result<Curve> {
+    let options = SessionOptions {
+        time_limit: Some(Duration::from_secs_f64(seconds)),
+        ..Default::default()
+    };
+    let mut points = Vec::new();
+    photon_map(scene, options, |f| {
+        let (rmse, rel_mse) = errors(&f.radiance, reference);
+        points.push(Checkpoint {
+            pass: f.pass,
+            secs: f.elapsed_secs,
+            rmse,
+            rel_mse,
+        });
+    })?;
+    Ok(Curve {
+        name: name.to_owned(),
+        points,
+    })
+}
+
+/// The table: each configuration's final error, slope, and how soon it reached the error the
+/// baseline (the first configuration) ended with.
+fn print_table(curves: &[Curve]) {
+    let Some(target) = curves.first().and_then(Curve::last).map(|p| p.rmse) else {
+        return;
+    };
+    let base_secs = curves[0].last().map_or(0.0, |p| p.secs);
+    // Timed to its first point at the target, like the others (noise may reach it early).
+    let base_reach = curves[0].time_to(target).unwrap_or(base_secs);
+    println!(
+        "{:<28} {:>7} {:>8} {:>11} {:>11} {:>7} {:>16} {:>9}",
+        "configuration", "passes", "seconds", "RMSE", "relMSE", "slope", "s to target", "speed-up"
+    );
+    for c in curves {
+        let Some(last) = c.last() else { continue };
+        let reach = c.time_to(target);
+        println!(
+            "{:<28} {:>7} {:>8.2} {:>11.4e} {:>11.4e} {:>7} {:>16} {:>9}",
+            c.name,
+            last.pass,
+            last.secs,
+            last.rmse,
+            last.rel_mse,
+            c.slope().map_or("-".into(), |s| format!("{s:.2}")),
+            reach.map_or("not reached".into(), |t| format!("{t:.2}")),
+            reach.map_or("-".into(), |t| format!("{:.1}x", base_reach / t.max(1e-9))),
+        );
+    }
+    println!(
+        "target: RMSE {target:.4e}, what '{}' reached after {base_secs:.1} s",
+        curves[0].name
+    );
+}
