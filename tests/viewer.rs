@@ -139,6 +139,7 @@ fn each_slider_sends_its_command() {
     let cases: Vec<(&str, f64, Change)> = vec![
         ("Alpha", 0.5, |p| p.alpha = 0.5),
         ("Photons per pass", 50_000.0, |p| p.photons_per_pass = 50_000),
+        ("Min photons per pixel", 8.0, |p| p.min_photons_per_pixel = 8.0),
         ("Max depth", 3.0, |p| p.max_depth = 3),
     ];
     for (label, value, change) in cases {

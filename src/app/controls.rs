@@ -248,6 +248,12 @@ pub fn side_panel_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) 
                 .text("Photons per pass"),
         )
         .on_hover_text("Photons traced per pass. Applies from the next pass, without restarting.");
+        ui.add(
+            egui::Slider::new(&mut p.render.min_photons_per_pixel, 0.0..=32.0)
+                .step_by(0.5)
+                .text("Min photons per pixel"),
+        )
+        .on_hover_text("When the eye pass is traced anew every pass (anti-aliasing, depth of field), each pass traces at least this many photons per pixel so the eye pass stays a small share of it. 0: exactly the photons per pass. Applies from the next pass, without restarting.");
         let mut auto = p.auto_radius();
         if ui
             .checkbox(&mut auto, "Automatic initial radius")

@@ -73,7 +73,8 @@ pub enum BenchCommand {
         /// final error is the target the others are timed to.
         #[arg(long)]
         baseline_seconds: Option<f64>,
-        /// Passes of the reference render (the scene's settings, another seed).
+        /// Passes of the reference render (the scene's own settings and photons per pass,
+        /// another seed).
         #[arg(long, default_value_t = 1000)]
         reference_passes: u32,
         /// Where reference renders are cached (default: ~/.cache/caustic/references).

@@ -120,12 +120,17 @@ pub fn bench_convergence(args: ConvergenceArgs) -> Result<()> {
     let aspect = scene.camera.height as f64 / scene.camera.width as f64;
     scene.camera.width = args.width;
     scene.camera.height = ((args.width as f64 * aspect).round() as u32).max(1);
+    scene.params.renderer = RendererKind::Ppm;
+    // The reference keeps the scene's own photons per pass, so runs with other --photons
+    // share it.
+    let reference = reference(&scene, args.reference_passes, args.reference_dir.as_deref())?;
     if let Some(n) = args.photons {
         scene.params.photons_per_pass = n;
     }
-    scene.params.renderer = RendererKind::Ppm;
-    scene.params.validate().map_err(|e| anyhow::anyhow!("{e}"))?;
-    let reference = reference(&scene, args.reference_passes, args.reference_dir.as_deref())?;
+    scene
+        .params
+        .validate()
+        .map_err(|e| anyhow::anyhow!("--photons: {e}"))?;
     let auto_radius = Ppm::automatic_initial_radius(&scene);
     println!(
         "Error against time on {}, {}x{}, {} photons per pass, {} s per configuration",

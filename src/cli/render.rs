@@ -56,6 +56,10 @@ pub struct PpmArgs {
     /// Photon mapping: photons per pass (default: the scene's).
     #[arg(long)]
     photons: Option<u64>,
+    /// Photon mapping: least photons per pixel of a pass when the eye pass is traced every
+    /// pass (anti-aliasing, depth of field); 0 for exactly --photons (default: the scene's).
+    #[arg(long, allow_negative_numbers = true)]
+    min_photons_per_pixel: Option<f64>,
     /// Photon mapping: radius reduction α in (0, 1] (default: the scene's).
     #[arg(long, allow_negative_numbers = true)]
     alpha: Option<f64>,
@@ -82,6 +86,9 @@ impl PpmArgs {
         if let Some(a) = self.alpha {
             params.alpha = a;
         }
+        if let Some(n) = self.min_photons_per_pixel {
+            params.min_photons_per_pixel = n;
+        }
         if let Some(r) = self.radius {
             params.initial_radius = Some(r);
         }
@@ -96,6 +103,7 @@ impl PpmArgs {
                 "photons_per_pass" => "--photons",
                 "alpha" => "--alpha",
                 "initial_radius" => "--radius",
+                "min_photons_per_pixel" => "--min-photons-per-pixel",
                 field => field,
             };
             anyhow::anyhow!("{flag} {}", e.problem)
@@ -236,8 +244,8 @@ fn render_ppm(mut scene: Scene, out: &Path, exposure: f32, force: bool, args: &P
         s.visible_points
     );
     println!(
-        "  time: eye passes {:.3} s ({} of them), index builds {:.3} s, photons {:.3} s",
-        s.eye_secs, s.eye_passes, s.index_secs, s.photon_secs
+        "  time: eye passes {:.3} s ({} of them), area-light sampling {:.3} s, index builds {:.3} s, photons {:.3} s",
+        s.eye_secs, s.eye_passes, s.direct_secs, s.index_secs, s.photon_secs
     );
     for skipped in &s.skipped {
         println!("  skipped: {skipped}");

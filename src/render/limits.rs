@@ -32,6 +32,15 @@ pub fn photons_per_pass(n: u64) -> Result<u64, Invalid> {
     within(n, PHOTONS_PER_PASS, "")
 }
 
+/// Least photons per pixel of a stochastic pass.
+pub fn photons_per_pixel(n: f64) -> Result<f64, Invalid> {
+    if n.is_finite() && (0.0..=1000.0).contains(&n) {
+        Ok(n)
+    } else {
+        Err(format!("must be between 0 and 1000, got {n}"))
+    }
+}
+
 /// Maximum specular depth.
 pub fn max_depth(d: u32) -> Result<u32, Invalid> {
     within(d, MAX_DEPTH, "")

@@ -46,6 +46,12 @@ pub struct RenderParams {
     pub renderer: RendererKind,
     /// Photons per photon-mapping pass (applies from the next pass, no restart).
     pub photons_per_pass: u64,
+    /// Stochastic PPM traces a new eye pass every pass; each pass then traces at least this
+    /// many photons per pixel, so the eye pass stays a small share of it (pbrt-v4's SPPM
+    /// traces one per pixel by default). A fixed ratio rather than a timing keeps the image
+    /// the same on any machine and thread count. 0: exactly `photons_per_pass`. Applies from
+    /// the next pass, no restart.
+    pub min_photons_per_pixel: f64,
     /// PPM radius reduction α in (0, 1] (applies from the next update, no restart).
     pub alpha: f64,
     /// PPM initial radius in scene units (`None`: from the pixel footprint).
@@ -77,6 +83,7 @@ impl Default for RenderParams {
         Self {
             renderer: RendererKind::Whitted,
             photons_per_pass: 200_000,
+            min_photons_per_pixel: 4.0,
             alpha: 0.7,
             initial_radius: None,
             max_depth: 8,
@@ -113,6 +120,10 @@ impl RenderParams {
             "photons_per_pass",
             limits::photons_per_pass(self.photons_per_pass).map(drop),
         )?;
+        check(
+            "min_photons_per_pixel",
+            limits::photons_per_pixel(self.min_photons_per_pixel).map(drop),
+        )?;
         if let Some(r) = self.initial_radius {
             check("initial_radius", limits::radius(r).map(drop))?;
         }
@@ -130,14 +141,29 @@ impl RenderParams {
     }
 
     /// Whether going from `old` to these values discards the accumulated image: every change
-    /// does except α and photons per pass, which apply from the next pass.
+    /// does except α and the photon counts, which apply from the next pass.
     pub fn restarts_from(&self, old: &RenderParams) -> bool {
         let kept = RenderParams {
             alpha: old.alpha,
             photons_per_pass: old.photons_per_pass,
+            min_photons_per_pixel: old.min_photons_per_pixel,
             ..self.clone()
         };
         kept != *old
+    }
+
+    /// Photons of a full pass over `pixels` pixels: `photons_per_pass`, raised to
+    /// `min_photons_per_pixel × pixels` when the eye pass is `stochastic` (traced anew every
+    /// pass).
+    pub fn pass_photons(&self, stochastic: bool, pixels: u64) -> u64 {
+        let floor = if stochastic {
+            (self.min_photons_per_pixel * pixels as f64).ceil() as u64
+        } else {
+            0
+        };
+        self.photons_per_pass
+            .max(floor)
+            .min(*limits::PHOTONS_PER_PASS.end())
     }
 }
 
@@ -174,6 +200,7 @@ mod tests {
         let gentle = RenderParams {
             alpha: 0.5,
             photons_per_pass: 1000,
+            min_photons_per_pixel: 0.0,
             ..old.clone()
         };
         assert!(!gentle.restarts_from(&old));
@@ -193,6 +220,19 @@ mod tests {
         ] {
             assert!(changed.restarts_from(&old), "{changed:?}");
         }
+    }
+
+    #[test]
+    fn stochastic_passes_trace_at_least_the_photons_per_pixel() {
+        let p = RenderParams::default();
+        assert_eq!(p.pass_photons(false, 1_000_000), 200_000, "classic PPM: as set");
+        assert_eq!(p.pass_photons(true, 1000), 200_000, "the floor is lower");
+        assert_eq!(p.pass_photons(true, 1_000_000), 4_000_000);
+        let exact = RenderParams {
+            min_photons_per_pixel: 0.0,
+            ..p
+        };
+        assert_eq!(exact.pass_photons(true, 1_000_000), 200_000);
     }
 
     #[test]

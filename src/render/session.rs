@@ -591,15 +591,13 @@ impl SessionState {
         self.preview_due = self.options.preview_divisor.is_some();
     }
 
-    /// Photons of the pass after `completed` passes: the ramp from
-    /// [`SessionOptions::first_pass_photons`] doubling up to the photons per pass.
-    pub fn pass_photons(&self, completed: u32) -> u64 {
+    /// Photons of the pass after `completed` passes of a render whose full pass is `full`
+    /// photons ([`RenderParams::pass_photons`]): the ramp from
+    /// [`SessionOptions::first_pass_photons`] doubling up to `full`.
+    pub fn pass_photons(&self, completed: u32, full: u64) -> u64 {
         match self.options.first_pass_photons {
-            Some(first) => self
-                .params
-                .photons_per_pass
-                .min(first.saturating_mul(1 << completed.min(40))),
-            None => self.params.photons_per_pass,
+            Some(first) => full.min(first.saturating_mul(1 << completed.min(40))),
+            None => full,
         }
     }
 }
@@ -691,7 +689,11 @@ impl Integrator {
             }
             Integrator::PhotonMapping(ppm) => {
                 ppm.alpha = state.params.alpha;
-                ppm.photons_per_pass = state.pass_photons(ppm.stats().passes);
+                let (w, h) = ppm.size();
+                let full = state
+                    .params
+                    .pass_photons(ppm.is_stochastic(), w as u64 * h as u64);
+                ppm.photons_per_pass = state.pass_photons(ppm.stats().passes, full);
                 let mut between_batches = |alpha: &mut f64| {
                     let c = control(state);
                     *alpha = state.params.alpha;
@@ -839,8 +841,10 @@ mod tests {
     #[test]
     fn passes_ramp_up_and_limits_end_the_session() {
         let mut s = state();
-        s.params.photons_per_pass = 5000;
-        assert_eq!([0, 1, 2, 3].map(|k| s.pass_photons(k)), [1000, 2000, 4000, 5000]);
+        assert_eq!(
+            [0, 1, 2, 3].map(|k| s.pass_photons(k, 5000)),
+            [1000, 2000, 4000, 5000]
+        );
         s.options.max_passes = Some(3);
         s.preview_due = false;
         s.passes = 2;

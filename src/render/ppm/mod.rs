@@ -282,7 +282,9 @@ impl Ppm {
             index: scene.params.index,
             stochastic,
             alpha: scene.params.alpha,
-            photons_per_pass: scene.params.photons_per_pass,
+            photons_per_pass: scene
+                .params
+                .pass_photons(stochastic, cam.width as u64 * cam.height as u64),
             initial_radius: scene.params.initial_radius,
             slots: Vec::new(),
             points: Vec::new(),
