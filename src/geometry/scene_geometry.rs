@@ -511,18 +511,38 @@ impl SceneGeometry {
 
     /// Whether anything lies on `ray` in `(0, t_max)` (shadow rays).
     pub fn occluded(&self, ray: &Ray, t_max: f64) -> bool {
+        self.occluded_except(ray, t_max, None)
+    }
+
+    /// Whether anything but the object `skip` lies on `ray` in `(0, t_max)`: a shadow ray
+    /// towards an area light passes its own surface, which a ray aimed near the edge of a
+    /// sphere light would otherwise graze on the way, the light shadowing itself.
+    pub fn occluded_except(&self, ray: &Ray, t_max: f64, skip: Option<u32>) -> bool {
+        let counts = |object: u32| skip != Some(object);
         if self
             .planes
             .iter()
-            .any(|(p, _)| p.intersect(ray, 0.0, t_max).is_some())
+            .any(|(p, obj)| counts(*obj) && p.intersect(ray, 0.0, t_max).is_some())
         {
             return true;
         }
         let frame = self.has_patches().then(|| RayFrame::new(ray));
         self.bvh.any(ray, t_max, |k| {
-            self.test(self.primitives[k as usize], ray, &frame, t_max)
-                .is_some()
+            let primitive = self.primitives[k as usize];
+            counts(self.object_of(primitive)) && self.test(primitive, ray, &frame, t_max).is_some()
         })
+    }
+
+    /// The object a primitive belongs to.
+    fn object_of(&self, primitive: Primitive) -> u32 {
+        match primitive {
+            Primitive::Sphere(i) => self.spheres[i as usize].1,
+            Primitive::Plane(i) => self.planes[i as usize].1,
+            Primitive::Quad(i) => self.quads[i as usize].1,
+            Primitive::Triangle { mesh, .. } => self.meshes[mesh as usize].1,
+            Primitive::PatchLeaf(i) => self.patches[self.leaves[i as usize].patch as usize].1,
+            Primitive::Patch(i) => self.patches[i as usize].1,
+        }
     }
 }
 

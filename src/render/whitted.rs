@@ -137,8 +137,7 @@ impl Tracer<'_> {
                         if cos <= 0.0 {
                             continue;
                         }
-                        let shadow = hit.spawn(ls.wi);
-                        if scene.geometry.occluded(&shadow, ls.distance * (1.0 - 1e-7)) {
+                        if scene.occluded_from(hit.point, hit.normal, k, &ls) {
                             continue;
                         }
                         visible += 1;

@@ -176,6 +176,20 @@ impl Light {
     }
 }
 
+impl LightSample {
+    /// The shadow ray from the surface point `point` (geometric normal `normal`) towards this
+    /// sample, pushed off the surface ([`crate::geometry::ray::spawn_ray`]), and how far it may
+    /// go before it reaches the light: measured from its own origin, less a relative margin of
+    /// 1e-7. (Measured from `point` instead, the push — at least 1e-9 — eats the margin in a
+    /// scene a thousandth of a unit across, and the light shadows itself.)
+    pub fn shadow_ray(&self, point: DVec3, normal: DVec3) -> (crate::geometry::Ray, f64) {
+        let ray = crate::geometry::ray::spawn_ray(point, normal, self.wi);
+        let target = point + self.wi * self.distance;
+        let reach = (target - ray.origin).dot(self.wi);
+        (ray, reach * (1.0 - 1e-7))
+    }
+}
+
 /// A photon leaving a light: where, which way, and its flux relative to the light's power.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Emission {

@@ -181,6 +181,7 @@ pub(super) fn load_str(text: &str, path: &Path, base_dir: Option<&Path>) -> Resu
     }
 
     let mut lights = Vec::new();
+    let mut light_objects = Vec::new();
     let mut emitter_material: Option<usize> = None;
     for (k, desc) in file.lights.iter().enumerate() {
         let light = light(&ctx, k, desc)?;
@@ -219,6 +220,7 @@ pub(super) fn load_str(text: &str, path: &Path, base_dir: Option<&Path>) -> Resu
             }
             Light::Point { .. } | Light::Spot { .. } => None,
         };
+        light_objects.push(emission.map(|_| id));
         if let Some(radiance) = emission {
             // Emitters reflect nothing: one shared black material serves them all.
             let material = *emitter_material.get_or_insert_with(|| {
@@ -257,6 +259,7 @@ pub(super) fn load_str(text: &str, path: &Path, base_dir: Option<&Path>) -> Resu
         textures,
         objects,
         lights,
+        light_objects,
         geometry: builder.build(),
         text: text.into(),
         base_dir: base_dir.map(Path::to_path_buf),

@@ -54,6 +54,9 @@ pub struct Scene {
     pub objects: Vec<SceneObject>,
     /// Lights.
     pub lights: Vec<Light>,
+    /// For each light, the object that is its visible surface (area lights), which its own
+    /// shadow rays ignore ([`Scene::occluded_from`]).
+    pub light_objects: Vec<Option<u32>>,
     /// Everything intersectable, behind one BVH.
     pub geometry: SceneGeometry,
     /// The TOML text the scene was read from (what [`save::scene_toml`] edits).
@@ -125,6 +128,15 @@ impl Scene {
             Some(l) if dir.dot(hit.normal) < 0.0 => l,
             _ => DVec3::ZERO,
         }
+    }
+
+    /// Whether something blocks the way from the surface point `point` (geometric normal
+    /// `normal`) to the sample `ls` of light `light`: the shadow ray of
+    /// [`light::LightSample::shadow_ray`], passing the light's own surface.
+    pub fn occluded_from(&self, point: DVec3, normal: DVec3, light: usize, ls: &light::LightSample) -> bool {
+        let (ray, reach) = ls.shadow_ray(point, normal);
+        let own = self.light_objects.get(light).copied().flatten();
+        self.geometry.occluded_except(&ray, reach, own)
     }
 
     /// What the scene contains, for skipping work it does not need.

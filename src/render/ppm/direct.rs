@@ -61,8 +61,7 @@ pub fn area_light_pass(
                 if cos <= 0.0 {
                     continue;
                 }
-                let shadow = crate::geometry::ray::spawn_ray(vp.position, vp.normal, ls.wi);
-                if !scene.geometry.occluded(&shadow, ls.distance * (1.0 - 1e-7)) {
+                if !scene.occluded_from(vp.position, vp.normal, l as usize, &ls) {
                     sum += vp.weight * ls.incident * cos;
                 }
             }

@@ -105,13 +105,17 @@ impl EyeWalk<'_> {
                 // diffuse part.
                 let weight = throughput * color / PI;
                 if self.direct_light {
-                    for light in scene.lights.iter().filter(|l| direct_by_shadow_rays(l)) {
+                    for (k, light) in scene
+                        .lights
+                        .iter()
+                        .enumerate()
+                        .filter(|(_, l)| direct_by_shadow_rays(l))
+                    {
                         let Some(ls) = light.sample(hit.point, DVec2::ZERO) else {
                             continue;
                         };
                         let cos = n.dot(ls.wi);
-                        let shadow = hit.spawn(ls.wi);
-                        if cos > 0.0 && !scene.geometry.occluded(&shadow, ls.distance * (1.0 - 1e-7)) {
+                        if cos > 0.0 && !scene.occluded_from(hit.point, hit.normal, k, &ls) {
                             out.direct += weight * ls.incident * cos;
                         }
                     }
