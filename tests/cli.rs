@@ -314,3 +314,40 @@ fn convergence_bench_writes_its_csv_and_plot_and_reuses_the_reference() {
     assert!(again.status.success(), "{}", text(&again));
     assert!(text(&again).contains("(cached)"), "{}", text(&again));
 }
+
+/// `--threads N` sizes the render's pool; the image does not depend on it.
+#[test]
+fn render_threads_flag_gives_the_same_image() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let render = |threads: &str| {
+        let out = dir.path().join(format!("t{threads}.exr"));
+        let o = caustic(&[
+            "render",
+            "scenes/cornell.toml",
+            "--renderer",
+            "ppm",
+            "--passes",
+            "2",
+            "--photons",
+            "5000",
+            "--width",
+            "48",
+            "--height",
+            "36",
+            "--threads",
+            threads,
+            "--out",
+            out.to_str().expect("utf-8"),
+        ]);
+        assert!(o.status.success(), "{}", text(&o));
+        image::open(&out).expect("EXR").to_rgb32f().into_raw()
+    };
+    assert_eq!(render("1"), render("2"));
+    let bad = caustic(&["render", "--threads", "0", "--out", "x.png"]);
+    assert!(!bad.status.success());
+    assert!(
+        text(&bad).contains("--threads must be between 1 and 4096"),
+        "{}",
+        text(&bad)
+    );
+}

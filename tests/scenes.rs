@@ -28,7 +28,14 @@ fn every_shipped_scene_loads_and_renders() {
         .collect();
     names.sort();
     let expected = [
-        "cornell", "hairpin", "leaf", "scroll", "showcase", "smallppm", "teapot",
+        "cornell",
+        "hairpin",
+        "inline_patch",
+        "leaf",
+        "scroll",
+        "showcase",
+        "smallppm",
+        "teapot",
     ];
     let stems: Vec<String> = names
         .iter()
@@ -450,4 +457,22 @@ fn renders_are_identical_for_one_and_two_threads() {
     let a = one.install(|| render_whitted(&scene, &|_| {}).0);
     let b = two.install(|| render_whitted(&scene, &|_| {}).0);
     assert_eq!(a.pixels, b.pixels);
+}
+
+/// FORMAT.md's inline-patch example is `scenes/inline_patch.toml` word for word, and its patch
+/// faces up as the text says (u along +z, v along +x: normal +z × +x = +y).
+#[test]
+fn the_inline_patch_example_is_the_shipped_scene_and_faces_up() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let scene_text = std::fs::read_to_string(root.join("scenes/inline_patch.toml")).expect("scene");
+    let format = std::fs::read_to_string(root.join("scenes/FORMAT.md")).expect("FORMAT.md");
+    assert!(
+        format.contains(&format!("```toml\n{scene_text}```")),
+        "FORMAT.md's example differs from scenes/inline_patch.toml"
+    );
+    let scene = Scene::load(&root.join("scenes/inline_patch.toml")).expect("loads");
+    let (patch, _) = scene.geometry.patches()[0];
+    let n = patch.normal(0.5, 0.5).expect("a normal");
+    assert!(n.dot(glam::DVec3::Y) > 0.99, "normal {n}");
+    assert!((patch.eval(0.0, 1.0) - glam::DVec3::new(1.0, 1.0, -1.0)).length() < 1e-12);
 }

@@ -97,6 +97,9 @@ pub enum BenchCommand {
         /// Replace existing CSV and plot files.
         #[arg(long)]
         force: bool,
+        /// Render with this many threads (default: one per core).
+        #[arg(long, value_name = "N")]
+        threads: Option<usize>,
     },
     /// Whitted ray tracer: rays per second on a scene, at the given thread counts.
     Whitted {
@@ -116,6 +119,17 @@ pub enum MethodChoice {
     Prepared,
     PerRay,
     Both,
+}
+
+impl BenchCommand {
+    /// The `--threads N` that sizes the whole command's pool (the benches that measure several
+    /// thread counts take a list of their own).
+    pub fn threads(&self) -> Option<usize> {
+        match self {
+            BenchCommand::Convergence { threads, .. } => *threads,
+            _ => None,
+        }
+    }
 }
 
 /// Runs a bench command.
@@ -160,6 +174,7 @@ pub fn bench(what: BenchCommand) -> Result<()> {
             csv,
             plot,
             force,
+            threads: _,
         } => super::convergence::bench_convergence(super::convergence::ConvergenceArgs {
             scene: photon_scene(scene.as_deref())?,
             width,

@@ -50,12 +50,33 @@ pub fn run() -> Result<()> {
     let command = Cli::parse()
         .command
         .unwrap_or_else(|| Command::View(view::ViewArgs::parse_from(["caustic view"])));
+    use_threads(match &command {
+        Command::View(a) => a.threads,
+        Command::Render(a) => a.threads,
+        Command::ExportObj(_) => None,
+        Command::Bench { what } => what.threads(),
+    })?;
     match command {
         Command::View(args) => view::view(args, launched),
         Command::Render(args) => render::render(args),
         Command::ExportObj(args) => export::export_obj(args),
         Command::Bench { what } => bench::bench(what),
     }
+}
+
+/// Sizes rayon's global pool for this run (`--threads N`, like pbrt's `--nthreads` and
+/// Mitsuba's `-t`): every render of the command then uses `N` threads. `None`: one per core.
+fn use_threads(threads: Option<usize>) -> Result<()> {
+    if let Some(n) = threads {
+        if n == 0 || n > 4096 {
+            bail!("--threads must be between 1 and 4096, got {n}");
+        }
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global()
+            .context("cannot start the render threads")?;
+    }
+    Ok(())
 }
 
 /// A progress bar over `len` steps (drawn only on a terminal).

@@ -40,6 +40,9 @@ pub struct RenderArgs {
     /// Replace the output file if it exists.
     #[arg(long)]
     force: bool,
+    /// Render with this many threads (default: one per core); the image does not depend on it.
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
     #[command(flatten)]
     ppm: PpmArgs,
 }
@@ -123,6 +126,7 @@ pub fn render(args: RenderArgs) -> Result<()> {
         exposure,
         force,
         ppm,
+        threads: _,
     } = args;
     let out = out.as_path();
     if caustic::render::film::Format::from_path(out).is_none() {

@@ -26,6 +26,9 @@ pub struct ViewArgs {
     /// an aperture change to the new image; print them and close.
     #[arg(long)]
     pub bench: bool,
+    /// Render with this many threads (default: one per core).
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
 }
 
 /// Opens the viewer (only with the `viewer` feature).
@@ -37,6 +40,7 @@ pub fn view(args: ViewArgs, launched: std::time::Instant) -> Result<()> {
         after_passes,
         force,
         bench,
+        threads: _,
     } = args;
     if let Some(p) = &screenshot {
         if p.extension().is_none_or(|e| !e.eq_ignore_ascii_case("png")) {
