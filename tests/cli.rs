@@ -299,7 +299,7 @@ fn convergence_bench_writes_its_csv_and_plot_and_reuses_the_reference() {
     assert_eq!(lines.next(), Some("configuration,pass,seconds,rmse,rel_mse"));
     let body: Vec<&str> = lines.collect();
     assert!(body.iter().all(|l| l.split(',').count() == 5), "{rows}");
-    for name in ["photons only (old default)", "default (light sampling)"] {
+    for name in ["old defaults (photons only)", "default (light sampling)"] {
         assert!(
             body.iter().any(|l| l.starts_with(name)),
             "no rows of {name}: {rows}"
@@ -350,4 +350,31 @@ fn render_threads_flag_gives_the_same_image() {
         "{}",
         text(&bad)
     );
+}
+
+/// `bench memory` samples resident memory while a stochastic render runs.
+#[test]
+fn memory_bench_prints_its_samples() {
+    let out = caustic(&[
+        "bench",
+        "memory",
+        "--width",
+        "32",
+        "--height",
+        "24",
+        "--passes",
+        "4",
+        "--every",
+        "2",
+        "--photons",
+        "1000",
+    ]);
+    let t = text(&out);
+    assert!(out.status.success(), "{t}");
+    assert!(t.contains("peak MiB"), "{t}");
+    let rows = t
+        .lines()
+        .filter(|l| l.split_whitespace().count() == 4 && l.trim_start().starts_with(char::is_numeric))
+        .count();
+    assert_eq!(rows, 3, "passes 1, 2 and 4 sampled: {t}");
 }

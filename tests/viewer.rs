@@ -437,3 +437,33 @@ fn settings_survive_storage_and_bad_stored_values_are_repaired() {
     .sanitized();
     assert_eq!((bad.exposure_stops, bad.zoom), (0.0, Zoom::Fit));
 }
+
+/// `R` asks before throwing passes away; `E` / Shift+`E` step the exposure as in tev.
+#[test]
+fn r_asks_before_discarding_passes_and_e_steps_the_exposure() {
+    let mut h = harness(ball(), false);
+    step_until(&mut h, "two passes", |v| v.frame().is_some_and(|f| f.pass >= 2));
+    let before = sent(&h).len();
+    h.key_press(egui::Key::R);
+    h.step();
+    h.step();
+    assert_eq!(sent(&h).len(), before, "R restarted without asking");
+    assert!(h.query_by_label("Discard and restart").is_some(), "no question");
+    h.get_by_label("Keep rendering").click();
+    h.step();
+    h.step();
+    assert_eq!(sent(&h).len(), before, "Keep rendering restarted");
+    h.key_press(egui::Key::R);
+    h.step();
+    h.step();
+    h.get_by_label("Discard and restart").click();
+    h.step();
+    assert_eq!(sent(&h).last(), Some(&Command::Restart));
+    let stops = viewer(&h).settings.exposure_stops;
+    h.key_press(egui::Key::E);
+    h.step();
+    assert_eq!(viewer(&h).settings.exposure_stops, stops + 0.5);
+    h.key_press_modifiers(egui::Modifiers::SHIFT, egui::Key::E);
+    h.step();
+    assert_eq!(viewer(&h).settings.exposure_stops, stops);
+}

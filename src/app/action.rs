@@ -55,6 +55,10 @@ pub enum Action {
     SetParams(PanelParams),
     /// Discard the accumulation and render again.
     Restart,
+    /// Restart, asking first when passes would be thrown away (the `R` key).
+    AskRestart,
+    /// The answer to [`Action::AskRestart`]'s question: restart or not.
+    ConfirmRestart(bool),
     /// Start a fresh render session (after a failure).
     RestartRenderer,
     /// Close the "could not open scene" window.
@@ -137,6 +141,20 @@ impl Viewer {
             Action::Close => self.unless_unsaved(AfterDiscard::Close),
             Action::SetParams(p) => self.set_params(p),
             Action::Restart => self.send(Command::Restart),
+            Action::AskRestart => {
+                // One pass (or a preview) is no work to lose; more is worth a question.
+                if self.frame.as_ref().is_some_and(|f| f.pass >= 2) {
+                    self.confirm_restart = true;
+                } else {
+                    self.send(Command::Restart);
+                }
+            }
+            Action::ConfirmRestart(restart) => {
+                self.confirm_restart = false;
+                if restart {
+                    self.send(Command::Restart);
+                }
+            }
             Action::RestartRenderer => self.restart_renderer(),
             Action::DismissSceneError => self.scene_error = None,
             Action::SetExposure(stops) => {

@@ -478,6 +478,26 @@ pub fn dialogs_ui(viewer: &Viewer, ctx: &egui::Context, out: &mut Vec<Action>) {
             out.push(Action::ConfirmSceneOverwrite(replace));
         }
     }
+    if viewer.confirm_restart {
+        let passes = viewer.frame.as_ref().map_or(0, |f| f.pass);
+        let modal = egui::Modal::new(egui::Id::unique("caustic-restart")).show(ctx, |ui| {
+            ui.heading("Restart the render?");
+            ui.label(format!("The {passes} passes rendered so far would be discarded."));
+            ui.horizontal(|ui| {
+                if ui.button("Discard and restart").clicked() {
+                    Some(true)
+                } else if ui.button("Keep rendering").clicked() {
+                    Some(false)
+                } else {
+                    None
+                }
+            })
+            .inner
+        });
+        if let Some(restart) = modal.inner.or(modal.should_close().then_some(false)) {
+            out.push(Action::ConfirmRestart(restart));
+        }
+    }
     if viewer.unsaved_question.is_some() {
         let modal = egui::Modal::new(egui::Id::unique("caustic-unsaved")).show(ctx, |ui| {
             ui.heading("Unsaved edits");

@@ -17,7 +17,11 @@ pub const HELP: &[(&str, &str)] = &[
         "Undo / redo an edit (control points, camera)",
     ),
     ("Space", "Pause / resume rendering"),
-    ("R", "Restart the render"),
+    ("R", "Restart the render (asks first when passes would be lost)"),
+    (
+        "E / Shift+E",
+        "Exposure up / down half a stop (as in tev; also ] and [)",
+    ),
     ("F", "Fit the image to the view (also: double-click)"),
     ("1", "Show the image 1:1"),
     ("+ / -", "Zoom in / out (also: mouse wheel over the image)"),
@@ -85,7 +89,13 @@ pub fn handle(viewer: &Viewer, ctx: &egui::Context, out: &mut Vec<Action>) {
         out.push(Action::SetParams(p));
     }
     if pressed(Key::R) {
-        out.push(Action::Restart);
+        out.push(Action::AskRestart);
+    }
+    // tev's exposure keys (Shift+E first: a plain-E match ignores Shift).
+    if ctx.input_mut(|i| i.consume_key(Modifiers::SHIFT, Key::E)) {
+        out.push(Action::SetExposure(settings.exposure_stops - 0.5));
+    } else if pressed(Key::E) {
+        out.push(Action::SetExposure(settings.exposure_stops + 0.5));
     }
     if pressed(Key::F) {
         out.push(Action::SetZoom {
@@ -159,10 +169,11 @@ fn editing_keys(viewer: &Viewer, ctx: &egui::Context, out: &mut Vec<Action>) {
         (Key::ArrowUp, Vec2::new(0.0, -1.0)),
         (Key::ArrowDown, Vec2::new(0.0, 1.0)),
     ] {
-        if pressed(key) {
-            out.push(Action::Nudge(step * 2.0));
-        } else if ctx.input_mut(|i| i.consume_key(Modifiers::SHIFT, key)) {
+        // Shift first: a plain match ignores Shift.
+        if ctx.input_mut(|i| i.consume_key(Modifiers::SHIFT, key)) {
             out.push(Action::Nudge(step * 20.0));
+        } else if pressed(key) {
+            out.push(Action::Nudge(step * 2.0));
         }
     }
 }

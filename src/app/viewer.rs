@@ -94,6 +94,8 @@ pub struct Viewer {
     pub(super) after_save: Option<AfterDiscard>,
     /// The window may close even with unsaved edits (the user said so).
     pub(super) allow_close: bool,
+    /// The `R` key asked to restart: "discard the passes?" is shown.
+    pub(super) confirm_restart: bool,
 }
 
 fn session_options(start_paused: bool) -> SessionOptions {
@@ -171,6 +173,7 @@ impl Viewer {
             unsaved_question: None,
             after_save: None,
             allow_close: false,
+            confirm_restart: false,
         }
     }
 

@@ -101,6 +101,27 @@ pub enum BenchCommand {
         #[arg(long, value_name = "N")]
         threads: Option<usize>,
     },
+    /// Photon mapping: resident memory (current and peak) of a long stochastic render (open
+    /// aperture), sampled every --every passes.
+    Memory {
+        /// Scene file; the built-in scene when omitted.
+        scene: Option<PathBuf>,
+        /// Image width.
+        #[arg(long, default_value_t = 1920)]
+        width: u32,
+        /// Image height.
+        #[arg(long, default_value_t = 1080)]
+        height: u32,
+        /// Passes to render.
+        #[arg(long, default_value_t = 100)]
+        passes: u32,
+        /// Sample the memory every this many passes.
+        #[arg(long, default_value_t = 10)]
+        every: u32,
+        /// Photons per pass (small: the eye pass and its visible points are what grows).
+        #[arg(long, default_value_t = 20_000)]
+        photons: u64,
+    },
     /// Whitted ray tracer: rays per second on a scene, at the given thread counts.
     Whitted {
         /// Scene file; the built-in scene when omitted.
@@ -156,6 +177,20 @@ pub fn bench(what: BenchCommand) -> Result<()> {
             width,
             threads,
         } => bench_whitted(scene.as_deref(), width, &threads),
+        BenchCommand::Memory {
+            scene,
+            width,
+            height,
+            passes,
+            every,
+            photons,
+        } => super::memory::bench_memory(super::memory::MemoryArgs {
+            scene: scene.as_deref(),
+            size: (width, height),
+            passes,
+            every,
+            photons,
+        }),
         BenchCommand::Ppm {
             scene,
             photons,

@@ -20,7 +20,8 @@ use caustic::scene::{RendererKind, Scene};
 /// A configuration measured: the scene's parameters with one thing changed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum Config {
-    /// The defaults before light sampling: photons carry all light (the baseline).
+    /// The defaults before light sampling and balanced passes: photons carry all light and a
+    /// pass traces exactly the scene's photons per pass (the baseline).
     PhotonsOnly,
     /// The defaults: direct light by light sampling, α 0.7, automatic radius, hash grid.
     Default,
@@ -44,7 +45,7 @@ impl Config {
     /// Name in tables, the CSV and the plot's legend.
     fn label(self) -> &'static str {
         match self {
-            Config::PhotonsOnly => "photons only (old default)",
+            Config::PhotonsOnly => "old defaults (photons only)",
             Config::Default => "default (light sampling)",
             Config::Alpha05 => "alpha 0.5",
             Config::Alpha067 => "alpha 2/3",
@@ -62,7 +63,10 @@ impl Config {
             ..base.clone()
         };
         match self {
-            Config::PhotonsOnly => p.direct_light = false,
+            Config::PhotonsOnly => {
+                p.direct_light = false;
+                p.min_photons_per_pixel = 0.0;
+            }
             Config::Default => {}
             Config::Alpha05 => p.alpha = 0.5,
             Config::Alpha067 => p.alpha = 2.0 / 3.0,

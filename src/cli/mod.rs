@@ -1,9 +1,10 @@
 //! The `caustic` command line: argument parsing and dispatch; each command lives in a file of
-//! its own ([`view`], [`render`], [`export`], [`bench`], [`convergence`]).
+//! its own ([`view`], [`render`], [`export`], [`bench`], [`convergence`], [`memory`]).
 
 mod bench;
 mod convergence;
 mod export;
+mod memory;
 mod render;
 mod view;
 

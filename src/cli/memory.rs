@@ -1,0 +1,95 @@
+//! `caustic bench memory`: resident memory of a long stochastic photon-mapping render (an open
+//! aperture, so every pass traces a new eye pass), sampled every few passes: the peak must
+//! stay bounded and the current size flat, whatever the number of passes.
+
+use std::path::Path;
+
+use anyhow::{bail, Result};
+
+use super::{load_scene, photon_map};
+use caustic::render::session::SessionOptions;
+use caustic::scene::RendererKind;
+
+/// `bench memory`'s settings.
+pub struct MemoryArgs<'a> {
+    /// Scene (the built-in teapot when `None`).
+    pub scene: Option<&'a Path>,
+    /// Image size.
+    pub size: (u32, u32),
+    /// Passes to render.
+    pub passes: u32,
+    /// Sample memory every this many passes.
+    pub every: u32,
+    /// Photons per pass.
+    pub photons: u64,
+}
+
+/// Resident set size and its peak, in MiB, from `/proc/self/status` (Linux).
+fn resident_mib() -> Option<(f64, f64)> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let field = |name: &str| -> Option<f64> {
+        let line = status.lines().find(|l| l.starts_with(name))?;
+        let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+        Some(kib / 1024.0)
+    };
+    Some((field("VmRSS:")?, field("VmHWM:")?))
+}
+
+/// Renders and prints the memory samples.
+pub fn bench_memory(args: MemoryArgs) -> Result<()> {
+    if args.passes == 0 || args.every == 0 {
+        bail!("--passes and --every must be at least 1");
+    }
+    if resident_mib().is_none() {
+        bail!("resident memory is read from /proc/self/status, which this system does not have");
+    }
+    let mut scene = load_scene(args.scene)?;
+    for (flag, v) in [("--width", args.size.0), ("--height", args.size.1)] {
+        caustic::render::limits::image_side(v).map_err(|e| anyhow::anyhow!("{flag} {e}"))?;
+    }
+    (scene.camera.width, scene.camera.height) = args.size;
+    // An open aperture: stochastic PPM, a new eye pass (and new visible points) every pass.
+    if scene.camera.aperture <= 0.0 {
+        scene.camera.aperture = 0.01 * scene.camera.focal_distance;
+    }
+    scene.params.renderer = RendererKind::Ppm;
+    scene.params.photons_per_pass = args.photons;
+    scene.params.min_photons_per_pixel = 0.0;
+    scene
+        .params
+        .validate()
+        .map_err(|e| anyhow::anyhow!("--photons: {e}"))?;
+    let before = resident_mib().map_or(0.0, |m| m.0);
+    println!(
+        "Memory of a stochastic render of {}, {}x{}, aperture {:.4}, {} photons per pass; {before:.0} MiB before rendering",
+        scene.source.display(),
+        args.size.0,
+        args.size.1,
+        scene.camera.aperture,
+        args.photons
+    );
+    println!(
+        "{:>8} {:>10} {:>14} {:>10}",
+        "pass", "seconds", "resident MiB", "peak MiB"
+    );
+    let options = SessionOptions {
+        max_passes: Some(args.passes),
+        ..Default::default()
+    };
+    let mut samples = Vec::new();
+    photon_map(scene, options, |f| {
+        if f.pass % args.every == 0 || f.pass == 1 {
+            if let Some((rss, peak)) = resident_mib() {
+                println!("{:>8} {:>10.1} {rss:>14.1} {peak:>10.1}", f.pass, f.elapsed_secs);
+                samples.push(rss);
+            }
+        }
+    })?;
+    if let (Some(first), Some(last)) = (samples.get(1).or(samples.first()), samples.last()) {
+        println!(
+            "resident size from the first sample after pass 1 to the last: {first:.1} → {last:.1} MiB ({:+.1} %)",
+            (last / first - 1.0) * 100.0
+        );
+    }
+    Ok(())
+}
