@@ -36,6 +36,24 @@ fn register_font() {
     });
 }
 
+/// Axis ticks for a logarithmic axis over `[lo, hi]`: 1, 2, 5 × 10ᵏ, or every 1…9 × 10ᵏ when
+/// that gives fewer than four.
+fn ticks(lo: f64, hi: f64) -> Vec<f64> {
+    let within = |mantissas: &[f64]| -> Vec<f64> {
+        let (k0, k1) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+        (k0..=k1)
+            .flat_map(|k| mantissas.iter().map(move |m| m * 10f64.powi(k)))
+            .filter(|v| (lo..=hi).contains(v))
+            .collect()
+    };
+    let coarse = within(&[1.0, 2.0, 5.0]);
+    if coarse.len() >= 4 {
+        coarse
+    } else {
+        within(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0])
+    }
+}
+
 /// A number with as few digits as its size needs (axis labels).
 fn compact(v: f64) -> String {
     if v >= 10.0 {
@@ -73,16 +91,21 @@ pub fn draw(curves: &[Curve], title: &str) -> Result<Vec<u8>, String> {
             .margin(16)
             .x_label_area_size(44)
             .y_label_area_size(72)
-            .build_cartesian_2d((t0 * 0.9..t1 * 1.1).log_scale(), (e0 * 0.9..e1 * 1.1).log_scale())
+            .build_cartesian_2d(
+                (t0 * 0.9..t1 * 1.1)
+                    .log_scale()
+                    .with_key_points(ticks(t0 * 0.9, t1 * 1.1)),
+                (e0 * 0.9..e1 * 1.1)
+                    .log_scale()
+                    .with_key_points(ticks(e0 * 0.9, e1 * 1.1)),
+            )
             .map_err(|e| err(&e))?;
         chart
             .configure_mesh()
             .x_desc("seconds")
             .y_desc("RMSE against the reference")
-            .x_labels(12)
-            .y_labels(12)
             .x_label_formatter(&|v| compact(*v))
-            .y_label_formatter(&|v| format!("{v:.1e}"))
+            .y_label_formatter(&|v| format!("{v:.0e}"))
             .light_line_style(RGBColor(238, 238, 238))
             .label_style(("sans-serif", 15))
             .draw()
