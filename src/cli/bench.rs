@@ -57,71 +57,10 @@ pub enum BenchCommand {
     /// Photon mapping: error against wall time for several configurations (old and new
     /// defaults, α, initial radius, index) against a long reference render, cached on disk.
     /// Prints a table; writes a CSV and a log-log plot on request.
-    Convergence {
-        /// Scene file; smallppm's scene (built in) when omitted.
-        scene: Option<PathBuf>,
-        /// Image width (height follows the scene's aspect).
-        #[arg(long, default_value_t = 256)]
-        width: u32,
-        /// Photons per pass (default: the scene's).
-        #[arg(long)]
-        photons: Option<u64>,
-        /// Seconds each configuration renders.
-        #[arg(long, default_value_t = 10.0)]
-        seconds: f64,
-        /// Seconds the first configuration (the baseline) renders, when not --seconds: its
-        /// final error is the target the others are timed to.
-        #[arg(long)]
-        baseline_seconds: Option<f64>,
-        /// Passes of the reference render (the scene's own settings and photons per pass,
-        /// another seed).
-        #[arg(long, default_value_t = 1000)]
-        reference_passes: u32,
-        /// Where reference renders are cached (default: ~/.cache/caustic/references).
-        #[arg(long)]
-        reference_dir: Option<PathBuf>,
-        /// Configurations to measure, the first being the baseline.
-        #[arg(
-            long,
-            value_enum,
-            value_delimiter = ',',
-            default_value = "photons-only,default,alpha-0.5,alpha-0.667,alpha-0.9,radius-x4,kd-tree"
-        )]
-        configs: Vec<super::convergence::Config>,
-        /// Write every (configuration, pass, seconds, RMSE, relMSE) row to this CSV file.
-        #[arg(long)]
-        csv: Option<PathBuf>,
-        /// Write the log-log plot of RMSE against seconds to this PNG file.
-        #[arg(long)]
-        plot: Option<PathBuf>,
-        /// Replace existing CSV and plot files.
-        #[arg(long)]
-        force: bool,
-        /// Render with this many threads (default: one per core).
-        #[arg(long, value_name = "N")]
-        threads: Option<usize>,
-    },
+    Convergence(super::convergence::ConvergenceArgs),
     /// Photon mapping: resident memory (current and peak) of a long stochastic render (open
     /// aperture), sampled every --every passes.
-    Memory {
-        /// Scene file; the built-in scene when omitted.
-        scene: Option<PathBuf>,
-        /// Image width.
-        #[arg(long, default_value_t = 1920)]
-        width: u32,
-        /// Image height.
-        #[arg(long, default_value_t = 1080)]
-        height: u32,
-        /// Passes to render.
-        #[arg(long, default_value_t = 100)]
-        passes: u32,
-        /// Sample the memory every this many passes.
-        #[arg(long, default_value_t = 10)]
-        every: u32,
-        /// Photons per pass (small: the eye pass and its visible points are what grows).
-        #[arg(long, default_value_t = 20_000)]
-        photons: u64,
-    },
+    Memory(super::memory::MemoryArgs),
     /// Whitted ray tracer: rays per second on a scene, at the given thread counts.
     Whitted {
         /// Scene file; the built-in scene when omitted.
@@ -147,7 +86,7 @@ impl BenchCommand {
     /// thread counts take a list of their own).
     pub fn threads(&self) -> Option<usize> {
         match self {
-            BenchCommand::Convergence { threads, .. } => *threads,
+            BenchCommand::Convergence(args) => args.threads,
             _ => None,
         }
     }
@@ -177,57 +116,19 @@ pub fn bench(what: BenchCommand) -> Result<()> {
             width,
             threads,
         } => bench_whitted(scene.as_deref(), width, &threads),
-        BenchCommand::Memory {
-            scene,
-            width,
-            height,
-            passes,
-            every,
-            photons,
-        } => super::memory::bench_memory(super::memory::MemoryArgs {
-            scene: scene.as_deref(),
-            size: (width, height),
-            passes,
-            every,
-            photons,
-        }),
+        BenchCommand::Memory(args) => super::memory::bench_memory(args),
         BenchCommand::Ppm {
             scene,
             photons,
             passes,
             threads,
         } => bench_ppm(scene.as_deref(), photons, passes, &threads),
-        BenchCommand::Convergence {
-            scene,
-            width,
-            photons,
-            seconds,
-            baseline_seconds,
-            reference_passes,
-            reference_dir,
-            configs,
-            csv,
-            plot,
-            force,
-            threads: _,
-        } => super::convergence::bench_convergence(super::convergence::ConvergenceArgs {
-            scene: photon_scene(scene.as_deref())?,
-            width,
-            photons,
-            seconds,
-            baseline_seconds,
-            reference_passes,
-            reference_dir,
-            configs,
-            csv,
-            plot,
-            force,
-        }),
+        BenchCommand::Convergence(args) => super::convergence::bench_convergence(args),
     }
 }
 
 /// The scene a photon-mapping bench measures: the file, or smallppm's built-in scene.
-fn photon_scene(path: Option<&Path>) -> Result<Scene> {
+pub(super) fn photon_scene(path: Option<&Path>) -> Result<Scene> {
     Ok(match path {
         Some(p) => Scene::load(p)?,
         None => Scene::from_str(SMALLPPM_SCENE, Path::new("<built-in smallppm>"), None)?,

@@ -78,35 +78,56 @@ impl Config {
     }
 }
 
-/// `bench convergence`'s settings.
+/// `bench convergence`'s flags.
+#[derive(clap::Args)]
 pub struct ConvergenceArgs {
-    /// Scene (already loaded).
-    pub scene: Scene,
-    /// Image width (height follows the aspect).
-    pub width: u32,
-    /// Photons per pass (`None`: the scene's).
-    pub photons: Option<u64>,
+    /// Scene file; smallppm's scene (built in) when omitted.
+    scene: Option<PathBuf>,
+    /// Image width (height follows the scene's aspect).
+    #[arg(long, default_value_t = 256)]
+    width: u32,
+    /// Photons per pass (default: the scene's).
+    #[arg(long)]
+    photons: Option<u64>,
     /// Seconds each configuration renders.
-    pub seconds: f64,
-    /// Seconds the baseline (the first configuration) renders; its final error is the target.
-    pub baseline_seconds: Option<f64>,
-    /// Passes of the reference.
-    pub reference_passes: u32,
-    /// Where references are cached.
-    pub reference_dir: Option<PathBuf>,
-    /// Configurations, the first being the baseline.
-    pub configs: Vec<Config>,
-    /// CSV output.
-    pub csv: Option<PathBuf>,
-    /// PNG plot output.
-    pub plot: Option<PathBuf>,
+    #[arg(long, default_value_t = 10.0)]
+    seconds: f64,
+    /// Seconds the first configuration (the baseline) renders, when not --seconds: its final
+    /// error is the target the others are timed to.
+    #[arg(long)]
+    baseline_seconds: Option<f64>,
+    /// Passes of the reference render (the scene's own settings and photons per pass, another
+    /// seed).
+    #[arg(long, default_value_t = 1000)]
+    reference_passes: u32,
+    /// Where reference renders are cached (default: ~/.cache/caustic/references).
+    #[arg(long)]
+    reference_dir: Option<PathBuf>,
+    /// Configurations to measure, the first being the baseline.
+    #[arg(
+        long,
+        value_enum,
+        value_delimiter = ',',
+        default_value = "photons-only,default,alpha-0.5,alpha-0.667,alpha-0.9,radius-x4,kd-tree"
+    )]
+    configs: Vec<Config>,
+    /// Write every (configuration, pass, seconds, RMSE, relMSE) row to this CSV file.
+    #[arg(long)]
+    csv: Option<PathBuf>,
+    /// Write the log-log plot of RMSE against seconds to this PNG file.
+    #[arg(long)]
+    plot: Option<PathBuf>,
     /// Replace existing CSV and plot files.
-    pub force: bool,
+    #[arg(long)]
+    force: bool,
+    /// Render with this many threads (default: one per core).
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
 }
 
 /// Runs the measurement and prints the table.
 pub fn bench_convergence(args: ConvergenceArgs) -> Result<()> {
-    let ConvergenceArgs { mut scene, .. } = args;
+    let mut scene = super::bench::photon_scene(args.scene.as_deref())?;
     check(
         &args.width,
         args.seconds,

@@ -2,7 +2,7 @@
 //! aperture, so every pass traces a new eye pass), sampled every few passes: the peak must
 //! stay bounded and the current size flat, whatever the number of passes.
 
-use std::path::Path;
+use std::path::PathBuf;
 
 use anyhow::{bail, Result};
 
@@ -10,18 +10,26 @@ use super::{load_scene, photon_map};
 use caustic::render::session::SessionOptions;
 use caustic::scene::RendererKind;
 
-/// `bench memory`'s settings.
-pub struct MemoryArgs<'a> {
-    /// Scene (the built-in teapot when `None`).
-    pub scene: Option<&'a Path>,
-    /// Image size.
-    pub size: (u32, u32),
+/// `bench memory`'s flags.
+#[derive(clap::Args)]
+pub struct MemoryArgs {
+    /// Scene file; the built-in scene when omitted.
+    scene: Option<PathBuf>,
+    /// Image width.
+    #[arg(long, default_value_t = 1920)]
+    width: u32,
+    /// Image height.
+    #[arg(long, default_value_t = 1080)]
+    height: u32,
     /// Passes to render.
-    pub passes: u32,
-    /// Sample memory every this many passes.
-    pub every: u32,
-    /// Photons per pass.
-    pub photons: u64,
+    #[arg(long, default_value_t = 100)]
+    passes: u32,
+    /// Sample the memory every this many passes.
+    #[arg(long, default_value_t = 10)]
+    every: u32,
+    /// Photons per pass (small: the eye pass and its visible points are what grows).
+    #[arg(long, default_value_t = 20_000)]
+    photons: u64,
 }
 
 /// Resident set size and its peak, in MiB, from `/proc/self/status` (Linux).
@@ -43,11 +51,11 @@ pub fn bench_memory(args: MemoryArgs) -> Result<()> {
     if resident_mib().is_none() {
         bail!("resident memory is read from /proc/self/status, which this system does not have");
     }
-    let mut scene = load_scene(args.scene)?;
-    for (flag, v) in [("--width", args.size.0), ("--height", args.size.1)] {
+    let mut scene = load_scene(args.scene.as_deref())?;
+    for (flag, v) in [("--width", args.width), ("--height", args.height)] {
         caustic::render::limits::image_side(v).map_err(|e| anyhow::anyhow!("{flag} {e}"))?;
     }
-    (scene.camera.width, scene.camera.height) = args.size;
+    (scene.camera.width, scene.camera.height) = (args.width, args.height);
     // An open aperture: stochastic PPM, a new eye pass (and new visible points) every pass.
     if scene.camera.aperture <= 0.0 {
         scene.camera.aperture = 0.01 * scene.camera.focal_distance;
@@ -63,8 +71,8 @@ pub fn bench_memory(args: MemoryArgs) -> Result<()> {
     println!(
         "Memory of a stochastic render of {}, {}x{}, aperture {:.4}, {} photons per pass; {before:.0} MiB before rendering",
         scene.source.display(),
-        args.size.0,
-        args.size.1,
+        args.width,
+        args.height,
         scene.camera.aperture,
         args.photons
     );
