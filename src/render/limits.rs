@@ -12,6 +12,8 @@ pub const PHOTONS_PER_PASS: RangeInclusive<u64> = 1..=1_000_000_000;
 pub const MAX_DEPTH: RangeInclusive<u32> = 1..=64;
 /// Lens and light samples per pixel or shading point.
 pub const SAMPLES: RangeInclusive<u32> = 1..=4096;
+/// Least photons per pixel of a stochastic pass.
+pub const PHOTONS_PER_PIXEL: RangeInclusive<f64> = 0.0..=1000.0;
 /// Image width and height in pixels.
 pub const IMAGE_SIDE: RangeInclusive<u32> = 1..=16384;
 
@@ -34,11 +36,7 @@ pub fn photons_per_pass(n: u64) -> Result<u64, Invalid> {
 
 /// Least photons per pixel of a stochastic pass.
 pub fn photons_per_pixel(n: f64) -> Result<f64, Invalid> {
-    if n.is_finite() && (0.0..=1000.0).contains(&n) {
-        Ok(n)
-    } else {
-        Err(format!("must be between 0 and 1000, got {n}"))
-    }
+    within(n, PHOTONS_PER_PIXEL, "")
 }
 
 /// Maximum specular depth.
