@@ -480,21 +480,14 @@ pub fn dialogs_ui(viewer: &Viewer, ctx: &egui::Context, out: &mut Vec<Action>) {
     }
     if viewer.confirm_restart {
         let passes = viewer.frame.as_ref().map_or(0, |f| f.pass);
-        let modal = egui::Modal::new(egui::Id::unique("caustic-restart")).show(ctx, |ui| {
-            ui.heading("Restart the render?");
-            ui.label(format!("The {passes} passes rendered so far would be discarded."));
-            ui.horizontal(|ui| {
-                if ui.button("Discard and restart").clicked() {
-                    Some(true)
-                } else if ui.button("Keep rendering").clicked() {
-                    Some(false)
-                } else {
-                    None
-                }
-            })
-            .inner
-        });
-        if let Some(restart) = modal.inner.or(modal.should_close().then_some(false)) {
+        let question = Question {
+            id: "caustic-restart",
+            heading: "Restart the render?",
+            text: &format!("The {passes} passes rendered so far would be discarded."),
+            yes: "Discard and restart",
+            no: "Keep rendering",
+        };
+        if let Some(restart) = question.ask(ctx) {
             out.push(Action::ConfirmRestart(restart));
         }
     }
@@ -529,21 +522,44 @@ pub fn dialogs_ui(viewer: &Viewer, ctx: &egui::Context, out: &mut Vec<Action>) {
     }
 }
 
+/// A modal yes/no question.
+struct Question<'a> {
+    id: &'static str,
+    heading: &'a str,
+    text: &'a str,
+    yes: &'a str,
+    no: &'a str,
+}
+
+impl Question<'_> {
+    /// Shows it: `Some(true)` yes, `Some(false)` no (or closed), `None` not answered yet.
+    fn ask(&self, ctx: &egui::Context) -> Option<bool> {
+        let modal = egui::Modal::new(egui::Id::unique(self.id)).show(ctx, |ui| {
+            ui.heading(self.heading);
+            ui.label(self.text);
+            ui.horizontal(|ui| {
+                if ui.button(self.yes).clicked() {
+                    Some(true)
+                } else if ui.button(self.no).clicked() {
+                    Some(false)
+                } else {
+                    None
+                }
+            })
+            .inner
+        });
+        modal.inner.or(modal.should_close().then_some(false))
+    }
+}
+
 /// A "Replace file?" modal: `Some(true)` replace, `Some(false)` cancel, `None` not answered.
-fn replace_question(ctx: &egui::Context, id: &str, text: &str) -> Option<bool> {
-    let modal = egui::Modal::new(egui::Id::unique(id)).show(ctx, |ui| {
-        ui.heading("Replace file?");
-        ui.label(text);
-        ui.horizontal(|ui| {
-            if ui.button("Replace").clicked() {
-                Some(true)
-            } else if ui.button("Cancel").clicked() {
-                Some(false)
-            } else {
-                None
-            }
-        })
-        .inner
-    });
-    modal.inner.or(modal.should_close().then_some(false))
+fn replace_question(ctx: &egui::Context, id: &'static str, text: &str) -> Option<bool> {
+    Question {
+        id,
+        heading: "Replace file?",
+        text,
+        yes: "Replace",
+        no: "Cancel",
+    }
+    .ask(ctx)
 }
