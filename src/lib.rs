@@ -10,6 +10,7 @@
 //! * [`render`]: the Whitted ray tracer, the film and its PNG/EXR output, random streams.
 //! * [`assets`]: the data the binary carries built in (Newell's teapot).
 //! * [`bench`]: measurement harnesses used by `caustic bench`.
+//! * [`tev`]: streaming frames to a running tev viewer.
 //! * `app` and `gpu` (feature `viewer`, on by default): the eframe viewer and the wgpu
 //!   control-net overlay it draws; the render core does not depend on them.
 //!
@@ -28,3 +29,4 @@ pub mod geometry;
 pub mod gpu;
 pub mod render;
 pub mod scene;
+pub mod tev;

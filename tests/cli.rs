@@ -378,3 +378,71 @@ fn memory_bench_prints_its_samples() {
         .count();
     assert_eq!(rows, 3, "passes 1, 2 and 4 sampled: {t}");
 }
+
+/// Every bench prints one JSON document on stdout with `--json` (its text goes to stderr).
+#[test]
+fn every_bench_has_a_json_summary() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let refs = dir.path().join("references");
+    let cases: [(&str, Vec<&str>, &str); 5] = [
+        ("intersect", vec!["--size", "16", "--repeat", "1"], "intersectors"),
+        (
+            "ppm",
+            vec!["--photons", "2000", "--passes", "1", "--threads", "1"],
+            "runs",
+        ),
+        (
+            "whitted",
+            vec!["scenes/leaf.toml", "--width", "16", "--threads", "1"],
+            "runs",
+        ),
+        (
+            "memory",
+            vec![
+                "--width",
+                "16",
+                "--height",
+                "12",
+                "--passes",
+                "2",
+                "--every",
+                "1",
+                "--photons",
+                "500",
+            ],
+            "samples",
+        ),
+        (
+            "convergence",
+            vec![
+                "scenes/cornell.toml",
+                "--width",
+                "12",
+                "--photons",
+                "1000",
+                "--seconds",
+                "0.2",
+                "--reference-passes",
+                "2",
+                "--configs",
+                "photons-only,default",
+                "--reference-dir",
+                refs.to_str().expect("utf-8"),
+            ],
+            "configurations",
+        ),
+    ];
+    for (bench, args, list) in cases {
+        let mut all = vec!["bench", bench, "--json"];
+        all.extend(args);
+        let out = caustic(&all);
+        assert!(out.status.success(), "{bench}: {}", text(&out));
+        let doc: serde_json::Value =
+            serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{bench}: {e}: {}", text(&out)));
+        assert_eq!(doc["bench"], bench);
+        let entries = doc[list]
+            .as_array()
+            .unwrap_or_else(|| panic!("{bench}: no {list}: {doc}"));
+        assert!(!entries.is_empty(), "{bench}: {doc}");
+    }
+}

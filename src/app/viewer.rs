@@ -369,7 +369,9 @@ impl Viewer {
         };
         // The parameters the panel changes are added below; the base pairs (scene file, seed,
         // size) do not depend on them.
-        let mut metadata = image_metadata(&self.scene, renderer);
+        let scene = self.edited_scene();
+        let text = crate::scene::save::scene_toml(&scene, &self.editor.loaded, None).ok();
+        let mut metadata = image_metadata(&scene, renderer, text);
         metadata.push(("caustic:passes".into(), frame.pass.to_string()));
         metadata.push(("caustic:photons".into(), frame.photons.to_string()));
         metadata.push(("caustic:alpha".into(), self.params.render.alpha.to_string()));
@@ -379,7 +381,7 @@ impl Viewer {
             self.params.focal_distance.to_string(),
         ));
         metadata.push((
-            "caustic:exposure_stops".into(),
+            crate::render::provenance::EXPOSURE.into(),
             self.settings.exposure_stops.to_string(),
         ));
         Some(Snapshot {

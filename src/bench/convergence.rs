@@ -7,6 +7,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use crate::files::{write_atomically, WriteError};
+pub use crate::render::error::errors;
 
 /// One checkpoint of a curve: a completed pass.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -29,20 +30,6 @@ pub struct Curve {
     pub name: String,
     /// Checkpoints in time order.
     pub points: Vec<Checkpoint>,
-}
-
-/// RMSE and relative MSE of `image` against `reference` (same size, linear RGB).
-pub fn errors(image: &[[f32; 3]], reference: &[[f32; 3]]) -> (f64, f64) {
-    let (mut sq, mut rel) = (0.0, 0.0);
-    for (x, r) in image.iter().zip(reference) {
-        for c in 0..3 {
-            let (x, r) = (x[c] as f64, r[c] as f64);
-            sq += (x - r) * (x - r);
-            rel += (x - r) * (x - r) / (r * r + 0.01);
-        }
-    }
-    let n = (3 * image.len().max(1)) as f64;
-    ((sq / n).sqrt(), rel / n)
 }
 
 impl Curve {
@@ -134,8 +121,5 @@ mod tests {
         assert!((c.slope().expect("slope") + 0.5).abs() < 1e-12);
         assert_eq!(c.time_to(0.3), Some(16.0));
         assert_eq!(c.time_to(1e-3), None);
-        assert_eq!(errors(&[[1.0, 2.0, 3.0]], &[[1.0, 2.0, 3.0]]), (0.0, 0.0));
-        let (rmse, rel) = errors(&[[1.1, 1.1, 1.1]], &[[1.0, 1.0, 1.0]]);
-        assert!((rmse - 0.1).abs() < 1e-6 && (rel - 0.01 / 1.01).abs() < 1e-6);
     }
 }

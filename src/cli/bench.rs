@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Result};
 use clap::{Subcommand, ValueEnum};
 
+use super::bench_output::BenchOutput;
 use super::{load_scene, photon_map, ppm_stats};
 use caustic::assets::SMALLPPM_SCENE;
 use caustic::bench::{teapot_geometry, teapot_view, time_intersect};
@@ -92,8 +93,16 @@ impl BenchCommand {
     }
 }
 
-/// Runs a bench command.
-pub fn bench(what: BenchCommand) -> Result<()> {
+/// Runs a bench command; `json` prints its figures as JSON.
+pub fn bench(what: BenchCommand, json: bool) -> Result<()> {
+    let name = match &what {
+        BenchCommand::Intersect { .. } => "intersect",
+        BenchCommand::Ppm { .. } => "ppm",
+        BenchCommand::Convergence(_) => "convergence",
+        BenchCommand::Memory(_) => "memory",
+        BenchCommand::Whitted { .. } => "whitted",
+    };
+    let mut out = BenchOutput::new(json, name);
     match what {
         BenchCommand::Intersect {
             size,
@@ -109,22 +118,24 @@ pub fn bench(what: BenchCommand) -> Result<()> {
                 max_size,
                 max_depth,
             };
-            bench_intersect(size, repeat, method, per_ray_depth, params)
+            bench_intersect(size, repeat, method, per_ray_depth, params, &mut out)
         }
         BenchCommand::Whitted {
             scene,
             width,
             threads,
-        } => bench_whitted(scene.as_deref(), width, &threads),
-        BenchCommand::Memory(args) => super::memory::bench_memory(args),
+        } => bench_whitted(scene.as_deref(), width, &threads, &mut out),
+        BenchCommand::Memory(args) => super::memory::bench_memory(args, &mut out),
         BenchCommand::Ppm {
             scene,
             photons,
             passes,
             threads,
-        } => bench_ppm(scene.as_deref(), photons, passes, &threads),
-        BenchCommand::Convergence(args) => super::convergence::bench_convergence(args),
-    }
+        } => bench_ppm(scene.as_deref(), photons, passes, &threads, &mut out),
+        BenchCommand::Convergence(args) => super::convergence::bench_convergence(args, &mut out),
+    }?;
+    out.finish();
+    Ok(())
 }
 
 /// The scene a photon-mapping bench measures: the file, or smallppm's built-in scene.
@@ -135,21 +146,31 @@ pub(super) fn photon_scene(path: Option<&Path>) -> Result<Scene> {
     })
 }
 
-fn bench_ppm(scene_path: Option<&Path>, photons: u64, passes: u32, threads: &[usize]) -> Result<()> {
+fn bench_ppm(
+    scene_path: Option<&Path>,
+    photons: u64,
+    passes: u32,
+    threads: &[usize],
+    out: &mut BenchOutput,
+) -> Result<()> {
     if photons == 0 || passes == 0 {
         bail!("--photons and --passes must be at least 1");
     }
     let mut scene = photon_scene(scene_path)?;
     scene.params.photons_per_pass = photons;
     let (w, h) = (scene.camera.width, scene.camera.height);
-    println!(
+    out.say(format!(
         "Photon mapping on {}, {w}x{h}, {passes} passes of {photons} photons",
         scene.source.display()
-    );
-    println!(
+    ));
+    out.set("scene", scene.source.display().to_string());
+    out.set("size", [w, h]);
+    out.set("passes", passes);
+    out.set("photons_per_pass", photons);
+    out.say(format!(
         "{:>8} {:>12} {:>16} {:>22} {:>10}",
         "threads", "photon s", "photon paths/s", "paths per core-second", "scaling"
-    );
+    ));
     scene.params.renderer = RendererKind::Ppm;
     let mut base = None;
     for &n in threads {
@@ -166,30 +187,47 @@ fn bench_ppm(scene_path: Option<&Path>, photons: u64, passes: u32, threads: &[us
         let rate = stats.photons as f64 / stats.photon_secs;
         let scaling = base.map_or(1.0, |b: f64| rate / b);
         base.get_or_insert(rate);
-        println!(
+        out.say(format!(
             "{n:>8} {:>12.3} {rate:>16.0} {:>22.0} {scaling:>9.2}x",
             stats.photon_secs,
             rate / n as f64
+        ));
+        out.push(
+            "runs",
+            serde_json::json!({
+                "threads": n,
+                "photon_seconds": stats.photon_secs,
+                "photon_paths_per_second": rate,
+                "paths_per_core_second": rate / n as f64,
+                "scaling": scaling,
+            }),
         );
     }
     Ok(())
 }
 
-fn bench_whitted(scene_path: Option<&Path>, width: u32, threads: &[usize]) -> Result<()> {
+fn bench_whitted(
+    scene_path: Option<&Path>,
+    width: u32,
+    threads: &[usize],
+    out: &mut BenchOutput,
+) -> Result<()> {
     let mut scene = load_scene(scene_path)?;
     let aspect = scene.camera.height as f64 / scene.camera.width as f64;
     scene.camera.width = width.clamp(1, 16384);
     scene.camera.height = ((width as f64 * aspect).round() as u32).max(1);
-    println!(
+    out.say(format!(
         "Whitted ray tracer on {}, {}x{}",
         scene.source.display(),
         scene.camera.width,
         scene.camera.height
-    );
-    println!(
+    ));
+    out.set("scene", scene.source.display().to_string());
+    out.set("size", [scene.camera.width, scene.camera.height]);
+    out.say(format!(
         "{:>8} {:>10} {:>14} {:>12}",
         "threads", "seconds", "camera rays/s", "speed-up"
-    );
+    ));
     let mut base = None;
     for &n in threads {
         if n == 0 {
@@ -200,9 +238,18 @@ fn bench_whitted(scene_path: Option<&Path>, width: u32, threads: &[usize]) -> Re
         let rate = stats.camera_rays as f64 / stats.elapsed_secs;
         let speedup = base.map_or(1.0, |b: f64| stats.elapsed_secs.recip() * b);
         base.get_or_insert(stats.elapsed_secs);
-        println!(
+        out.say(format!(
             "{n:>8} {:>10.3} {rate:>14.0} {speedup:>11.2}x",
             stats.elapsed_secs
+        ));
+        out.push(
+            "runs",
+            serde_json::json!({
+                "threads": n,
+                "seconds": stats.elapsed_secs,
+                "camera_rays_per_second": rate,
+                "speedup": speedup,
+            }),
         );
     }
     Ok(())
@@ -214,6 +261,7 @@ fn bench_intersect(
     method: MethodChoice,
     per_ray_depth: u32,
     params: SubdivisionParams,
+    out: &mut BenchOutput,
 ) -> Result<()> {
     if size == 0 || size > 8192 {
         bail!("--size must be between 1 and 8192, got {size}");
@@ -228,11 +276,15 @@ fn bench_intersect(
         bail!("--flatness and --max-size must be positive and --max-depth at most 12");
     }
     let rays = teapot_view(size, size);
-    println!("Utah teapot (32 patches), {size}x{size} primary rays, 1 thread, {repeat} repeats");
-    println!(
+    out.say(format!(
+        "Utah teapot (32 patches), {size}x{size} primary rays, 1 thread, {repeat} repeats"
+    ));
+    out.set("size", size);
+    out.set("repeat", repeat);
+    out.say(format!(
         "{:<22} {:>9} {:>9} {:>12} {:>13}",
         "intersector", "hit rays", "miss rays", "ns/hit ray", "ns/miss ray"
-    );
+    ));
     let mut methods = Vec::new();
     if method != MethodChoice::PerRay {
         methods.push(("prepared".to_owned(), PatchMethod::Prepared(params)));
@@ -248,14 +300,29 @@ fn bench_intersect(
         let geometry = teapot_geometry(m);
         let prep_ms = start.elapsed().as_secs_f64() * 1e3;
         let t = time_intersect(&name, &geometry, &rays, repeat);
-        println!(
+        out.say(format!(
             "{:<22} {:>9} {:>9} {:>12.1} {:>13.1}",
             t.method, t.hit_rays, t.miss_rays, t.ns_per_hit, t.ns_per_miss
-        );
+        ));
         let s = geometry.stats();
-        println!(
+        out.say(format!(
             "    prepare {prep_ms:.2} ms; {} BVH primitives ({} patch leaves), {} nodes, depth {}",
             s.primitives, s.patch_leaves, s.bvh_nodes, s.bvh_depth
+        ));
+        out.push(
+            "intersectors",
+            serde_json::json!({
+                "method": t.method,
+                "hit_rays": t.hit_rays,
+                "miss_rays": t.miss_rays,
+                "ns_per_hit": t.ns_per_hit,
+                "ns_per_miss": t.ns_per_miss,
+                "prepare_ms": prep_ms,
+                "bvh_primitives": s.primitives,
+                "patch_leaves": s.patch_leaves,
+                "bvh_nodes": s.bvh_nodes,
+                "bvh_depth": s.bvh_depth,
+            }),
         );
     }
     Ok(())

@@ -8,6 +8,7 @@ use std::time::Duration;
 use anyhow::{bail, Context, Result};
 use clap::ValueEnum;
 
+use super::bench_output::BenchOutput;
 use super::photon_map;
 use caustic::bench::convergence::{errors, write_csv, Checkpoint, Curve};
 use caustic::bench::plot::write_plot;
@@ -126,7 +127,7 @@ pub struct ConvergenceArgs {
 }
 
 /// Runs the measurement and prints the table.
-pub fn bench_convergence(args: ConvergenceArgs) -> Result<()> {
+pub fn bench_convergence(args: ConvergenceArgs, out: &mut BenchOutput) -> Result<()> {
     let mut scene = super::bench::photon_scene(args.scene.as_deref())?;
     check(
         &args.width,
@@ -148,7 +149,7 @@ pub fn bench_convergence(args: ConvergenceArgs) -> Result<()> {
     scene.params.renderer = RendererKind::Ppm;
     // The reference keeps the scene's own photons per pass, so runs with other --photons
     // share it.
-    let reference = reference(&scene, args.reference_passes, args.reference_dir.as_deref())?;
+    let reference = reference(&scene, args.reference_passes, args.reference_dir.as_deref(), out)?;
     if let Some(n) = args.photons {
         scene.params.photons_per_pass = n;
     }
@@ -157,14 +158,17 @@ pub fn bench_convergence(args: ConvergenceArgs) -> Result<()> {
         .validate()
         .map_err(|e| anyhow::anyhow!("--photons: {e}"))?;
     let auto_radius = Ppm::automatic_initial_radius(&scene);
-    println!(
+    out.say(format!(
         "Error against time on {}, {}x{}, {} photons per pass, {} s per configuration",
         scene.source.display(),
         scene.camera.width,
         scene.camera.height,
         scene.params.photons_per_pass,
         args.seconds
-    );
+    ));
+    out.set("scene", scene.source.display().to_string());
+    out.set("size", [scene.camera.width, scene.camera.height]);
+    out.set("photons_per_pass", scene.params.photons_per_pass);
     let mut curves = Vec::new();
     for (k, config) in args.configs.iter().enumerate() {
         let seconds = match (k, args.baseline_seconds) {
@@ -176,10 +180,10 @@ pub fn bench_convergence(args: ConvergenceArgs) -> Result<()> {
         eprintln!("  {} ({seconds} s)...", config.label());
         curves.push(measure(configured, config.label(), seconds, &reference)?);
     }
-    print_table(&curves);
+    print_table(&curves, out);
     if let Some(path) = &args.csv {
         write_csv(&curves, path, args.force)?;
-        println!("rows written to {}", path.display());
+        out.say(format!("rows written to {}", path.display()));
     }
     if let Some(path) = &args.plot {
         let title = format!(
@@ -192,7 +196,7 @@ pub fn bench_convergence(args: ConvergenceArgs) -> Result<()> {
             scene.camera.height
         );
         write_plot(&curves, &title, path, args.force)?;
-        println!("plot written to {}", path.display());
+        out.say(format!("plot written to {}", path.display()));
     }
     Ok(())
 }
@@ -214,13 +218,14 @@ fn check(width: &u32, seconds: f64, baseline: Option<f64>, passes: u32) -> Resul
 
 /// The reference: from the cache when its record matches, else rendered (another seed, the
 /// scene's own parameters) and cached.
-fn reference(scene: &Scene, passes: u32, dir: Option<&Path>) -> Result<Vec<[f32; 3]>> {
+fn reference(scene: &Scene, passes: u32, dir: Option<&Path>, out: &mut BenchOutput) -> Result<Vec<[f32; 3]>> {
     let dir = dir.map_or_else(default_cache_dir, Path::to_path_buf);
     let mut reference_scene = scene.clone();
     reference_scene.params.seed ^= 0x5eed;
     let record = ReferenceRecord::new(&reference_scene, passes);
     if let Some(pixels) = record.load(&dir) {
-        println!("reference: {} (cached)", record.path_in(&dir).display());
+        out.say(format!("reference: {} (cached)", record.path_in(&dir).display()));
+        out.set("reference", record.path_in(&dir).display().to_string());
         return Ok(pixels);
     }
     let bar = super::progress_bar(
@@ -238,7 +243,8 @@ fn reference(scene: &Scene, passes: u32, dir: Option<&Path>) -> Result<Vec<[f32;
         .store(&dir, &frame.radiance)
         .map_err(|e| anyhow::anyhow!(e))
         .context("cannot cache the reference render")?;
-    println!("reference: {} ({passes} passes, cached)", path.display());
+    out.say(format!("reference: {} ({passes} passes, cached)", path.display()));
+    out.set("reference", path.display().to_string());
     Ok(frame.radiance.to_vec())
 }
 
@@ -266,21 +272,22 @@ fn measure(scene: Scene, name: &str, seconds: f64, reference: &[[f32; 3]]) -> Re
 
 /// The table: each configuration's final error, slope, and how soon it reached the error the
 /// baseline (the first configuration) ended with.
-fn print_table(curves: &[Curve]) {
+fn print_table(curves: &[Curve], out: &mut BenchOutput) {
     let Some(target) = curves.first().and_then(Curve::last).map(|p| p.rmse) else {
         return;
     };
     let base_secs = curves[0].last().map_or(0.0, |p| p.secs);
     // Timed to its first point at the target, like the others (noise may reach it early).
     let base_reach = curves[0].time_to(target).unwrap_or(base_secs);
-    println!(
+    out.say(format!(
         "{:<28} {:>7} {:>8} {:>11} {:>11} {:>7} {:>16} {:>9}",
         "configuration", "passes", "seconds", "RMSE", "relMSE", "slope", "s to target", "speed-up"
-    );
+    ));
+    out.set("target_rmse", target);
     for c in curves {
         let Some(last) = c.last() else { continue };
         let reach = c.time_to(target);
-        println!(
+        out.say(format!(
             "{:<28} {:>7} {:>8.2} {:>11.4e} {:>11.4e} {:>7} {:>16} {:>9}",
             c.name,
             last.pass,
@@ -290,10 +297,24 @@ fn print_table(curves: &[Curve]) {
             c.slope().map_or("-".into(), |s| format!("{s:.2}")),
             reach.map_or("not reached".into(), |t| format!("{t:.2}")),
             reach.map_or("-".into(), |t| format!("{:.1}x", base_reach / t.max(1e-9))),
+        ));
+        out.push(
+            "configurations",
+            serde_json::json!({
+                "name": c.name,
+                "passes": last.pass,
+                "seconds": last.secs,
+                "rmse": last.rmse,
+                "rel_mse": last.rel_mse,
+                "slope": c.slope(),
+                "seconds_to_target": reach,
+                "speedup": reach.map(|t| base_reach / t.max(1e-9)),
+                "points": c.points.iter().map(|p| [p.secs, p.rmse, p.rel_mse]).collect::<Vec<_>>(),
+            }),
         );
     }
-    println!(
+    out.say(format!(
         "target: RMSE {target:.4e}, what '{}' reached after {base_secs:.1} s",
         curves[0].name
-    );
+    ));
 }

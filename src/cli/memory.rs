@@ -6,6 +6,7 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Result};
 
+use super::bench_output::BenchOutput;
 use super::{load_scene, photon_map};
 use caustic::render::session::SessionOptions;
 use caustic::scene::RendererKind;
@@ -44,7 +45,7 @@ fn resident_mib() -> Option<(f64, f64)> {
 }
 
 /// Renders and prints the memory samples.
-pub fn bench_memory(args: MemoryArgs) -> Result<()> {
+pub fn bench_memory(args: MemoryArgs, out: &mut BenchOutput) -> Result<()> {
     if args.passes == 0 || args.every == 0 {
         bail!("--passes and --every must be at least 1");
     }
@@ -68,18 +69,23 @@ pub fn bench_memory(args: MemoryArgs) -> Result<()> {
         .validate()
         .map_err(|e| anyhow::anyhow!("--photons: {e}"))?;
     let before = resident_mib().map_or(0.0, |m| m.0);
-    println!(
+    out.say(format!(
         "Memory of a stochastic render of {}, {}x{}, aperture {:.4}, {} photons per pass; {before:.0} MiB before rendering",
         scene.source.display(),
         args.width,
         args.height,
         scene.camera.aperture,
         args.photons
-    );
-    println!(
+    ));
+    out.set("scene", scene.source.display().to_string());
+    out.set("size", [args.width, args.height]);
+    out.set("aperture", scene.camera.aperture);
+    out.set("photons_per_pass", args.photons);
+    out.set("resident_mib_before", before);
+    out.say(format!(
         "{:>8} {:>10} {:>14} {:>10}",
         "pass", "seconds", "resident MiB", "peak MiB"
-    );
+    ));
     let options = SessionOptions {
         max_passes: Some(args.passes),
         ..Default::default()
@@ -88,16 +94,29 @@ pub fn bench_memory(args: MemoryArgs) -> Result<()> {
     photon_map(scene, options, |f| {
         if f.pass % args.every == 0 || f.pass == 1 {
             if let Some((rss, peak)) = resident_mib() {
-                println!("{:>8} {:>10.1} {rss:>14.1} {peak:>10.1}", f.pass, f.elapsed_secs);
+                out.say(format!(
+                    "{:>8} {:>10.1} {rss:>14.1} {peak:>10.1}",
+                    f.pass, f.elapsed_secs
+                ));
+                out.push(
+                    "samples",
+                    serde_json::json!({
+                        "pass": f.pass,
+                        "seconds": f.elapsed_secs,
+                        "resident_mib": rss,
+                        "peak_mib": peak,
+                    }),
+                );
                 samples.push(rss);
             }
         }
     })?;
     if let (Some(first), Some(last)) = (samples.get(1).or(samples.first()), samples.last()) {
-        println!(
+        out.say(format!(
             "resident size from the first sample after pass 1 to the last: {first:.1} → {last:.1} MiB ({:+.1} %)",
             (last / first - 1.0) * 100.0
-        );
+        ));
+        out.set("growth_percent", (last / first - 1.0) * 100.0);
     }
     Ok(())
 }

@@ -2,10 +2,12 @@
 //! its own ([`view`], [`render`], [`export`], [`bench`], [`convergence`], [`memory`]).
 
 mod bench;
+mod bench_output;
 mod convergence;
 mod export;
 mod memory;
 mod render;
+mod render_report;
 mod view;
 
 use std::path::Path;
@@ -39,6 +41,9 @@ enum Command {
     ExportObj(export::ExportArgs),
     /// Measure performance; prints figures (nothing is asserted).
     Bench {
+        /// Print the figures as one JSON document on stdout (the text goes to stderr).
+        #[arg(long, global = true)]
+        json: bool,
         #[command(subcommand)]
         what: bench::BenchCommand,
     },
@@ -55,13 +60,13 @@ pub fn run() -> Result<()> {
         Command::View(a) => a.threads,
         Command::Render(a) => a.threads,
         Command::ExportObj(_) => None,
-        Command::Bench { what } => what.threads(),
+        Command::Bench { what, .. } => what.threads(),
     })?;
     match command {
         Command::View(args) => view::view(args, launched),
         Command::Render(args) => render::render(args),
         Command::ExportObj(args) => export::export_obj(args),
-        Command::Bench { what } => bench::bench(what),
+        Command::Bench { what, json } => bench::bench(what, json),
     }
 }
 

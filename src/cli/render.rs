@@ -1,25 +1,37 @@
 //! `caustic render`: a scene to a PNG or EXR image, ray traced or photon mapped, with a
-//! progress bar and the render's figures in the image's metadata.
+//! progress bar, the render's figures and provenance in the image's metadata (so `--from`
+//! renders it again), per-pixel EXR layers, and optionally a reference comparison per pass,
+//! a tev stream and a JSON summary ([`super::render_report`]).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Duration;
 
 use anyhow::{bail, Result};
 
-use super::{load_scene, photon_map, ppm_stats, progress_bar};
-use caustic::render::limits;
+use super::render_report::{RendererSummary, Report};
+use super::{load_scene, photon_map, ppm_stats};
+use caustic::render::compare::Reference;
+use caustic::render::error::pixel_error_estimate;
 use caustic::render::params::RenderParams;
 use caustic::render::ppm::IndexKind;
-use caustic::render::session::SessionOptions;
-use caustic::render::{image_metadata, render_whitted};
+use caustic::render::provenance::{self, software, Recorded};
+use caustic::render::session::{Frame, SessionOptions};
+use caustic::render::{image_metadata, limits, render_whitted, Image, Layer};
 use caustic::scene::{RendererKind, Scene};
+use caustic::tev::TevStream;
 
 /// `caustic render`'s flags.
 #[derive(clap::Args)]
 pub struct RenderArgs {
     /// Scene file (TOML); the built-in teapot scene when omitted.
+    #[arg(conflicts_with = "from")]
     scene: Option<PathBuf>,
-    /// Output image: .png or .exr.
+    /// Render again what an image written by caustic records (its scene text, overrides,
+    /// seed and passes): the same pixels, whatever the thread count. Flags given as well
+    /// override what it records.
+    #[arg(long, value_name = "IMAGE")]
+    from: Option<PathBuf>,
+    /// Output image: .png or .exr (EXR adds the layers radius.Y, photons.Y and error.Y).
     #[arg(short, long)]
     out: PathBuf,
     /// Override the scene's image width.
@@ -34,15 +46,27 @@ pub struct RenderArgs {
     /// Override the scene's renderer.
     #[arg(long, value_enum)]
     renderer: Option<RendererKind>,
-    /// PNG exposure in stops (EXR is always linear).
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-    exposure: f32,
+    /// PNG exposure in stops (EXR is always linear); default 0, or what --from records.
+    #[arg(long, allow_negative_numbers = true)]
+    exposure: Option<f32>,
     /// Replace the output file if it exists.
     #[arg(long)]
     force: bool,
     /// Render with this many threads (default: one per core); the image does not depend on it.
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,
+    /// Compare with a reference image (.exr or .pfm of the same size): RMSE and relative MSE
+    /// after every pass and at the end.
+    #[arg(long, value_name = "FILE")]
+    reference: Option<PathBuf>,
+    /// Stream every pass to a running tev (default address 127.0.0.1:14158); if tev cannot
+    /// be reached the render goes on without it.
+    #[arg(long, value_name = "HOST:PORT", num_args = 0..=1,
+          default_missing_value = caustic::tev::DEFAULT_ADDRESS)]
+    tev: Option<String>,
+    /// Print the summary as JSON on stdout (progress and warnings stay on stderr).
+    #[arg(long)]
+    json: bool,
     #[command(flatten)]
     ppm: PpmArgs,
 }
@@ -50,9 +74,9 @@ pub struct RenderArgs {
 /// Photon-mapping flags of `render`.
 #[derive(clap::Args, Clone, Debug)]
 pub struct PpmArgs {
-    /// Photon mapping: passes to run.
-    #[arg(long, default_value_t = 16)]
-    passes: u32,
+    /// Photon mapping: passes to run (default 16, or what --from records).
+    #[arg(long)]
+    passes: Option<u32>,
     /// Photon mapping: stop after this many seconds even if passes remain.
     #[arg(long, allow_negative_numbers = true)]
     time_limit: Option<f64>,
@@ -116,81 +140,157 @@ impl PpmArgs {
 
 /// Renders a scene to an image with the ray tracer or photon mapping.
 pub fn render(args: RenderArgs) -> Result<()> {
-    let RenderArgs {
-        scene: scene_path,
-        out,
-        width,
-        height,
-        seed,
-        renderer,
-        exposure,
-        force,
-        ppm,
-        threads: _,
-    } = args;
-    let out = out.as_path();
+    let out = args.out.as_path();
     if caustic::render::film::Format::from_path(out).is_none() {
         bail!("{}: unknown image format (use .png or .exr)", out.display());
     }
-    if out.exists() && !force {
+    if out.exists() && !args.force {
         bail!(
             "{}: the file exists; choose another name or pass --force to overwrite it",
             out.display()
         );
     }
+    let mut report = Report::new(args.json);
+    let (mut scene, recorded) = match &args.from {
+        Some(image) => {
+            let recorded = Recorded::read(image)?;
+            if recorded.software != software() {
+                report.warn(format!(
+                    "{} was written by {}, this is {}: the pixels may differ",
+                    image.display(),
+                    recorded.software,
+                    software()
+                ));
+            }
+            (recorded.scene.clone(), Some(recorded))
+        }
+        None => (load_scene(args.scene.as_deref())?, None),
+    };
+    let exposure = args
+        .exposure
+        .or(recorded.as_ref().and_then(|r| r.exposure))
+        .unwrap_or(0.0);
     if !exposure.is_finite() || exposure.abs() > 64.0 {
         bail!("--exposure must be a finite number of stops between -64 and 64, got {exposure}");
     }
-    let mut scene = load_scene(scene_path.as_deref())?;
-    for (flag, v) in [("--width", width), ("--height", height)] {
+    for (flag, v) in [("--width", args.width), ("--height", args.height)] {
         if let Some(v) = v {
             flag_check(flag, limits::image_side(v))?;
         }
     }
-    if let Some(w) = width {
+    if let Some(w) = args.width {
         scene.camera.width = w;
     }
-    if let Some(h) = height {
+    if let Some(h) = args.height {
         scene.camera.height = h;
     }
-    if let Some(s) = seed {
+    if let Some(s) = args.seed {
         scene.params.seed = s;
     }
-    let kind = match renderer {
-        Some(kind) => kind,
-        None => scene.params.renderer,
-    };
-    if kind == RendererKind::Ppm {
-        return render_ppm(scene, out, exposure, force, &ppm);
+    if let Some(kind) = args.renderer {
+        scene.params.renderer = kind;
     }
+    let reference = match &args.reference {
+        Some(path) => {
+            let reference = Reference::open(path)?;
+            reference.check_size(scene.camera.width, scene.camera.height)?;
+            Some(reference)
+        }
+        None => None,
+    };
+    let name = out
+        .file_name()
+        .map_or_else(|| "caustic".into(), |n| n.to_string_lossy().into_owned());
+    let mut tev = args.tev.as_deref().and_then(|address| {
+        TevStream::connect(address, &name)
+            .map_err(|e| report.warn(format!("{e}; rendering without it")))
+            .ok()
+    });
+    let mut output = Output {
+        reference: reference.as_ref(),
+        tev: &mut tev,
+        report: &mut report,
+    };
+    let rendered = match scene.params.renderer {
+        RendererKind::Ppm => {
+            let passes = args
+                .ppm
+                .passes
+                .or(recorded.as_ref().and_then(|r| r.passes))
+                .unwrap_or(16);
+            render_ppm(&mut scene, passes, &args.ppm, &mut output)?
+        }
+        RendererKind::Whitted => render_ray_traced(&scene, &mut output),
+    };
+    let layers: Vec<Layer> = rendered
+        .layers
+        .iter()
+        .map(|(name, values)| Layer { name, values })
+        .collect();
+    rendered
+        .image
+        .save_with_layers(out, exposure, &rendered.metadata, &layers, args.force)?;
+    report.finish(out, &scene, rendered.summary, reference.as_ref(), &rendered.image);
+    Ok(())
+}
+
+/// Where each finished pass goes besides the file: the reference comparison, tev, the report.
+struct Output<'a> {
+    reference: Option<&'a Reference>,
+    tev: &'a mut Option<TevStream>,
+    report: &'a mut Report,
+}
+
+impl Output<'_> {
+    /// Compares a pass with the reference and sends it to tev (dropping tev after a failure,
+    /// with a warning).
+    fn pass(&mut self, pass: u32, secs: f64, image: &Image, layers: &[Layer]) {
+        if let Some(errors) = self.reference.and_then(|r| r.errors(&image.pixels)) {
+            self.report.pass_error(pass, secs, errors);
+        }
+        if let Some(stream) = self.tev.as_mut() {
+            if let Err(e) = stream.send(image.width, image.height, &image.pixels, layers) {
+                self.report.warn(format!("{e}; no more passes are sent"));
+                *self.tev = None;
+            }
+        }
+    }
+}
+
+/// A finished render: the image, its EXR layers, its metadata and what the report says.
+struct Rendered {
+    image: Image,
+    layers: Vec<(&'static str, Vec<f32>)>,
+    metadata: caustic::render::Metadata,
+    summary: RendererSummary,
+}
+
+fn render_ray_traced(scene: &Scene, output: &mut Output) -> Rendered {
     let (w, h) = (scene.camera.width, scene.camera.height);
-    let bar = progress_bar(
+    let bar = output.report.bar(
         h as u64,
         "{msg} [{bar:40}] {pos}/{len} rows, {elapsed} (eta {eta})",
         format!("ray tracing {w}x{h}"),
-    )?;
-    let (image, stats) = render_whitted(&scene, &|rows| bar.inc(rows as u64));
+    );
+    let (image, stats) = render_whitted(scene, &|rows| bar.inc(rows as u64));
     bar.finish_and_clear();
-    let mut metadata = image_metadata(&scene, "whitted");
+    output.pass(1, stats.elapsed_secs, &image, &[]);
+    let mut metadata = image_metadata(scene, "whitted", None);
     metadata.push(("caustic:camera_rays".into(), stats.camera_rays.to_string()));
     metadata.push((
         "caustic:elapsed_secs".into(),
         format!("{:.3}", stats.elapsed_secs),
     ));
-    image.save(out, exposure, &metadata, force)?;
-    println!(
-        "{}: {w}x{h} ray traced in {:.2} s ({} camera rays, {} edge pixels re-sampled, {:.0} rays/s)",
-        out.display(),
-        stats.elapsed_secs,
-        stats.camera_rays,
-        stats.edge_pixels,
-        stats.camera_rays as f64 / stats.elapsed_secs.max(1e-9)
-    );
-    Ok(())
+    Rendered {
+        image,
+        layers: Vec::new(),
+        metadata,
+        summary: RendererSummary::Whitted(stats),
+    }
 }
 
-fn render_ppm(mut scene: Scene, out: &Path, exposure: f32, force: bool, args: &PpmArgs) -> Result<()> {
-    if args.passes == 0 {
+fn render_ppm(scene: &mut Scene, passes: u32, args: &PpmArgs, output: &mut Output) -> Result<Rendered> {
+    if passes == 0 {
         bail!("--passes must be at least 1");
     }
     if let Some(t) = args.time_limit {
@@ -200,17 +300,19 @@ fn render_ppm(mut scene: Scene, out: &Path, exposure: f32, force: bool, args: &P
     }
     args.overlay(&mut scene.params)?;
     let (w, h) = (scene.camera.width, scene.camera.height);
-    let bar = progress_bar(
-        args.passes as u64,
+    let bar = output.report.bar(
+        passes as u64,
         "{msg} [{bar:40}] pass {pos}/{len}, {elapsed} (eta {eta})",
         format!("photon mapping {w}x{h}"),
-    )?;
-    scene.params.renderer = RendererKind::Ppm;
+    );
+    output.report.set_bar(Some(bar.clone()));
     let session = SessionOptions {
-        max_passes: Some(args.passes),
+        max_passes: Some(passes),
         time_limit: args.time_limit.map(Duration::from_secs_f64),
         ..Default::default()
     };
+    let mut previous: Option<Frame> = None;
+    let mut last: Option<Frame> = None;
     let frame = photon_map(scene.clone(), session, |f| {
         let Some(s) = f.stats.photon_mapping() else {
             return;
@@ -220,41 +322,60 @@ fn render_ppm(mut scene: Scene, out: &Path, exposure: f32, force: bool, args: &P
             s.photons as f64 / s.photon_secs.max(1e-9) / 1e6
         ));
         bar.set_position(s.passes as u64);
+        let image = frame_image(f);
+        output.pass(f.pass, f.elapsed_secs, &image, &frame_layers(f));
+        previous = last.replace(f.clone());
     })?;
     bar.finish_and_clear();
+    output.report.set_bar(None);
     let s = ppm_stats(&frame)?.clone();
-    let image = caustic::render::Image {
-        width: w,
-        height: h,
-        pixels: frame.radiance.to_vec(),
-    };
-    let mut metadata = image_metadata(&scene, "ppm");
+    let mut layers = vec![
+        ("radius", frame.radius.to_vec()),
+        ("photons", frame.gathered.to_vec()),
+    ];
+    let error = previous
+        .as_ref()
+        .and_then(|p| pixel_error_estimate(p.photons, &p.radiance, frame.photons, &frame.radiance));
+    if let Some(error) = error {
+        layers.push(("error", error));
+    }
+    let mut metadata = image_metadata(scene, "ppm", None);
     metadata.extend([
-        ("caustic:passes".into(), s.passes.to_string()),
+        (provenance::PASSES.into(), s.passes.to_string()),
         ("caustic:photons".into(), s.photons.to_string()),
         ("caustic:alpha".into(), scene.params.alpha.to_string()),
         ("caustic:mean_radius".into(), format!("{:.6}", s.mean_radius)),
         ("caustic:elapsed_secs".into(), format!("{:.3}", s.elapsed_secs)),
     ]);
-    image.save(out, exposure, &metadata, force)?;
-    println!(
-        "{}: {w}x{h}, {} passes, {} photons in {:.2} s ({:.0} photons/s while tracing photons), mean radius {:.4}, {} visible points",
-        out.display(),
-        s.passes,
-        s.photons,
-        s.elapsed_secs,
-        s.photons as f64 / s.photon_secs.max(1e-9),
-        s.mean_radius,
-        s.visible_points
-    );
-    println!(
-        "  time: eye passes {:.3} s ({} of them), area-light sampling {:.3} s, index builds {:.3} s, photons {:.3} s",
-        s.eye_secs, s.eye_passes, s.direct_secs, s.index_secs, s.photon_secs
-    );
-    for skipped in &s.skipped {
-        println!("  skipped: {skipped}");
+    Ok(Rendered {
+        image: frame_image(&frame),
+        layers,
+        metadata,
+        summary: RendererSummary::PhotonMapping(s),
+    })
+}
+
+/// A frame's radiance as an image.
+fn frame_image(f: &Frame) -> Image {
+    Image {
+        width: f.width,
+        height: f.height,
+        pixels: f.radiance.to_vec(),
     }
-    Ok(())
+}
+
+/// The per-pixel layers a frame carries (what tev shows beside RGB).
+fn frame_layers(f: &Frame) -> [Layer<'_>; 2] {
+    [
+        Layer {
+            name: "radius",
+            values: &f.radius,
+        },
+        Layer {
+            name: "photons",
+            values: &f.gathered,
+        },
+    ]
 }
 
 /// A flag's value checked against [`limits`]: the message names the flag.

@@ -25,7 +25,7 @@ use crate::scene::material::{dielectric, reflect};
 use crate::scene::{MaterialKind, Scene};
 
 /// What a render did.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
 pub struct WhittedStats {
     /// Camera rays traced.
     pub camera_rays: u64,

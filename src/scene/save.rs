@@ -109,6 +109,28 @@ pub fn scene_toml(
     Ok(doc.to_string())
 }
 
+/// The scene's own text with only its render settings (`[render]`) and image size brought up to
+/// date: what a render made from the text with command-line overrides would need, every
+/// other line (camera, objects) kept verbatim, so the text loads back to the same camera bit
+/// for bit (re-deriving `look_at` from the camera could move it by a rounding step).
+pub fn settings_toml(scene: &Scene) -> Result<String, SaveError> {
+    let mut doc: DocumentMut = scene
+        .text
+        .parse()
+        .map_err(|e: toml_edit::TomlError| SaveError::Text {
+            path: scene.source.clone(),
+            message: e.to_string(),
+        })?;
+    write_size(table(&mut doc, "camera"), scene);
+    write_render(&mut doc, scene);
+    Ok(doc.to_string())
+}
+
+fn write_size(t: &mut Table, scene: &Scene) {
+    t.insert("width", toml_edit::value(i64::from(scene.camera.width)));
+    t.insert("height", toml_edit::value(i64::from(scene.camera.height)));
+}
+
 fn table<'d>(doc: &'d mut DocumentMut, name: &str) -> &'d mut Table {
     let item = doc.entry(name).or_insert_with(|| Item::Table(Table::new()));
     if !item.is_table() {
@@ -127,6 +149,7 @@ fn write_camera(doc: &mut DocumentMut, scene: &Scene) {
     );
     t.insert("up", toml_edit::value(vec3(c.up)));
     t.insert("fov", toml_edit::value(c.fov_y.to_degrees()));
+    write_size(t, scene);
     t.insert("aperture", toml_edit::value(c.aperture));
     t.insert("focal_distance", toml_edit::value(c.focal_distance));
 }

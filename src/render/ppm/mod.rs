@@ -166,7 +166,7 @@ struct Gathered {
 }
 
 /// Run statistics.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
 pub struct PpmStats {
     /// Completed passes.
     pub passes: u32,
