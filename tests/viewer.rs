@@ -467,3 +467,129 @@ fn r_asks_before_discarding_passes_and_e_steps_the_exposure() {
     h.step();
     assert_eq!(viewer(&h).settings.exposure_stops, stops);
 }
+
+/// Opening a reference (dropped on the window, as a person would) adds the true error to the
+/// convergence plot; the difference views show their legend; A/B shows the reference; a
+/// reference of another size is refused with a message.
+#[test]
+fn opening_a_reference_shows_the_true_error_curve_and_the_difference_view() {
+    use caustic::app::settings::DisplayMode;
+    let dir = tempfile::tempdir().expect("temp dir");
+    let frames = fixed_frames();
+    // The reference: the last fixed frame, 0.05 brighter everywhere.
+    let last = frames.last().expect("frames").clone();
+    let reference = caustic::render::Image {
+        width: last.width,
+        height: last.height,
+        pixels: last.radiance.iter().map(|p| p.map(|c| c + 0.05)).collect(),
+    };
+    let path = dir.path().join("reference.exr");
+    reference
+        .save(&path, 0.0, &Vec::new(), false)
+        .expect("write reference");
+
+    let mut h = Harness::builder()
+        .with_size(egui::Vec2::new(1100.0, 880.0))
+        .wgpu()
+        .build_ui_state(
+            |ui, viewer: &mut Option<Viewer>| {
+                if let Some(v) = viewer {
+                    v.ui(ui);
+                }
+            },
+            None,
+        );
+    let v = Viewer::with_pause(&h.ctx, ball(), ViewerSettings::default(), true);
+    *h.state_mut() = Some(v);
+    h.step();
+    h.input_mut()
+        .dropped_files
+        .push(Arc::new(DroppedPath(path.clone())));
+    h.step();
+    step_until(&mut h, "the reference", |v| v.reference().is_some());
+    for f in frames {
+        viewer_mut(&mut h).show_frame(f);
+    }
+    h.run_steps(3);
+    let points = viewer(&h).convergence().reference_points.clone();
+    assert_eq!(points.len(), 4, "one true error per frame: {points:?}");
+    let last_rmse = points[3][1];
+    assert!(
+        (last_rmse - 0.05).abs() < 1e-4,
+        "the last frame is 0.05 off: {last_rmse}"
+    );
+    assert!(points[0][1] > points[3][1], "the error falls: {points:?}");
+    h.get_by_label_contains("against the reference: RMSE 5.000e-2");
+
+    // The signed difference view shows its legend; A/B shows the reference.
+    h.key_press(egui::Key::D);
+    h.key_press(egui::Key::D);
+    h.key_press(egui::Key::D);
+    h.run_steps(2);
+    assert_eq!(viewer(&h).settings.display, DisplayMode::SignedDifference);
+    h.get_by_label("render − reference");
+    h.get_by_label_contains("+5.000e-2");
+    h.key_press(egui::Key::D);
+    h.run_steps(2);
+    h.get_by_label("|render − reference| / (reference + 0.01)");
+    h.key_press(egui::Key::B);
+    h.run_steps(2);
+    assert!(viewer(&h).showing_reference());
+    assert!(
+        h.query_by_label_contains("render − reference").is_none(),
+        "no legend in A/B"
+    );
+
+    // Another size: refused, the open reference stays.
+    let small = dir.path().join("small.pfm");
+    let tiny = caustic::render::Image::new(4, 3);
+    std::fs::write(&small, caustic::render::compare::write_pfm(&tiny)).expect("write");
+    viewer_mut(&mut h).open_reference(small);
+    step_until(
+        &mut h,
+        "the refusal",
+        |v| matches!(v.status(), Some(Status::Error(e)) if e.contains("4x3")),
+    );
+    assert_eq!(viewer(&h).reference().map(|r| r.path.clone()), Some(path));
+}
+
+/// "Send frame to tev" reaches a listener with the frame's size; nothing listening is a
+/// message in the status bar.
+#[test]
+fn the_viewer_sends_its_frame_to_tev() {
+    use caustic::tev::{read_packets, Packet};
+    let listener = std::net::TcpListener::bind("127.0.0.1:0").expect("bind");
+    let address = listener.local_addr().expect("address").to_string();
+    let reader = std::thread::spawn(move || read_packets(listener.accept().expect("accept").0));
+    let mut h = harness(ball(), true);
+    for f in fixed_frames() {
+        viewer_mut(&mut h).show_frame(f);
+    }
+    viewer_mut(&mut h).send_to_tev(&address);
+    step_until(&mut h, "the send", |v| !v.busy());
+    assert!(
+        matches!(viewer(&h).status(), Some(Status::Info(s)) if s.contains(&address)),
+        "{:?}",
+        viewer(&h).status()
+    );
+    let packets = reader.join().expect("listener");
+    assert!(
+        matches!(&packets[0], Some(Packet::Create { width: 96, height: 72, channels, .. }) if channels.len() == 5),
+        "{packets:?}"
+    );
+    assert!(matches!(
+        &packets[1],
+        Some(Packet::Update {
+            width: 96,
+            height: 72,
+            ..
+        })
+    ));
+    viewer_mut(&mut h).send_to_tev("127.0.0.1:1");
+    step_until(&mut h, "the failed send", |v| !v.busy());
+    assert!(
+        matches!(viewer(&h).status(), Some(Status::Error(s)) if s.contains("127.0.0.1:1")),
+        "{:?}",
+        viewer(&h).status()
+    );
+}

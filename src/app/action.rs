@@ -34,6 +34,16 @@ pub enum Action {
     PickScene,
     /// Open a scene file (asks first when there are unsaved edits).
     OpenScene(PathBuf),
+    /// Show the open dialog for a reference image (.exr, .pfm).
+    PickReference,
+    /// Compare with this reference image.
+    OpenReference(PathBuf),
+    /// Stop comparing with the reference.
+    CloseReference,
+    /// Show the reference instead of the render (`true`), or the render (A/B).
+    ShowReference(bool),
+    /// Send the current frame to tev at this address.
+    SendToTev(String),
     /// Show the save dialog for the current frame.
     SaveFrame,
     /// Answer the frame overwrite question (`true`: replace).
@@ -131,6 +141,11 @@ impl Viewer {
         match action {
             Action::PickScene => self.unless_unsaved(AfterDiscard::Pick),
             Action::OpenScene(path) => self.unless_unsaved(AfterDiscard::Open(path)),
+            Action::PickReference => self.pick_reference(),
+            Action::OpenReference(path) => self.open_reference(path),
+            Action::CloseReference => self.close_reference(),
+            Action::ShowReference(on) => self.show_reference(on),
+            Action::SendToTev(address) => self.send_to_tev(&address),
             Action::SaveFrame => self.save_with_dialog(),
             Action::ConfirmFrameOverwrite(replace) => self.confirm_overwrite(replace),
             Action::SaveScene => self.save_scene(),

@@ -26,6 +26,8 @@ pub struct LaunchOptions {
     pub bench: bool,
     /// When the process started (for launch-to-first-image).
     pub launched: Instant,
+    /// A reference image to compare with from the start.
+    pub reference: Option<crate::render::compare::Reference>,
 }
 
 impl Default for LaunchOptions {
@@ -36,6 +38,7 @@ impl Default for LaunchOptions {
             force: false,
             bench: false,
             launched: Instant::now(),
+            reference: None,
         }
     }
 }

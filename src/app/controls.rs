@@ -65,6 +65,31 @@ pub fn menu_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) {
             {
                 out.push(Action::SaveFrame);
             }
+            if ui
+                .button("Send frame to tev")
+                .on_hover_text(format!(
+                    "Show the current frame (radiance, radius, photon count) in a running tev at {}",
+                    crate::tev::DEFAULT_ADDRESS
+                ))
+                .clicked()
+            {
+                out.push(Action::SendToTev(crate::tev::DEFAULT_ADDRESS.into()));
+            }
+            ui.separator();
+            if ui
+                .button("Open reference...")
+                .on_hover_text("Compare with a reference image (.exr or .pfm of the render's size): the true error in the plot, difference views and A/B; you can also drop one on the window")
+                .clicked()
+            {
+                out.push(Action::PickReference);
+            }
+            if ui
+                .add_enabled(viewer.reference().is_some(), egui::Button::new("Close reference"))
+                .on_hover_text("Stop comparing with the reference")
+                .clicked()
+            {
+                out.push(Action::CloseReference);
+            }
             ui.separator();
             if ui
                 .button("Save scene  (Ctrl+Shift+S)")
@@ -114,8 +139,28 @@ pub fn menu_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) {
             ui.separator();
             let mut display = viewer.settings.display;
             for mode in DisplayMode::ALL {
-                ui.radio_value(&mut display, mode, mode.label())
-                    .on_hover_text("What the image shows; the probe always reports all three (D cycles)");
+                let enabled = viewer.reference().is_some() || !mode.needs_reference();
+                let hover = if enabled {
+                    "What the image shows; the probe always reports radiance, radius and photons (D cycles)"
+                } else {
+                    "Open a reference image first (File > Open reference...)"
+                };
+                ui.add_enabled_ui(enabled, |ui| {
+                    ui.radio_value(&mut display, mode, mode.label())
+                        .on_hover_text(hover)
+                        .on_disabled_hover_text(hover);
+                });
+            }
+            let mut ab = viewer.showing_reference();
+            if ui
+                .add_enabled(
+                    viewer.reference().is_some(),
+                    egui::Checkbox::new(&mut ab, "Show the reference (A/B)  (B)"),
+                )
+                .on_hover_text("Show the reference image instead of the render, with the same exposure")
+                .changed()
+            {
+                out.push(Action::ShowReference(ab));
             }
             if display != viewer.settings.display {
                 out.push(Action::SetDisplay(display));
@@ -394,24 +439,67 @@ fn statistics_ui(viewer: &Viewer, ui: &mut egui::Ui) {
         }
     }
     if frame.stats.renderer() == RendererKind::Ppm {
-        ui.label("Estimated error")
-            .on_hover_text("Relative RMS noise estimated from successive frames (log scale) against seconds; falls as the image converges");
-        let points: Vec<[f64; 2]> = viewer
-            .convergence
-            .points
-            .iter()
-            .map(|[t, e]| [*t, e.max(1e-12).log10()])
-            .collect();
-        Plot::new("caustic-convergence")
-            .height(120.0)
-            .allow_zoom(false)
-            .allow_drag(false)
-            .allow_scroll(false)
-            .y_axis_formatter(|mark, _| percent(10f64.powf(mark.value)))
-            .show(ui, |plot| plot.line(Line::new("error", PlotPoints::from(points))));
-        if let Some(e) = viewer.convergence.latest() {
-            ui.label(format!("now {}", percent(e)));
+        convergence_plot_ui(viewer, ui);
+    }
+}
+
+/// The error against time (log scale): the estimate from successive frames and, with a
+/// reference open, the true RMSE and relative MSE against it.
+fn convergence_plot_ui(viewer: &Viewer, ui: &mut egui::Ui) {
+    let with_reference = viewer.reference().is_some();
+    let title = if with_reference {
+        "Error against time"
+    } else {
+        "Estimated error"
+    };
+    ui.label(title).on_hover_text(
+        "Log scale against seconds. Estimate: relative RMS noise from successive frames. With a reference: its RMSE and pbrt's relative MSE",
+    );
+    let log = |v: f64| v.max(1e-12).log10();
+    let series = |k: usize| -> Vec<[f64; 2]> {
+        let points = &viewer.convergence.reference_points;
+        points.iter().map(|p| [p[0], log(p[k])]).collect()
+    };
+    let estimate: Vec<[f64; 2]> = viewer
+        .convergence
+        .points
+        .iter()
+        .map(|[t, e]| [*t, log(*e)])
+        .collect();
+    let mut plot = Plot::new("caustic-convergence")
+        .height(if with_reference { 150.0 } else { 120.0 })
+        .allow_zoom(false)
+        .allow_drag(false)
+        .allow_scroll(false);
+    plot = if with_reference {
+        plot.legend(egui_plot::Legend::default().position(egui_plot::Corner::LeftBottom))
+            .y_axis_formatter(|mark, _| format!("{:.0e}", 10f64.powf(mark.value)))
+    } else {
+        plot.y_axis_formatter(|mark, _| percent(10f64.powf(mark.value)))
+    };
+    plot.show(ui, |plot| {
+        plot.line(Line::new("estimate (relative)", PlotPoints::from(estimate)));
+        if with_reference {
+            plot.line(Line::new("RMSE", PlotPoints::from(series(1))));
+            plot.line(Line::new("relative MSE", PlotPoints::from(series(2))));
         }
+    });
+    if let Some(e) = viewer.convergence.latest() {
+        ui.label(format!("now {}", percent(e)));
+    }
+    if let Some(e) = viewer.reference_errors() {
+        ui.label(format!(
+            "against the reference: RMSE {:.3e}, relative MSE {:.3e}",
+            e.rmse, e.rel_mse
+        ));
+    } else if let Some(r) = viewer.reference() {
+        ui.label(
+            RichText::new(format!(
+                "reference {} (no frame to compare yet)",
+                r.path.display()
+            ))
+            .small(),
+        );
     }
 }
 

@@ -4,6 +4,7 @@
 
 use std::sync::Arc;
 
+use crate::render::compare::ReferenceErrors;
 use crate::render::error::relative_error_estimate;
 
 /// One frame as the estimator needs it.
@@ -19,6 +20,9 @@ pub struct Convergence {
     previous: Option<Sample>,
     /// `(elapsed seconds, estimated relative RMS error)` per frame after the first.
     pub points: Vec<[f64; 2]>,
+    /// `(elapsed seconds, RMSE, relative MSE)` against the reference, per frame since it was
+    /// opened.
+    pub reference_points: Vec<[f64; 3]>,
 }
 
 impl Convergence {
@@ -41,6 +45,17 @@ impl Convergence {
             count: photons,
             radiance: radiance.clone(),
         });
+    }
+
+    /// Takes a frame's true error against the reference.
+    pub fn add_reference(&mut self, elapsed_secs: f64, errors: ReferenceErrors) {
+        self.reference_points
+            .push([elapsed_secs, errors.rmse, errors.rel_mse]);
+    }
+
+    /// Forgets the true errors (the reference closed or changed).
+    pub fn clear_reference(&mut self) {
+        self.reference_points.clear();
     }
 
     /// The newest estimate.

@@ -3,6 +3,7 @@
 
 use egui::{Color32, ColorImage, Pos2, Rect, Sense, TextureHandle, TextureOptions, Vec2};
 
+use super::difference::{difference_bytes, DifferenceKind, Legend};
 use super::settings::{DisplayMode, Zoom};
 use crate::render::film::srgb8;
 use crate::render::session::Frame;
@@ -20,6 +21,8 @@ pub struct ImageView {
     pan: Vec2,
     /// Set when the texture must be rebuilt (new frame, exposure or display mode changed).
     dirty: bool,
+    /// The legend of the difference view shown, if one is.
+    pub legend: Option<Legend>,
 }
 
 /// What [`ImageView::ui`] did this frame.
@@ -51,12 +54,13 @@ impl Default for ImageView {
             texture: None,
             pan: Vec2::ZERO,
             dirty: true,
+            legend: None,
         }
     }
 }
 
 /// A false-colour ramp (dark blue → cyan → yellow → white) for `t` in `[0, 1]`.
-fn false_colour(t: f32) -> [u8; 3] {
+pub fn false_colour(t: f32) -> [u8; 3] {
     let t = if t.is_finite() { t.clamp(0.0, 1.0) } else { 0.0 };
     const STOPS: [[f32; 3]; 5] = [
         [0.05, 0.03, 0.25],
@@ -94,13 +98,42 @@ fn false_colour_image(values: &[f32]) -> Vec<u8> {
         .collect()
 }
 
-/// The 8-bit RGB picture of a frame in a display mode.
-pub fn display_bytes(frame: &Frame, mode: DisplayMode, exposure_stops: f32) -> Vec<u8> {
-    match mode {
-        DisplayMode::Radiance => srgb8(&frame.radiance, exposure_stops),
+/// What the image view shows besides the frame's own channels.
+#[derive(Clone, Copy, Default)]
+pub struct Comparison<'a> {
+    /// The reference's pixels (same size as the frame; other sizes are ignored).
+    pub reference: Option<&'a [[f32; 3]]>,
+    /// Show the reference instead of the frame (A/B).
+    pub show_reference: bool,
+}
+
+/// The 8-bit RGB picture of a frame in a display mode, and the legend of a difference view.
+/// A difference mode without a (matching) reference shows the radiance.
+pub fn display_bytes(
+    frame: &Frame,
+    mode: DisplayMode,
+    exposure_stops: f32,
+    comparison: Comparison,
+) -> (Vec<u8>, Option<Legend>) {
+    let reference = comparison.reference.filter(|r| r.len() == frame.radiance.len());
+    if let (Some(r), true) = (reference, comparison.show_reference) {
+        return (srgb8(r, exposure_stops), None);
+    }
+    let kind = match mode {
+        DisplayMode::SignedDifference => Some(DifferenceKind::Signed),
+        DisplayMode::RelativeDifference => Some(DifferenceKind::Relative),
+        _ => None,
+    };
+    if let (Some(kind), Some(r)) = (kind, reference) {
+        let (bytes, legend) = difference_bytes(&frame.radiance, r, kind);
+        return (bytes, Some(legend));
+    }
+    let bytes = match mode {
         DisplayMode::Radius => false_colour_image(&frame.radius),
         DisplayMode::PhotonCount => false_colour_image(&frame.gathered),
-    }
+        _ => srgb8(&frame.radiance, exposure_stops),
+    };
+    (bytes, None)
 }
 
 /// The frame's radiance as an [`Image`] (for display and saving).
@@ -119,11 +152,19 @@ impl ImageView {
     }
 
     /// Rebuilds the texture from `frame` if it is stale.
-    pub fn update_texture(&mut self, ctx: &egui::Context, frame: &Frame, mode: DisplayMode, exposure: f32) {
+    pub fn update_texture(
+        &mut self,
+        ctx: &egui::Context,
+        frame: &Frame,
+        mode: DisplayMode,
+        exposure: f32,
+        comparison: Comparison,
+    ) {
         if !self.dirty && self.texture.is_some() {
             return;
         }
-        let bytes = display_bytes(frame, mode, exposure);
+        let (bytes, legend) = display_bytes(frame, mode, exposure, comparison);
+        self.legend = legend;
         let image = ColorImage::from_rgb([frame.width as usize, frame.height as usize], &bytes);
         // Nearest when magnified, so zoomed-in pixels stay crisp for the probe.
         let options = TextureOptions {

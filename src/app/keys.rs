@@ -47,7 +47,11 @@ pub const HELP: &[(&str, &str)] = &[
     ("C", "Frame the selection (or all patches) with the camera"),
     ("W", "Show / hide the control nets"),
     ("[ / ]", "Exposure down / up by half a stop"),
-    ("D", "Next display mode: radiance, radius, photon count"),
+    (
+        "D",
+        "Next display mode: radiance, radius, photon count (and the differences to a reference)",
+    ),
+    ("B", "A/B: show the reference instead of the render, and back"),
     ("P", "Show / hide the side panel"),
     ("F1", "This help"),
 ];
@@ -131,9 +135,15 @@ pub fn handle(viewer: &Viewer, ctx: &egui::Context, out: &mut Vec<Action>) {
         out.push(Action::SetExposure(settings.exposure_stops + 0.5));
     }
     if pressed(Key::D) {
-        let modes = DisplayMode::ALL;
+        let modes: Vec<DisplayMode> = DisplayMode::ALL
+            .into_iter()
+            .filter(|m| viewer.reference().is_some() || !m.needs_reference())
+            .collect();
         let at = modes.iter().position(|m| *m == settings.display).unwrap_or(0);
         out.push(Action::SetDisplay(modes[(at + 1) % modes.len()]));
+    }
+    if pressed(Key::B) && viewer.reference().is_some() {
+        out.push(Action::ShowReference(!viewer.showing_reference()));
     }
     if pressed(Key::P) {
         out.push(Action::ShowSidePanel(!settings.show_side_panel));

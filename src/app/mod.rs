@@ -12,14 +12,18 @@
 //!   and camera moves (drawn by [`crate::gpu::wireframe`]).
 //! - [`image_view`]: texture, fit / 1:1 / zoom / pan, probe.
 //! - [`params`]: parameters and the session commands their changes send.
-//! - [`convergence`]: the error estimate plotted against time.
-//! - [`save`], [`job`]: dialogs and file writes off the UI thread.
+//! - [`convergence`]: the error estimate (and the true error against a reference) plotted
+//!   against time; [`reference`], [`difference`]: the reference image, the difference views
+//!   and the A/B toggle.
+//! - [`save`], [`job`]: dialogs and file writes off the UI thread; [`tev_send`]: the frame
+//!   to a running tev.
 //! - [`keys`], [`settings`], [`automation`]: shortcuts, stored preferences, scripted runs.
 
 pub mod action;
 pub mod automation;
 pub mod controls;
 pub mod convergence;
+pub mod difference;
 pub mod edit_panel;
 pub mod editor;
 pub mod image_view;
@@ -28,9 +32,11 @@ pub mod keys;
 pub mod navigate;
 pub mod overlay;
 pub mod params;
+pub mod reference;
 pub mod save;
 mod scene_file;
 pub mod settings;
+pub mod tev_send;
 pub mod view_input;
 pub mod viewer;
 
@@ -73,7 +79,8 @@ impl eframe::App for CausticApp {
 
 /// Opens the viewer window on `scene_path` (the built-in scene when `None`) and runs until it
 /// closes. A scene that fails to load is reported in the window over the built-in scene.
-pub fn run(scene_path: Option<PathBuf>, launch: LaunchOptions) -> anyhow::Result<()> {
+pub fn run(scene_path: Option<PathBuf>, mut launch: LaunchOptions) -> anyhow::Result<()> {
+    let reference = launch.reference.take();
     let (scene, error) = match &scene_path {
         None => (Scene::builtin(), None),
         Some(p) => match Scene::load(p) {
@@ -116,6 +123,9 @@ pub fn run(scene_path: Option<PathBuf>, launch: LaunchOptions) -> anyhow::Result
             }
             if let Some(e) = error {
                 viewer.scene_error = Some(e);
+            }
+            if let Some(r) = reference {
+                viewer.set_reference(r);
             }
             Ok(Box::new(CausticApp {
                 viewer,

@@ -30,15 +30,29 @@ pub enum DisplayMode {
     Radius,
     /// The accumulated photon count per pixel in false colour (log scale).
     PhotonCount,
+    /// `render − reference`, diverging false colour (needs a reference).
+    SignedDifference,
+    /// `|render − reference| / (reference + 0.01)`, false colour (needs a reference).
+    RelativeDifference,
 }
 
 impl DisplayMode {
     /// Every mode, in menu order.
-    pub const ALL: [DisplayMode; 3] = [
+    pub const ALL: [DisplayMode; 5] = [
         DisplayMode::Radiance,
         DisplayMode::Radius,
         DisplayMode::PhotonCount,
+        DisplayMode::SignedDifference,
+        DisplayMode::RelativeDifference,
     ];
+
+    /// Whether the mode compares with a reference (and so shows radiance without one).
+    pub fn needs_reference(self) -> bool {
+        matches!(
+            self,
+            DisplayMode::SignedDifference | DisplayMode::RelativeDifference
+        )
+    }
 
     /// Name shown in menus.
     pub fn label(self) -> &'static str {
@@ -46,6 +60,8 @@ impl DisplayMode {
             DisplayMode::Radiance => "Radiance (sRGB)",
             DisplayMode::Radius => "Search radius (false colour)",
             DisplayMode::PhotonCount => "Photon count (false colour)",
+            DisplayMode::SignedDifference => "Difference to reference (signed)",
+            DisplayMode::RelativeDifference => "Difference to reference (relative)",
         }
     }
 }

@@ -10,13 +10,15 @@ use super::action::{Action, AfterDiscard};
 use super::controls;
 use super::convergence::Convergence;
 use super::editor::Editor;
-use super::image_view::{frame_image, ImageView, Probe};
+use super::image_view::{frame_image, Comparison, ImageView, Probe};
 use super::job::{Job, Poll};
 use super::keys;
 use super::overlay::OverlayProjection;
 use super::params::{PanelParams, Ranges};
+use super::reference::{is_reference_file, ReferenceState};
 use super::save::{default_file_name, SaveEvent, SaveFlow, Snapshot};
 use super::settings::{ViewerSettings, Zoom};
+use super::tev_send::TevSend;
 use super::view_input;
 use crate::geometry::BezierPatch;
 use crate::render::image_metadata;
@@ -96,6 +98,10 @@ pub struct Viewer {
     pub(super) allow_close: bool,
     /// The `R` key asked to restart: "discard the passes?" is shown.
     pub(super) confirm_restart: bool,
+    /// The reference image compared with, and its loading.
+    pub(super) reference: ReferenceState,
+    /// A frame being sent to tev.
+    pub(super) tev: TevSend,
 }
 
 fn session_options(start_paused: bool) -> SessionOptions {
@@ -174,6 +180,8 @@ impl Viewer {
             after_save: None,
             allow_close: false,
             confirm_restart: false,
+            reference: ReferenceState::default(),
+            tev: TevSend::default(),
         }
     }
 
@@ -198,6 +206,11 @@ impl Viewer {
         self.frame.as_ref()
     }
 
+    /// The error curves of the epoch shown (estimate, and the true error against a reference).
+    pub fn convergence(&self) -> &Convergence {
+        &self.convergence
+    }
+
     /// Commands sent to the render session, oldest first (the last 256).
     pub fn recent_commands(&self) -> impl Iterator<Item = &Command> {
         self.recent_commands.iter()
@@ -220,7 +233,12 @@ impl Viewer {
 
     /// Whether a scene is being opened or a frame or scene saved.
     pub fn busy(&self) -> bool {
-        self.loading.is_some() || self.picking.is_some() || self.save.busy() || self.scene_dialog.is_some()
+        self.loading.is_some()
+            || self.picking.is_some()
+            || self.save.busy()
+            || self.scene_dialog.is_some()
+            || self.reference.busy()
+            || self.tev.busy()
     }
 
     /// Seconds from creation to the first image shown, once there is one.
@@ -428,7 +446,7 @@ impl Viewer {
     }
 
     /// File dialogs start in the folder of the last file opened or saved.
-    fn remember_folder_of(&mut self, path: &Path) {
+    pub(super) fn remember_folder_of(&mut self, path: &Path) {
         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
             self.settings.last_directory = Some(dir.to_path_buf());
         }
@@ -496,6 +514,8 @@ impl Viewer {
             self.on_save_event(event);
         }
         self.poll_scene_dialog();
+        self.poll_reference();
+        self.poll_tev();
     }
 
     /// Shows `frame` as the newest image if it is newer (a later epoch, or a later pass of
@@ -519,6 +539,16 @@ impl Viewer {
             self.convergence
                 .add(frame.photons, frame.elapsed_secs, &frame.radiance);
         }
+        if let Some(errors) = self
+            .reference
+            .open
+            .as_ref()
+            .and_then(|r| r.errors(&frame.radiance))
+        {
+            if !frame.preview {
+                self.convergence.add_reference(frame.elapsed_secs, errors);
+            }
+        }
         self.first_image_secs
             .get_or_insert_with(|| self.created.elapsed().as_secs_f64());
         self.frame = Some(frame);
@@ -531,7 +561,8 @@ impl Viewer {
         self.poll();
         let mut actions = Vec::new();
         keys::handle(self, ui.ctx(), &mut actions);
-        // Files dropped on the window open as scenes (the first one).
+        // Files dropped on the window open as scenes (the first one); images (.exr, .pfm)
+        // open as the reference.
         let dropped: Option<PathBuf> = ui.input(|i| {
             i.raw
                 .dropped_files
@@ -539,7 +570,10 @@ impl Viewer {
                 .map(|f| f.path().to_path_buf())
                 .find(|p| !p.as_os_str().is_empty())
         });
-        actions.extend(dropped.map(Action::OpenScene));
+        actions.extend(dropped.map(|p| match is_reference_file(&p) {
+            true => Action::OpenReference(p),
+            false => Action::OpenScene(p),
+        }));
         // Closing with unsaved edits asks first.
         if ui.input(|i| i.viewport().close_requested()) && !self.allow_close && self.editor.history.unsaved()
         {
@@ -547,11 +581,16 @@ impl Viewer {
             actions.push(Action::Close);
         }
         if let Some(frame) = &self.frame {
+            let comparison = Comparison {
+                reference: self.reference.open.as_ref().map(|r| &r.image.pixels[..]),
+                show_reference: self.reference.show_reference,
+            };
             self.image_view.update_texture(
                 ui.ctx(),
                 frame,
                 self.settings.display,
                 self.settings.exposure_stops,
+                comparison,
             );
         }
 
@@ -626,5 +665,8 @@ impl Viewer {
                 ));
         }
         self.projection = Some(projection);
+        if let Some(legend) = self.image_view.legend {
+            super::difference::legend_ui(ui, shown.view, legend);
+        }
     }
 }

@@ -88,6 +88,7 @@ impl BenchCommand {
     pub fn threads(&self) -> Option<usize> {
         match self {
             BenchCommand::Convergence(args) => args.threads,
+            BenchCommand::Memory(args) => args.threads,
             _ => None,
         }
     }

@@ -31,6 +31,9 @@ pub struct MemoryArgs {
     /// Photons per pass (small: the eye pass and its visible points are what grows).
     #[arg(long, default_value_t = 20_000)]
     photons: u64,
+    /// Render with this many threads (default: one per core).
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
 }
 
 /// Resident set size and its peak, in MiB, from `/proc/self/status` (Linux).

@@ -29,6 +29,10 @@ pub struct ViewArgs {
     /// Render with this many threads (default: one per core).
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,
+    /// Compare with this reference image (.exr or .pfm of the scene's size): the true error
+    /// in the convergence plot, the difference views and the A/B toggle (B).
+    #[arg(long, value_name = "FILE")]
+    pub reference: Option<PathBuf>,
 }
 
 /// Opens the viewer (only with the `viewer` feature).
@@ -41,7 +45,11 @@ pub fn view(args: ViewArgs, launched: std::time::Instant) -> Result<()> {
         force,
         bench,
         threads: _,
+        reference,
     } = args;
+    let reference = reference
+        .map(|p| caustic::render::compare::Reference::open(&p))
+        .transpose()?;
     if let Some(p) = &screenshot {
         if p.extension().is_none_or(|e| !e.eq_ignore_ascii_case("png")) {
             bail!(
@@ -56,6 +64,7 @@ pub fn view(args: ViewArgs, launched: std::time::Instant) -> Result<()> {
         force,
         bench,
         launched,
+        reference,
     };
     caustic::app::run(scene, launch)
 }
