@@ -4,21 +4,9 @@
 use std::path::Path;
 use std::process::Command;
 
-fn caustic(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_caustic"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("run caustic")
-}
+mod common;
 
-fn text(out: &std::process::Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    )
-}
+use common::{caustic, text};
 
 #[test]
 fn render_writes_png_and_exr_with_metadata_and_refuses_to_overwrite() {

@@ -4,28 +4,15 @@
 
 use std::net::TcpListener;
 use std::path::Path;
-use std::process::Command;
 
 use caustic::render::compare::write_pfm;
 use caustic::render::film::exr_channel_names;
 use caustic::render::Image;
 use caustic::tev::{read_packets, Packet};
 
-fn caustic(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_caustic"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("run caustic")
-}
+mod common;
 
-fn text(out: &std::process::Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    )
-}
+use common::{caustic, text};
 
 fn pixels(path: &Path) -> Vec<[f32; 3]> {
     let img = image::open(path).expect("readable image").to_rgb32f();
@@ -71,17 +58,19 @@ fn from_renders_the_same_pixels_and_the_exr_has_its_layers() {
         exr_channel_names(&a).expect("channels"),
         ["B", "G", "R", "error.Y", "photons.Y", "radius.Y"]
     );
+    let from = |out: &Path, extra: &[&str]| {
+        let mut args = vec![
+            "render",
+            "--from",
+            a.to_str().expect("utf-8"),
+            "--out",
+            out.to_str().expect("utf-8"),
+        ];
+        args.extend_from_slice(extra);
+        caustic(&args)
+    };
     let b = dir.path().join("b.exr");
-    let again = caustic(&[
-        "render",
-        "--from",
-        a.to_str().expect("utf-8"),
-        "--out",
-        b.to_str().expect("utf-8"),
-        "--threads",
-        "1",
-        "--json",
-    ]);
+    let again = from(&b, &["--threads", "1", "--json"]);
     let summary = json(&again);
     assert_eq!(summary["photon_mapping"]["passes"], 3, "{summary}");
     assert_eq!(summary["seed"], 5);
@@ -96,15 +85,7 @@ fn from_renders_the_same_pixels_and_the_exr_has_its_layers() {
     );
     // A flag given with --from overrides what the image records.
     let c = dir.path().join("c.exr");
-    let other = caustic(&[
-        "render",
-        "--from",
-        a.to_str().expect("utf-8"),
-        "--out",
-        c.to_str().expect("utf-8"),
-        "--seed",
-        "6",
-    ]);
+    let other = from(&c, &["--seed", "6"]);
     assert!(other.status.success(), "{}", text(&other));
     assert_ne!(pixels(&c), pa, "another seed gives another image");
     // An image without the record says so.

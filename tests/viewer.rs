@@ -355,6 +355,22 @@ fn a_render_thread_panic_is_shown_and_the_renderer_can_restart() {
     step_until(&mut h, "frames after the restart", |v| v.frame().is_some());
 }
 
+/// A harness that renders the window with wgpu (paint callbacks included), 1100×880, no
+/// viewer yet.
+fn wgpu_harness<'a>() -> App<'a> {
+    Harness::builder()
+        .with_size(egui::Vec2::new(1100.0, 880.0))
+        .wgpu()
+        .build_ui_state(
+            |ui, viewer: &mut Option<Viewer>| {
+                if let Some(v) = viewer {
+                    v.ui(ui);
+                }
+            },
+            None,
+        )
+}
+
 /// Four deterministic passes of the test scene as frames with fixed timings.
 fn fixed_frames() -> Vec<Frame> {
     let scene = ball();
@@ -375,17 +391,7 @@ fn fixed_frames() -> Vec<Frame> {
 
 #[test]
 fn window_snapshot_with_a_fixed_frame() {
-    let mut h = Harness::builder()
-        .with_size(egui::Vec2::new(1100.0, 880.0))
-        .wgpu()
-        .build_ui_state(
-            |ui, viewer: &mut Option<Viewer>| {
-                if let Some(v) = viewer {
-                    v.ui(ui);
-                }
-            },
-            None,
-        );
+    let mut h = wgpu_harness();
     let mut v = Viewer::with_pause(&h.ctx, ball(), ViewerSettings::default(), true);
     for f in fixed_frames() {
         v.show_frame(f);
@@ -488,17 +494,7 @@ fn opening_a_reference_shows_the_true_error_curve_and_the_difference_view() {
         .save(&path, 0.0, &Vec::new(), false)
         .expect("write reference");
 
-    let mut h = Harness::builder()
-        .with_size(egui::Vec2::new(1100.0, 880.0))
-        .wgpu()
-        .build_ui_state(
-            |ui, viewer: &mut Option<Viewer>| {
-                if let Some(v) = viewer {
-                    v.ui(ui);
-                }
-            },
-            None,
-        );
+    let mut h = wgpu_harness();
     let v = Viewer::with_pause(&h.ctx, ball(), ViewerSettings::default(), true);
     *h.state_mut() = Some(v);
     h.step();

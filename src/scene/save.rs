@@ -74,13 +74,7 @@ pub fn scene_toml(
     loaded: &[BezierPatch],
     out_dir: Option<&Path>,
 ) -> Result<String, SaveError> {
-    let mut doc: DocumentMut = scene
-        .text
-        .parse()
-        .map_err(|e: toml_edit::TomlError| SaveError::Text {
-            path: scene.source.clone(),
-            message: e.to_string(),
-        })?;
+    let mut doc = parse_text(scene)?;
     write_camera(&mut doc, scene);
     write_render(&mut doc, scene);
     write_patches(&mut doc, scene, loaded);
@@ -114,13 +108,7 @@ pub fn scene_toml(
 /// other line (camera, objects) kept verbatim, so the text loads back to the same camera bit
 /// for bit (re-deriving `look_at` from the camera could move it by a rounding step).
 pub fn settings_toml(scene: &Scene) -> Result<String, SaveError> {
-    let mut doc: DocumentMut = scene
-        .text
-        .parse()
-        .map_err(|e: toml_edit::TomlError| SaveError::Text {
-            path: scene.source.clone(),
-            message: e.to_string(),
-        })?;
+    let mut doc = parse_text(scene)?;
     write_size(table(&mut doc, "camera"), scene);
     write_render(&mut doc, scene);
     Ok(doc.to_string())
@@ -129,6 +117,17 @@ pub fn settings_toml(scene: &Scene) -> Result<String, SaveError> {
 fn write_size(t: &mut Table, scene: &Scene) {
     t.insert("width", toml_edit::value(i64::from(scene.camera.width)));
     t.insert("height", toml_edit::value(i64::from(scene.camera.height)));
+}
+
+/// The scene's own text as an editable TOML document.
+fn parse_text(scene: &Scene) -> Result<DocumentMut, SaveError> {
+    scene
+        .text
+        .parse()
+        .map_err(|e: toml_edit::TomlError| SaveError::Text {
+            path: scene.source.clone(),
+            message: e.to_string(),
+        })
 }
 
 fn table<'d>(doc: &'d mut DocumentMut, name: &str) -> &'d mut Table {

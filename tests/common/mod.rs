@@ -6,6 +6,24 @@ use glam::{DVec2, DVec3};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
+/// Runs the `caustic` binary with `args` in the project folder.
+pub fn caustic(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_caustic"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("run caustic")
+}
+
+/// A run's stdout and stderr, for assertion messages.
+pub fn text(out: &std::process::Output) -> String {
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    )
+}
+
 /// The project's own teapot file (never ../shared).
 pub fn teapot_from_assets() -> Vec<BezierPatch> {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/teapot.bpt");
