@@ -53,15 +53,28 @@ pub struct TriangleHit {
 impl TriangleMesh {
     /// Loads every model of an OBJ file into one mesh (triangulated; materials ignored).
     pub fn load_obj(path: &Path) -> Result<Self, MeshError> {
+        let file = std::fs::File::open(path).map_err(|_| MeshError::Parse {
+            path: path.to_owned(),
+            source: tobj::LoadError::OpenFileFailed,
+        })?;
+        Self::parse_obj(&mut std::io::BufReader::new(file), path)
+    }
+
+    /// Reads OBJ text (every model into one mesh, triangulated; materials ignored); `path`
+    /// names it in errors.
+    pub fn parse_obj(reader: &mut impl std::io::BufRead, path: &Path) -> Result<Self, MeshError> {
         let options = tobj::LoadOptions {
             triangulate: true,
             single_index: true,
             ..Default::default()
         };
-        let (models, _materials) = tobj::load_obj(path, &options).map_err(|source| MeshError::Parse {
-            path: path.to_owned(),
-            source,
-        })?;
+        // Material libraries are not read (materials come from the scene file).
+        let no_materials = |_: &Path| Ok((Vec::new(), Default::default()));
+        let (models, _materials) =
+            tobj::load_obj_buf(reader, &options, no_materials).map_err(|source| MeshError::Parse {
+                path: path.to_owned(),
+                source,
+            })?;
         let invalid = |message: String| MeshError::Invalid {
             path: path.to_owned(),
             message,

@@ -79,6 +79,20 @@ impl TextureSource {
             path: path.to_owned(),
             source,
         })?;
+        Ok(Self::from_image(img, path))
+    }
+
+    /// Decodes an image file's bytes (PNG or JPEG, by their content); `path` names it in
+    /// errors and in the texture.
+    pub fn decode(bytes: &[u8], path: &Path) -> Result<Self, TextureError> {
+        let img = image::load_from_memory(bytes).map_err(|source| TextureError {
+            path: path.to_owned(),
+            source,
+        })?;
+        Ok(Self::from_image(img, path))
+    }
+
+    fn from_image(img: image::DynamicImage, path: &Path) -> Self {
         let rgb = img.to_rgb8();
         let (width, height) = (rgb.width() as usize, rgb.height() as usize);
         let lut: Vec<f64> = (0..=255u8).map(srgb_to_linear).collect();
@@ -86,12 +100,12 @@ impl TextureSource {
             .pixels()
             .map(|p| DVec3::new(lut[p[0] as usize], lut[p[1] as usize], lut[p[2] as usize]))
             .collect();
-        Ok(TextureSource::Image {
+        TextureSource::Image {
             width,
             height,
             texels,
             path: path.to_owned(),
-        })
+        }
     }
 }
 

@@ -42,55 +42,62 @@ impl HashGrid {
             - DVec3::splat(max_r);
         let inv_cell = 1.0 / cell;
         let cell_of = |p: DVec3| ((p - origin) * inv_cell).floor().as_ivec3();
-        // Each point's cell range.
-        let ranges: Vec<(IVec3, IVec3)> = points
-            .iter()
-            .map(|p| {
-                let r = p.radius2.sqrt();
-                (cell_of(p.position - r), cell_of(p.position + r))
-            })
-            .collect();
-        // The distinct buckets of each point's cells: two of its cells may hash to the same
-        // bucket, and a point listed twice there would be handed a photon twice. A sphere spans
-        // 2 cells per axis, 3 when rounding puts its edge a hair past a cell boundary (seen in
-        // the Cornell box), so at most 27.
         // About eight buckets per point (two per entry): few collisions, so photons test few
         // needless candidates (a table of two per point made `bench ppm` 25 % slower).
         let buckets = (8 * points.len()).next_power_of_two().max(2);
         let mask = buckets as u64 - 1;
-        let pairs: Vec<(u32, u32)> = ranges
-            .par_iter()
-            .enumerate()
-            .flat_map_iter(|(k, (lo, hi))| {
-                let mut b = [0u32; 27];
-                let mut n = 0;
-                for z in lo.z..=hi.z {
-                    for y in lo.y..=hi.y {
-                        for x in lo.x..=hi.x {
-                            let h = (hash(IVec3::new(x, y, z)) & mask) as u32;
-                            if !b[..n].contains(&h) {
-                                b[n] = h;
-                                n += 1;
-                            }
+        // The distinct buckets of a point's cells: two of its cells may hash to the same
+        // bucket, and a point listed twice there would be handed a photon twice. A sphere spans
+        // 2 cells per axis, 3 when rounding puts its edge a hair past a cell boundary (seen in
+        // the Cornell box), so at most 27.
+        let buckets_of = |p: &VisiblePoint| -> ([u32; 27], usize) {
+            let r = p.radius2.sqrt();
+            let (lo, hi) = (cell_of(p.position - r), cell_of(p.position + r));
+            let mut b = [0u32; 27];
+            let mut n = 0;
+            for z in lo.z..=hi.z {
+                for y in lo.y..=hi.y {
+                    for x in lo.x..=hi.x {
+                        let h = (hash(IVec3::new(x, y, z)) & mask) as u32;
+                        if n < b.len() && !b[..n].contains(&h) {
+                            b[n] = h;
+                            n += 1;
                         }
                     }
                 }
-                (0..n).map(move |i| (b[i], k as u32))
+            }
+            (b, n)
+        };
+        // Each point's bucket count, then all buckets in point order (4 bytes an entry: at
+        // 1920×1080 no (bucket, point) pairs, cell ranges or second cursor table are held).
+        let counts: Vec<u8> = points.par_iter().map(|p| buckets_of(p).1 as u8).collect();
+        let ids: Vec<u32> = points
+            .par_iter()
+            .flat_map_iter(|p| {
+                let (b, n) = buckets_of(p);
+                b.into_iter().take(n)
             })
             .collect();
-        // Counting sort by bucket; within a bucket points stay in index order.
+        // Counting sort by bucket: sizes, running ends, then filled from the back so that each
+        // `starts[b]` comes down to its bucket's beginning and points stay in index order.
         let mut starts = vec![0u32; buckets + 1];
-        for &(b, _) in &pairs {
-            starts[b as usize + 1] += 1;
+        for &b in &ids {
+            starts[b as usize] += 1;
         }
-        for b in 0..buckets {
-            starts[b + 1] += starts[b];
+        let mut end = 0;
+        for s in starts.iter_mut() {
+            end += *s;
+            *s = end;
         }
-        let mut fill = starts.clone();
-        let mut entries = vec![0u32; pairs.len()];
-        for &(b, k) in &pairs {
-            entries[fill[b as usize] as usize] = k;
-            fill[b as usize] += 1;
+        let mut entries = vec![0u32; ids.len()];
+        let mut at = ids.len();
+        for (k, &n) in counts.iter().enumerate().rev() {
+            for _ in 0..n {
+                at -= 1;
+                let b = ids[at] as usize;
+                starts[b] -= 1;
+                entries[starts[b] as usize] = k as u32;
+            }
         }
         Self {
             origin,

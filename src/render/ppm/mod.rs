@@ -133,6 +133,16 @@ impl SpatialIndex {
     }
 }
 
+/// The empty visible point (no slot): a stochastic eye pass's placeholder for a pixel whose
+/// path found no diffuse surface.
+const NO_POINT: VisiblePoint = VisiblePoint {
+    slot: u32::MAX,
+    position: DVec3::ZERO,
+    normal: DVec3::ZERO,
+    weight: DVec3::ZERO,
+    radius2: 0.0,
+};
+
 /// Accumulated statistics of one gathering point (classic PPM) or pixel (stochastic PPM).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Slot {
@@ -332,80 +342,131 @@ impl Ppm {
         (self.width, self.height)
     }
 
-    /// Traces an eye ray per pixel (per pixel sample), in parallel; `None` when interrupted.
-    fn trace_eye_pass(&self, scene: &Scene) -> Option<Vec<visible::EyeResult>> {
+    /// Stochastic PPM's eye pass: one eye ray per pixel (jittered, through the lens), in
+    /// parallel, written in place: each pixel's visible point (at most one: glass is chosen,
+    /// not split) into `points` at the pixel's index, its directly seen light into
+    /// `pass_direct`; pixels without a point are then squeezed out. Nothing is allocated per
+    /// pixel, and the buffers keep their capacity from pass to pass. `false` when interrupted
+    /// (the pass is then traced again, so the half-written buffers do not matter).
+    fn trace_stochastic_eye_pass(&mut self, scene: &Scene) -> bool {
         let (w, h) = (self.width as u64, self.height as u64);
         let pass = self.stats.passes as u64;
-        let (stochastic, direct_light, seed) = (self.stochastic, self.direct_light, self.seed);
+        let (direct_light, seed) = (self.direct_light, self.seed);
         let interrupt = self.interrupt.as_deref();
         let skipped = std::sync::atomic::AtomicBool::new(false);
-        let results: Vec<visible::EyeResult> = (0..w * h)
-            .into_par_iter()
-            .map(|i| {
+        let pixels = (w * h) as usize;
+        self.points.clear();
+        self.points.resize(pixels, NO_POINT);
+        self.pass_direct.clear();
+        self.pass_direct.resize(pixels, DVec3::ZERO);
+        self.points
+            .par_iter_mut()
+            .zip(self.pass_direct.par_iter_mut())
+            .enumerate()
+            .for_each(|(i, (point, direct))| {
                 if interrupt.is_some_and(|f| f()) {
                     skipped.store(true, std::sync::atomic::Ordering::Relaxed);
-                    return visible::EyeResult::default();
+                    return;
                 }
+                let i = i as u64;
                 let (x, y) = (i % w, i / w);
                 let mut rng = stream_rng(seed, streams::EYE, pass * w * h + i);
-                if stochastic {
-                    let px = DVec2::new(x as f64 + rng.random::<f64>(), y as f64 + rng.random::<f64>());
-                    let lens = concentric_disk(DVec2::new(rng.random(), rng.random()));
-                    trace_eye(
-                        scene,
-                        px,
-                        lens,
-                        i as u32,
-                        Branching::Choose,
-                        direct_light,
-                        &mut rng,
-                    )
-                } else {
+                let px = DVec2::new(x as f64 + rng.random::<f64>(), y as f64 + rng.random::<f64>());
+                let lens = concentric_disk(DVec2::new(rng.random(), rng.random()));
+                let mut sink = |vp: VisiblePoint| {
+                    debug_assert!(point.slot == NO_POINT.slot, "a chosen path ends once");
+                    *point = vp;
+                };
+                *direct = trace_eye(
+                    scene,
+                    px,
+                    lens,
+                    i as u32,
+                    Branching::Choose,
+                    direct_light,
+                    &mut rng,
+                    &mut sink,
+                );
+            });
+        if skipped.into_inner() {
+            return false;
+        }
+        self.points.retain(|p| p.slot != NO_POINT.slot);
+        true
+    }
+
+    /// Classic PPM's one eye pass: an eye ray through each pixel centre, split at glass, rows
+    /// in parallel. Per pixel: the directly seen light; per visible point: the point, its
+    /// `slot` holding its pixel. `None` when interrupted.
+    fn trace_classic_eye_pass(&self, scene: &Scene) -> Option<(Vec<DVec3>, Vec<VisiblePoint>)> {
+        let (w, h) = (self.width as u64, self.height as u64);
+        let pass = self.stats.passes as u64;
+        let (direct_light, seed) = (self.direct_light, self.seed);
+        let interrupt = self.interrupt.as_deref();
+        let skipped = std::sync::atomic::AtomicBool::new(false);
+        let rows: Vec<(Vec<DVec3>, Vec<VisiblePoint>)> = (0..h)
+            .into_par_iter()
+            .map(|y| {
+                let (mut direct, mut points) = (Vec::with_capacity(w as usize), Vec::new());
+                if interrupt.is_some_and(|f| f()) {
+                    skipped.store(true, std::sync::atomic::Ordering::Relaxed);
+                    return (direct, points);
+                }
+                for x in 0..w {
+                    let i = y * w + x;
+                    let mut rng = stream_rng(seed, streams::EYE, pass * w * h + i);
                     let px = Scene::pixel_center(x as u32, y as u32);
-                    trace_eye(
+                    direct.push(trace_eye(
                         scene,
                         px,
                         DVec2::ZERO,
-                        0,
+                        i as u32,
                         Branching::Split,
                         direct_light,
                         &mut rng,
-                    )
+                        &mut |vp| points.push(vp),
+                    ));
                 }
+                (direct, points)
             })
             .collect();
-        (!skipped.into_inner()).then_some(results)
+        if skipped.into_inner() {
+            return None;
+        }
+        let mut direct = Vec::with_capacity((w * h) as usize);
+        let mut points = Vec::new();
+        for (d, p) in rows {
+            direct.extend(d);
+            points.extend(p);
+        }
+        Some((direct, points))
     }
 
-    /// Traces the eye pass; `false` when interrupted (nothing changed then).
+    /// Traces the eye pass; `false` when interrupted (nothing the next pass needs changed then).
     fn eye_pass(&mut self, scene: &Scene) -> bool {
-        let Some(results) = self.trace_eye_pass(scene) else {
-            return false;
-        };
-        let stochastic = self.stochastic;
-        // Classic PPM keeps its one eye pass at once; a stochastic pass's directly seen light
-        // counts only when the pass completes (an abandoned pass is traced again).
-        if !stochastic {
+        if self.stochastic {
+            // A stochastic pass's directly seen light counts only when the pass completes.
+            if !self.trace_stochastic_eye_pass(scene) {
+                return false;
+            }
+            if self.slots.is_empty() {
+                self.slots = (0..self.width * self.height).map(Slot::new).collect();
+            }
+        } else {
+            // Classic PPM keeps its one eye pass at once: a slot per visible point.
+            let Some((direct, points)) = self.trace_classic_eye_pass(scene) else {
+                return false;
+            };
             self.stats.eye_passes += 1;
-        }
-        self.pass_direct.clear();
-        self.points.clear();
-        for (pixel, r) in results.into_iter().enumerate() {
-            if stochastic {
-                self.pass_direct.push(r.direct);
-            } else {
-                self.direct[pixel] += r.direct;
+            for (d, p) in self.direct.iter_mut().zip(direct) {
+                *d += p;
             }
-            for mut vp in r.points {
-                if !stochastic {
-                    vp.slot = self.slots.len() as u32;
-                    self.slots.push(Slot::new(pixel as u32));
-                }
-                self.points.push(vp);
+            self.points = points;
+            for vp in &mut self.points {
+                let pixel = vp.slot;
+                vp.slot = self.slots.len() as u32;
+                self.slots.push(Slot::new(pixel));
             }
-        }
-        if stochastic && self.slots.is_empty() {
-            self.slots = (0..self.width * self.height).map(Slot::new).collect();
         }
         if self.stats.passes == 0 && self.slots.iter().all(|s| s.radius2 == 0.0) {
             let r0 = self

@@ -40,16 +40,16 @@ pub enum Branching {
     Choose,
 }
 
-/// One eye path's outputs: visible points and light seen directly.
-#[derive(Default)]
-pub struct EyeResult {
-    /// Visible points (0, 1, or several with [`Branching::Split`]).
-    pub points: Vec<VisiblePoint>,
-    /// Emission seen directly plus (if enabled) direct light from point/spot lights.
-    pub direct: DVec3,
+/// Where one eye path's outputs go: its visible points (0, 1, or several with
+/// [`Branching::Split`]) to a sink — so a pass allocates nothing per pixel — and the light it
+/// sees directly (emission, plus direct light from point and spot lights when enabled) summed.
+struct EyeOut<'a> {
+    points: &'a mut dyn FnMut(VisiblePoint),
+    direct: DVec3,
 }
 
-/// Traces the eye ray for `pixel` (pixel coordinates) through `lens` (unit disk).
+/// Traces the eye ray for `pixel` (pixel coordinates) through `lens` (unit disk), handing each
+/// visible point, tagged with `slot`, to `points`; returns the light seen directly.
 #[allow(clippy::too_many_arguments)]
 pub fn trace_eye(
     scene: &Scene,
@@ -59,9 +59,10 @@ pub fn trace_eye(
     branching: Branching,
     direct_light: bool,
     rng: &mut Pcg64Mcg,
-) -> EyeResult {
-    let mut out = EyeResult {
-        points: Vec::new(),
+    points: &mut dyn FnMut(VisiblePoint),
+) -> DVec3 {
+    let mut out = EyeOut {
+        points,
         direct: DVec3::ZERO,
     };
     let walk = EyeWalk {
@@ -71,7 +72,7 @@ pub fn trace_eye(
         direct_light,
     };
     walk.walk(&scene.camera.ray(pixel, lens), DVec3::ONE, 0, rng, &mut out);
-    out
+    out.direct
 }
 
 /// What stays fixed along one pixel's eye path.
@@ -84,7 +85,7 @@ struct EyeWalk<'s> {
 
 impl EyeWalk<'_> {
     /// Follows `ray` carrying `throughput` to the diffuse surfaces it reaches.
-    fn walk(&self, ray: &Ray, throughput: DVec3, depth: u32, rng: &mut Pcg64Mcg, out: &mut EyeResult) {
+    fn walk(&self, ray: &Ray, throughput: DVec3, depth: u32, rng: &mut Pcg64Mcg, out: &mut EyeOut) {
         let scene = self.scene;
         if throughput.max_element() <= 0.0 {
             return;
@@ -120,7 +121,7 @@ impl EyeWalk<'_> {
                         }
                     }
                 }
-                out.points.push(VisiblePoint {
+                (out.points)(VisiblePoint {
                     slot: self.slot,
                     position: hit.point,
                     normal: n,
