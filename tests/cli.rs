@@ -372,7 +372,12 @@ fn memory_bench_prints_its_samples() {
 fn every_bench_has_a_json_summary() {
     let dir = tempfile::tempdir().expect("temp dir");
     let refs = dir.path().join("references");
-    let cases: [(&str, Vec<&str>, &str); 5] = [
+    let cases: [(&str, Vec<&str>, &str); 6] = [
+        (
+            "tessellation",
+            vec!["--width", "24", "--segments", "2,4", "--per-ray-depth", "3"],
+            "renders",
+        ),
         ("intersect", vec!["--size", "16", "--repeat", "1"], "intersectors"),
         (
             "ppm",
@@ -433,4 +438,49 @@ fn every_bench_has_a_json_summary() {
             .unwrap_or_else(|| panic!("{bench}: no {list}: {doc}"));
         assert!(!entries.is_empty(), "{bench}: {doc}");
     }
+}
+
+/// `bench tessellation`: the exact render, the per-ray one (same picture) and tessellations
+/// whose error falls as they get finer, as a CSV and a readable plot.
+#[test]
+fn tessellation_bench_compares_exact_and_tessellated_renders() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let csv = dir.path().join("tess.csv");
+    let plot = dir.path().join("tess.png");
+    let out = caustic(&[
+        "bench",
+        "tessellation",
+        "--width",
+        "64",
+        "--segments",
+        "2,8",
+        "--csv",
+        csv.to_str().expect("utf-8"),
+        "--plot",
+        plot.to_str().expect("utf-8"),
+    ]);
+    assert!(out.status.success(), "{}", text(&out));
+    let rows = std::fs::read_to_string(&csv).expect("CSV");
+    let lines: Vec<&str> = rows.lines().collect();
+    assert_eq!(
+        lines[0],
+        "geometry,segments,triangles,prepare_seconds,render_seconds,rmse"
+    );
+    assert_eq!(lines.len(), 5, "{rows}");
+    let rmse = |line: &str| -> f64 { line.rsplit(',').next().expect("rmse").parse().expect("number") };
+    assert_eq!(rmse(lines[1]), 0.0, "the exact render is the reference");
+    assert!(rmse(lines[2]) < 1e-3, "per-ray and prepared agree: {rows}");
+    assert!(
+        rmse(lines[3]) > rmse(lines[4]),
+        "finer tessellation, less error: {rows}"
+    );
+    assert!(lines[4].contains(",8,") && lines[4].contains(&(2 * 8 * 8 * 32).to_string()));
+    let png = image::open(&plot).expect("readable PNG");
+    assert_eq!((png.width(), png.height()), caustic::bench::plot::SIZE);
+    let flat = caustic(&["bench", "tessellation", "scenes/smallppm.toml", "--width", "8"]);
+    assert!(
+        !flat.status.success() && text(&flat).contains("no Bézier patches"),
+        "{}",
+        text(&flat)
+    );
 }

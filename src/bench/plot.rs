@@ -1,4 +1,4 @@
-//! The log-log plot of error against time (plotters, drawn into an RGB buffer and written as
+//! Log-log plots — error against time, and any lines with point labels and markers (plotters, drawn into an RGB buffer and written as
 //! PNG by the `png` crate). Text uses egui's bundled Ubuntu Light, so no system font is read.
 
 use std::path::Path;
@@ -65,66 +65,122 @@ fn compact(v: f64) -> String {
     }
 }
 
+/// One line of a plot: its legend name, its points and (optionally) a label beside each point.
+#[derive(Clone, Debug, Default)]
+pub struct Series {
+    /// Legend text.
+    pub name: String,
+    /// `(x, y)` points; those not positive on both axes are left out (log scales).
+    pub points: Vec<(f64, f64)>,
+    /// Text beside each point (empty: none).
+    pub point_labels: Vec<String>,
+}
+
+/// What a log-log plot shows besides its lines.
+#[derive(Clone, Debug, Default)]
+pub struct Frame<'a> {
+    /// Title above the plot.
+    pub title: &'a str,
+    /// The x axis' description.
+    pub x: &'a str,
+    /// The y axis' description.
+    pub y: &'a str,
+    /// Vertical marker lines: legend text and x position.
+    pub markers: Vec<(String, f64)>,
+}
+
 /// Draws RMSE against seconds, both axes logarithmic, one line per curve with its fitted slope
 /// in the legend; returns the RGB pixels, `SIZE` row by row.
 pub fn draw(curves: &[Curve], title: &str) -> Result<Vec<u8>, String> {
+    let series: Vec<Series> = curves
+        .iter()
+        .map(|curve| Series {
+            name: match curve.slope() {
+                Some(s) => format!("{} (slope {s:.2})", curve.name),
+                None => curve.name.clone(),
+            },
+            points: curve.points.iter().map(|p| (p.secs, p.rmse)).collect(),
+            point_labels: Vec::new(),
+        })
+        .collect();
+    let frame = Frame {
+        title,
+        x: "seconds",
+        y: "RMSE against the reference",
+        markers: Vec::new(),
+    };
+    draw_series(&series, &frame)
+}
+
+/// Draws lines on log-log axes (ticks 1, 2, 5 × 10ᵏ), with point labels and vertical markers;
+/// returns the RGB pixels, `SIZE` row by row.
+pub fn draw_series(series: &[Series], frame: &Frame) -> Result<Vec<u8>, String> {
     register_font();
     let (w, h) = SIZE;
     let mut pixels = vec![255u8; (w * h * 3) as usize];
-    let points = curves
-        .iter()
-        .flat_map(|c| &c.points)
-        .filter(|p| p.secs > 0.0 && p.rmse > 0.0);
-    let (mut t0, mut t1, mut e0, mut e1) = (f64::MAX, 0.0f64, f64::MAX, 0.0f64);
-    for p in points {
-        (t0, t1) = (t0.min(p.secs), t1.max(p.secs));
-        (e0, e1) = (e0.min(p.rmse), e1.max(p.rmse));
+    let positive = |&(x, y): &(f64, f64)| x > 0.0 && y > 0.0 && x.is_finite() && y.is_finite();
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, 0.0f64, f64::MAX, 0.0f64);
+    for &(x, y) in series.iter().flat_map(|s| &s.points).filter(|p| positive(p)) {
+        (x0, x1) = (x0.min(x), x1.max(x));
+        (y0, y1) = (y0.min(y), y1.max(y));
     }
-    if t1 <= 0.0 || e1 <= 0.0 {
-        return Err("no checkpoint with a positive time and error to plot".into());
+    for &(_, x) in frame.markers.iter().filter(|(_, x)| *x > 0.0) {
+        (x0, x1) = (x0.min(x), x1.max(x));
+    }
+    if x1 <= 0.0 || y1 <= 0.0 {
+        return Err("no point with positive coordinates to plot".into());
     }
     {
         let root = BitMapBackend::with_buffer(&mut pixels, SIZE).into_drawing_area();
         let err = |e: &dyn std::fmt::Display| e.to_string();
+        let (xr, yr) = ((x0 * 0.8, x1 * 1.25), (y0 * 0.8, y1 * 1.25));
         let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 22))
+            .caption(frame.title, ("sans-serif", 22))
             .margin(16)
             .x_label_area_size(44)
             .y_label_area_size(72)
             .build_cartesian_2d(
-                (t0 * 0.9..t1 * 1.1)
-                    .log_scale()
-                    .with_key_points(ticks(t0 * 0.9, t1 * 1.1)),
-                (e0 * 0.9..e1 * 1.1)
-                    .log_scale()
-                    .with_key_points(ticks(e0 * 0.9, e1 * 1.1)),
+                (xr.0..xr.1).log_scale().with_key_points(ticks(xr.0, xr.1)),
+                (yr.0..yr.1).log_scale().with_key_points(ticks(yr.0, yr.1)),
             )
             .map_err(|e| err(&e))?;
         chart
             .configure_mesh()
-            .x_desc("seconds")
-            .y_desc("RMSE against the reference")
+            .x_desc(frame.x)
+            .y_desc(frame.y)
             .x_label_formatter(&|v| compact(*v))
             .y_label_formatter(&|v| format!("{v:.0e}"))
             .light_line_style(RGBColor(238, 238, 238))
             .label_style(("sans-serif", 15))
             .draw()
             .map_err(|e| err(&e))?;
-        for (k, curve) in curves.iter().enumerate() {
+        for (k, line) in series.iter().enumerate() {
             let colour = COLOURS[k % COLOURS.len()];
-            let line = curve
+            let points: Vec<(f64, f64)> = line.points.iter().copied().filter(positive).collect();
+            chart
+                .draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))
+                .map_err(|e| err(&e))?
+                .label(line.name.clone())
+                .legend(move |(x, y)| PathElement::new([(x, y), (x + 18, y)], colour.stroke_width(2)));
+            let labelled = line
                 .points
                 .iter()
-                .filter(|p| p.secs > 0.0 && p.rmse > 0.0)
-                .map(|p| (p.secs, p.rmse));
-            let label = match curve.slope() {
-                Some(s) => format!("{} (slope {s:.2})", curve.name),
-                None => curve.name.clone(),
-            };
+                .zip(&line.point_labels)
+                .filter(|(p, _)| positive(p));
             chart
-                .draw_series(LineSeries::new(line, colour.stroke_width(2)))
+                .draw_series(labelled.map(|(&(x, y), text)| {
+                    EmptyElement::at((x, y))
+                        + Circle::new((0, 0), 3, colour.filled())
+                        + Text::new(text.clone(), (6, -16), ("sans-serif", 14))
+                }))
+                .map_err(|e| err(&e))?;
+        }
+        for (k, (name, x)) in frame.markers.iter().enumerate() {
+            let colour = COLOURS[(series.len() + k) % COLOURS.len()];
+            chart
+                .draw_series(LineSeries::new([(*x, yr.0), (*x, yr.1)], colour.stroke_width(2)))
                 .map_err(|e| err(&e))?
-                .label(label)
+                .label(name.clone())
                 .legend(move |(x, y)| PathElement::new([(x, y), (x + 18, y)], colour.stroke_width(2)));
         }
         chart
@@ -146,13 +202,18 @@ pub fn write_plot(curves: &[Curve], title: &str, path: &Path, force: bool) -> Re
         path: path.to_owned(),
         message,
     })?;
+    write_png(&pixels, path, force)
+}
+
+/// Writes plot pixels (`SIZE`, RGB) to `path` as PNG (replacing it only when `force`).
+pub fn write_png(pixels: &[u8], path: &Path, force: bool) -> Result<(), WriteError> {
     write_atomically(path, force, |temporary| {
         let file = std::fs::File::create(temporary).map_err(|e| e.to_string())?;
         let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), SIZE.0, SIZE.1);
         encoder.set_color(png::ColorType::Rgb);
         encoder.set_depth(png::BitDepth::Eight);
         let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
-        writer.write_image_data(&pixels).map_err(|e| e.to_string())?;
+        writer.write_image_data(pixels).map_err(|e| e.to_string())?;
         writer.finish().map_err(|e| e.to_string())
     })
 }

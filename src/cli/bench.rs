@@ -62,6 +62,10 @@ pub enum BenchCommand {
     /// Photon mapping: resident memory (current and peak) of a long stochastic render (open
     /// aperture), sampled every --every passes.
     Memory(super::memory::MemoryArgs),
+    /// What exact patches buy: ray-traced renders with exact patches (prepared and per-ray)
+    /// and with patches tessellated at several resolutions, timed, with each one's RMSE
+    /// against the exact render (CSV and a log-log plot on request).
+    Tessellation(super::tessellation::TessellationArgs),
     /// Whitted ray tracer: rays per second on a scene, at the given thread counts.
     Whitted {
         /// Scene file; the built-in scene when omitted.
@@ -89,6 +93,7 @@ impl BenchCommand {
         match self {
             BenchCommand::Convergence(args) => args.threads,
             BenchCommand::Memory(args) => args.threads,
+            BenchCommand::Tessellation(args) => args.threads,
             _ => None,
         }
     }
@@ -102,6 +107,7 @@ pub fn bench(what: BenchCommand, json: bool) -> Result<()> {
         BenchCommand::Convergence(_) => "convergence",
         BenchCommand::Memory(_) => "memory",
         BenchCommand::Whitted { .. } => "whitted",
+        BenchCommand::Tessellation(_) => "tessellation",
     };
     let mut out = BenchOutput::new(json, name);
     match what {
@@ -127,6 +133,7 @@ pub fn bench(what: BenchCommand, json: bool) -> Result<()> {
             threads,
         } => bench_whitted(scene.as_deref(), width, &threads, &mut out),
         BenchCommand::Memory(args) => super::memory::bench_memory(args, &mut out),
+        BenchCommand::Tessellation(args) => super::tessellation::bench_tessellation(args, &mut out),
         BenchCommand::Ppm {
             scene,
             photons,

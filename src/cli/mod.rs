@@ -8,6 +8,7 @@ mod export;
 mod memory;
 mod render;
 mod render_report;
+mod tessellation;
 mod view;
 
 use std::path::Path;

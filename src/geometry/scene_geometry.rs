@@ -245,6 +245,28 @@ struct Candidate {
 }
 
 impl SceneGeometry {
+    /// The same shapes built again with another patch intersector, or with every patch
+    /// replaced by its tessellation (`tessellate_segments` quads per patch edge, one triangle
+    /// mesh per patch, same object, the patch's (u,v) as texture coordinates): what exactness
+    /// buys is measured against these.
+    pub fn rebuilt(&self, method: PatchMethod, tessellate_segments: Option<usize>) -> SceneGeometry {
+        let mut builder = GeometryBuilder {
+            spheres: self.spheres.clone(),
+            quads: self.quads.clone(),
+            planes: self.planes.clone(),
+            meshes: self.meshes.clone(),
+            patches: Vec::new(),
+            patch_method: method,
+        };
+        for (p, object) in &self.patches {
+            match tessellate_segments {
+                Some(n) => builder.add_mesh(super::tessellate::tessellate(p, n), *object),
+                None => builder.add_patch(*p, *object),
+            };
+        }
+        builder.build()
+    }
+
     /// Bounds of the bounded shapes (planes excluded).
     pub fn bounds(&self) -> Aabb {
         self.bvh.bounds()

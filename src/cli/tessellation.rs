@@ -1,0 +1,220 @@
+//! `caustic bench tessellation`: what exact patches buy. The scene is ray traced (Whitted:
+//! deterministic, so every difference is geometry, not noise) with its patches intersected
+//! exactly (prepared sub-patches + Newton), with the seed report's per-ray subdivision, and
+//! with every patch tessellated into a triangle mesh at several resolutions; each render's
+//! time and its RMSE against the exact one are printed, and written as CSV and a log-log plot
+//! of error against time on request.
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{bail, Context, Result};
+
+use super::bench_output::BenchOutput;
+use super::load_scene;
+use caustic::bench::plot::{draw_series, write_png, Frame, Series};
+use caustic::files::write_atomically;
+use caustic::geometry::{PatchMethod, SubdivisionParams};
+use caustic::render::error::errors;
+use caustic::render::render_whitted;
+use caustic::scene::Scene;
+
+/// `bench tessellation`'s flags.
+#[derive(clap::Args)]
+pub struct TessellationArgs {
+    /// Scene file; the built-in teapot scene when omitted. It must have Bézier patches.
+    scene: Option<PathBuf>,
+    /// Image width (height follows the scene's aspect).
+    #[arg(long, default_value_t = 640)]
+    width: u32,
+    /// Segments per patch edge to tessellate with (each patch becomes 2·n² triangles).
+    #[arg(long, value_delimiter = ',', default_value = "4,8,16,32,64")]
+    segments: Vec<usize>,
+    /// Subdivision depth of the per-ray (seed report) intersector.
+    #[arg(long, default_value_t = 5)]
+    per_ray_depth: u32,
+    /// Write every row (method, segments, triangles, seconds, RMSE) to this CSV file.
+    #[arg(long)]
+    csv: Option<PathBuf>,
+    /// Write the log-log plot of RMSE against render seconds to this PNG file.
+    #[arg(long)]
+    plot: Option<PathBuf>,
+    /// Replace existing CSV and plot files.
+    #[arg(long)]
+    force: bool,
+    /// Render with this many threads (default: one per core).
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
+}
+
+/// One render of the comparison.
+struct Row {
+    method: String,
+    segments: Option<usize>,
+    triangles: usize,
+    prepare_secs: f64,
+    render_secs: f64,
+    rmse: f64,
+}
+
+/// Renders the scene with each intersector and prints the table.
+pub fn bench_tessellation(args: TessellationArgs, out: &mut BenchOutput) -> Result<()> {
+    let mut scene = load_scene(args.scene.as_deref())?;
+    if !scene.geometry.has_patches() {
+        bail!(
+            "{}: the scene has no Bézier patches to tessellate",
+            scene.source.display()
+        );
+    }
+    if let Some(&bad) = args.segments.iter().find(|&&n| !(1..=256).contains(&n)) {
+        bail!("--segments must be between 1 and 256, got {bad}");
+    }
+    if !(1..=30).contains(&args.per_ray_depth) {
+        bail!(
+            "--per-ray-depth must be between 1 and 30, got {}",
+            args.per_ray_depth
+        );
+    }
+    for path in [&args.csv, &args.plot].into_iter().flatten() {
+        if path.exists() && !args.force {
+            bail!(
+                "{}: the file exists; choose another name or pass --force",
+                path.display()
+            );
+        }
+    }
+    caustic::render::limits::image_side(args.width).map_err(|e| anyhow::anyhow!("--width {e}"))?;
+    let aspect = scene.camera.height as f64 / scene.camera.width as f64;
+    scene.camera.width = args.width;
+    scene.camera.height = ((args.width as f64 * aspect).round() as u32).max(1);
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    let patches = scene.geometry.patches().len();
+    out.say(format!(
+        "Exact patches against tessellation on {}, {w}x{h}, {patches} patches, ray traced",
+        scene.source.display()
+    ));
+    out.set("scene", scene.source.display().to_string());
+    out.set("size", [w, h]);
+    out.set("patches", patches);
+
+    let exact_method = PatchMethod::Prepared(SubdivisionParams::default());
+    let mut methods = vec![
+        ("exact (prepared)".to_owned(), exact_method, None),
+        (
+            format!("exact (per-ray, depth {})", args.per_ray_depth),
+            PatchMethod::PerRay {
+                depth: args.per_ray_depth,
+            },
+            None,
+        ),
+    ];
+    for &n in &args.segments {
+        methods.push((format!("tessellated {n}x{n}"), exact_method, Some(n)));
+    }
+    let mut reference: Option<Vec<[f32; 3]>> = None;
+    let mut rows = Vec::new();
+    out.say(format!(
+        "{:<26} {:>10} {:>11} {:>10} {:>12}",
+        "geometry", "triangles", "prepare ms", "render s", "RMSE vs exact"
+    ));
+    for (method, patch_method, segments) in methods {
+        eprintln!("  {method}...");
+        let start = Instant::now();
+        let mut variant: Scene = scene.clone();
+        variant.geometry = scene.geometry.rebuilt(patch_method, segments);
+        let prepare_secs = start.elapsed().as_secs_f64();
+        let (image, stats) = render_whitted(&variant, &|_| {});
+        let rmse = match &reference {
+            Some(r) => errors(&image.pixels, r).0,
+            None => 0.0,
+        };
+        reference.get_or_insert(image.pixels);
+        let row = Row {
+            method,
+            segments,
+            triangles: segments.map_or(0, |n| 2 * n * n * patches),
+            prepare_secs,
+            render_secs: stats.elapsed_secs,
+            rmse,
+        };
+        out.say(format!(
+            "{:<26} {:>10} {:>11.1} {:>10.3} {:>12.4e}",
+            row.method,
+            row.triangles,
+            row.prepare_secs * 1e3,
+            row.render_secs,
+            row.rmse
+        ));
+        out.push(
+            "renders",
+            serde_json::json!({
+                "geometry": row.method,
+                "segments": row.segments,
+                "triangles": row.triangles,
+                "prepare_seconds": row.prepare_secs,
+                "render_seconds": row.render_secs,
+                "rmse": row.rmse,
+            }),
+        );
+        rows.push(row);
+    }
+    if let Some(path) = &args.csv {
+        let mut text = String::from("geometry,segments,triangles,prepare_seconds,render_seconds,rmse\n");
+        for r in &rows {
+            let segments = r.segments.map_or(String::new(), |n| n.to_string());
+            let _ = writeln!(
+                text,
+                "{},{segments},{},{:.6},{:.6},{:.6e}",
+                r.method, r.triangles, r.prepare_secs, r.render_secs, r.rmse
+            );
+        }
+        write_atomically(path, args.force, |t| {
+            std::fs::write(t, &text).map_err(|e| e.to_string())
+        })?;
+        out.say(format!("rows written to {}", path.display()));
+    }
+    if let Some(path) = &args.plot {
+        let name = scene
+            .source
+            .file_name()
+            .map_or("scene".into(), |n| n.to_string_lossy());
+        let title = format!("{name}: tessellation error against render time ({w}x{h}, ray traced)");
+        let pixels = draw_series(
+            &[tessellated_series(&rows)],
+            &Frame {
+                title: &title,
+                x: "render seconds",
+                y: "RMSE against the exact render",
+                markers: rows
+                    .iter()
+                    .filter(|r| r.segments.is_none())
+                    .map(|r| {
+                        (
+                            format!("{}: {:.2} s, error 0", r.method, r.render_secs),
+                            r.render_secs,
+                        )
+                    })
+                    .collect(),
+            },
+        )
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        write_png(&pixels, path, args.force).context("cannot write the plot")?;
+        out.say(format!("plot written to {}", path.display()));
+    }
+    Ok(())
+}
+
+/// The tessellated renders as one line: render time against error, each point labelled with
+/// its segments per edge.
+fn tessellated_series(rows: &[Row]) -> Series {
+    let tessellated: Vec<&Row> = rows.iter().filter(|r| r.segments.is_some()).collect();
+    Series {
+        name: "tessellated (segments per patch edge)".into(),
+        points: tessellated.iter().map(|r| (r.render_secs, r.rmse)).collect(),
+        point_labels: tessellated
+            .iter()
+            .map(|r| r.segments.map_or(String::new(), |n| n.to_string()))
+            .collect(),
+    }
+}
