@@ -287,7 +287,10 @@ fn convergence_bench_writes_its_csv_and_plot_and_reuses_the_reference() {
     assert_eq!(lines.next(), Some("configuration,pass,seconds,rmse,rel_mse"));
     let body: Vec<&str> = lines.collect();
     assert!(body.iter().all(|l| l.split(',').count() == 5), "{rows}");
-    for name in ["old defaults (photons only)", "default (light sampling)"] {
+    for name in [
+        "old defaults (photons only)",
+        "default (light sampling and guided emission)",
+    ] {
         assert!(
             body.iter().any(|l| l.starts_with(name)),
             "no rows of {name}: {rows}"
@@ -470,6 +473,8 @@ fn tessellation_bench_compares_exact_and_tessellated_renders() {
     let rmse = |line: &str| -> f64 { line.rsplit(',').next().expect("rmse").parse().expect("number") };
     assert_eq!(rmse(lines[1]), 0.0, "the exact render is the reference");
     assert!(rmse(lines[2]) < 1e-3, "per-ray and prepared agree: {rows}");
+    // A name with a comma is quoted: every row has six fields.
+    assert!(lines[2].starts_with("\"exact (per-ray, depth 5)\",,0,"), "{rows}");
     assert!(
         rmse(lines[3]) > rmse(lines[4]),
         "finer tessellation, less error: {rows}"

@@ -228,6 +228,8 @@ fn ppm_is_identical_for_one_and_two_threads() {
         let scene = cornell_small(aperture);
         // Its quad light is sampled at the visible points (the default) as well as photon mapped.
         assert!(scene.params.direct_light);
+        // Its photons are guided (the default), learned from earlier passes.
+        assert!(scene.params.guided_emission);
         let a = one.install(|| render_passes(&scene, PpmOptions::default(), 3));
         let b = two.install(|| render_passes(&scene, PpmOptions::default(), 3));
         assert_eq!(a, b, "aperture {aperture}");
@@ -738,4 +740,52 @@ fn light_sampling_agrees_with_photons_and_the_closed_form_for_every_light() {
             by_photons / by_sampling
         );
     }
+}
+
+/// Emission guided by what the camera sees: the camera looks at a small part of an infinite
+/// plane, so most of a point light's photons land where it does not look. Guided, many times
+/// more of them reach a visible point, the image still converges to the closed form (the
+/// weights keep it unbiased) with no more error than unguided emission after as many passes,
+/// and it is the same for one and two threads.
+#[test]
+fn guided_emission_sends_photons_where_the_camera_looks_and_keeps_the_image() {
+    let mut scene = Scene::from_str(PLANE, Path::new("plane.toml"), None).expect("scene");
+    let expected = expected_plane(&scene);
+    let mut render = |guided: bool, threads: usize| {
+        scene.params.guided_emission = guided;
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("pool");
+        pool.install(|| {
+            let mut ppm = Ppm::new(&scene, PpmOptions::default());
+            for _ in 0..40 {
+                ppm.run_pass(&scene, &mut |_| Control::Continue);
+            }
+            (ppm.radiance(), ppm.stats().clone())
+        })
+    };
+    let (unguided, u) = render(false, 2);
+    let (guided, g) = render(true, 2);
+    let share = |s: &caustic::render::ppm::PpmStats| s.useful_paths as f64 / s.photons as f64;
+    assert!(
+        share(&g) > 3.0 * share(&u),
+        "useful photons: guided {:.4}, unguided {:.4}",
+        share(&g),
+        share(&u)
+    );
+    assert!(g.photons < u.photons, "guided passes trace fewer photons");
+    let (mean_u, rms_u) = relative_errors(&unguided, &expected);
+    let (mean_g, rms_g) = relative_errors(&guided, &expected);
+    assert!(
+        (mean_u - 1.0).abs() < 0.01,
+        "unguided mean / closed form {mean_u}"
+    );
+    assert!((mean_g - 1.0).abs() < 0.01, "guided mean / closed form {mean_g}");
+    assert!(
+        rms_g < 1.25 * rms_u,
+        "RMS relative error guided {rms_g}, unguided {rms_u}"
+    );
+    let (one_thread, _) = render(true, 1);
+    assert_eq!(guided, one_thread, "guided emission with one and two threads");
 }

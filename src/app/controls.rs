@@ -321,6 +321,8 @@ pub fn side_panel_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) 
         }
         ui.checkbox(&mut p.render.direct_light, "Direct light by light sampling")
             .on_hover_text("Direct light from every light by shadow rays at the visible points (area lights: one sample per pass); photons carry only caustics and indirect light. Off: photons carry everything. Restarts.");
+        ui.checkbox(&mut p.render.guided_emission, "Photons where the camera looks")
+            .on_hover_text("Each light learns which of its photons reach what the camera sees and sends more there (weighted: the image converges to the same result). Off: lights emit as they shine. Restarts.");
         ui.horizontal(|ui| {
             ui.label("Index").on_hover_text("Spatial index over visible points; the image is the same, the speed differs");
             ui.selectable_value(&mut p.render.index, IndexKind::HashGrid, "Hash grid")
@@ -415,6 +417,14 @@ fn statistics_ui(viewer: &Viewer, ui: &mut egui::Ui) {
                     "Visible points",
                     count(stats.visible_points as u64),
                     "Gathering points of the last eye pass",
+                );
+                row(
+                    "Useful photons",
+                    format!(
+                        "{:.1} %",
+                        100.0 * stats.useful_paths as f64 / stats.photons.max(1) as f64
+                    ),
+                    "Share of the photons that handed light to at least one visible point (guided emission raises it)",
                 );
             }
             row(

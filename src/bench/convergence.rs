@@ -80,7 +80,11 @@ pub fn csv(curves: &[Curve]) -> String {
             let _ = writeln!(
                 text,
                 "{},{},{:.4},{:.6e},{:.6e}",
-                curve.name, p.pass, p.secs, p.rmse, p.rel_mse
+                super::csv_field(&curve.name),
+                p.pass,
+                p.secs,
+                p.rmse,
+                p.rel_mse
             );
         }
     }

@@ -7,12 +7,23 @@ pub mod convergence;
 pub mod plot;
 pub mod reference;
 
+use std::borrow::Cow;
 use std::time::Instant;
 
 use glam::DVec3;
 
 use crate::assets::teapot;
 use crate::geometry::{GeometryBuilder, PatchMethod, Ray, SceneGeometry};
+
+/// `text` as one CSV field (RFC 4180): quoted, with quotes doubled, when it holds a comma,
+/// a quote or a line break; as it is otherwise.
+pub fn csv_field(text: &str) -> Cow<'_, str> {
+    if text.contains([',', '"', '\n', '\r']) {
+        Cow::Owned(format!("\"{}\"", text.replace('"', "\"\"")))
+    } else {
+        Cow::Borrowed(text)
+    }
+}
 
 /// Primary rays of a `width × height` pinhole view that frames the whole Utah teapot (z up),
 /// one ray through each pixel centre, row by row from the top.
@@ -111,4 +122,17 @@ pub fn time_reprepare(geometry: &SceneGeometry, patch: usize, index: usize, roun
         .collect();
     secs.sort_by(f64::total_cmp);
     secs
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn csv_fields_are_quoted_only_when_they_must_be() {
+        assert_eq!(super::csv_field("tessellated 4x4"), "tessellated 4x4");
+        assert_eq!(
+            super::csv_field("exact (per-ray, depth 5)"),
+            "\"exact (per-ray, depth 5)\""
+        );
+        assert_eq!(super::csv_field("a \"b\""), "\"a \"\"b\"\"\"");
+    }
 }

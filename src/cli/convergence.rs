@@ -21,11 +21,15 @@ use caustic::scene::{RendererKind, Scene};
 /// A configuration measured: the scene's parameters with one thing changed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum Config {
-    /// The defaults before light sampling and balanced passes: photons carry all light and a
-    /// pass traces exactly the scene's photons per pass (the baseline).
+    /// The defaults before light sampling, balanced passes and guided emission: photons carry
+    /// all light, lights emit as they shine and a pass traces exactly the scene's photons per
+    /// pass (the baseline).
     PhotonsOnly,
-    /// The defaults: direct light by light sampling, α 0.7, automatic radius, hash grid.
+    /// The defaults: direct light by light sampling, guided emission, α 0.7, automatic
+    /// radius, hash grid.
     Default,
+    /// The defaults with lights emitting as they shine (no guided emission).
+    Unguided,
     /// α = 0.5.
     #[value(name = "alpha-0.5")]
     Alpha05,
@@ -47,7 +51,8 @@ impl Config {
     fn label(self) -> &'static str {
         match self {
             Config::PhotonsOnly => "old defaults (photons only)",
-            Config::Default => "default (light sampling)",
+            Config::Default => "default (light sampling and guided emission)",
+            Config::Unguided => "default without guided emission",
             Config::Alpha05 => "alpha 0.5",
             Config::Alpha067 => "alpha 2/3",
             Config::Alpha09 => "alpha 0.9",
@@ -61,14 +66,17 @@ impl Config {
     fn params(self, base: &RenderParams, auto_radius: f64) -> RenderParams {
         let mut p = RenderParams {
             direct_light: true,
+            guided_emission: true,
             ..base.clone()
         };
         match self {
             Config::PhotonsOnly => {
                 p.direct_light = false;
+                p.guided_emission = false;
                 p.min_photons_per_pixel = 0.0;
             }
             Config::Default => {}
+            Config::Unguided => p.guided_emission = false,
             Config::Alpha05 => p.alpha = 0.5,
             Config::Alpha067 => p.alpha = 2.0 / 3.0,
             Config::Alpha09 => p.alpha = 0.9,
@@ -109,7 +117,7 @@ pub struct ConvergenceArgs {
         long,
         value_enum,
         value_delimiter = ',',
-        default_value = "photons-only,default,alpha-0.5,alpha-0.667,alpha-0.9,radius-x4,kd-tree"
+        default_value = "photons-only,default,unguided,alpha-0.5,alpha-0.667,alpha-0.9,radius-x4,kd-tree"
     )]
     configs: Vec<Config>,
     /// Write every (configuration, pass, seconds, RMSE, relMSE) row to this CSV file.

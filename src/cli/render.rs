@@ -101,6 +101,12 @@ pub struct PpmArgs {
     #[arg(long, value_name = "on|off", action = clap::ArgAction::Set,
           value_parser = clap::builder::BoolishValueParser::new())]
     direct_light: Option<bool>,
+    /// Photon mapping: send photons where the camera looks, by each light's emission density
+    /// learned from which photons reached a visible point (default: the scene's
+    /// `guided_emission`, on unless it says otherwise).
+    #[arg(long, value_name = "on|off", action = clap::ArgAction::Set,
+          value_parser = clap::builder::BoolishValueParser::new())]
+    guided_emission: Option<bool>,
 }
 
 impl PpmArgs {
@@ -124,6 +130,9 @@ impl PpmArgs {
         }
         if let Some(on) = self.direct_light {
             params.direct_light = on;
+        }
+        if let Some(on) = self.guided_emission {
+            params.guided_emission = on;
         }
         params.validate().map_err(|e| {
             let flag = match e.field {

@@ -157,7 +157,7 @@ impl Report {
             }
             return;
         }
-        print_text(out, image, &renderer);
+        print_text(out, image, &renderer, scene.params.guided_emission);
         if let Some(r) = reference_summary {
             if let Some(e) = r.last {
                 println!(
@@ -169,7 +169,7 @@ impl Report {
     }
 }
 
-fn print_text(out: &Path, image: &Image, renderer: &RendererSummary) {
+fn print_text(out: &Path, image: &Image, renderer: &RendererSummary, guided: bool) {
     let (w, h) = (image.width, image.height);
     match renderer {
         RendererSummary::Whitted(stats) => println!(
@@ -190,6 +190,11 @@ fn print_text(out: &Path, image: &Image, renderer: &RendererSummary) {
                 s.photons as f64 / s.photon_secs.max(1e-9),
                 s.mean_radius,
                 s.visible_points
+            );
+            println!(
+                "  photons that reached a visible point: {:.1} %{}",
+                100.0 * s.useful_paths as f64 / s.photons.max(1) as f64,
+                if guided { " (emission guided)" } else { "" }
             );
             println!(
                 "  time: eye passes {:.3} s ({} of them), area-light sampling {:.3} s, index builds {:.3} s, photons {:.3} s",

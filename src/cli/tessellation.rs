@@ -166,7 +166,11 @@ pub fn bench_tessellation(args: TessellationArgs, out: &mut BenchOutput) -> Resu
             let _ = writeln!(
                 text,
                 "{},{segments},{},{:.6},{:.6},{:.6e}",
-                r.method, r.triangles, r.prepare_secs, r.render_secs, r.rmse
+                caustic::bench::csv_field(&r.method),
+                r.triangles,
+                r.prepare_secs,
+                r.render_secs,
+                r.rmse
             );
         }
         write_atomically(path, args.force, |t| {
@@ -178,7 +182,8 @@ pub fn bench_tessellation(args: TessellationArgs, out: &mut BenchOutput) -> Resu
         let name = scene
             .source
             .file_name()
-            .map_or("scene".into(), |n| n.to_string_lossy());
+            .map_or("scene".into(), |n| n.to_string_lossy())
+            .replace("<built-in>", "built-in teapot scene");
         let title = format!("{name}: tessellation error against render time ({w}x{h}, ray traced)");
         let pixels = draw_series(
             &[tessellated_series(&rows)],
@@ -189,12 +194,7 @@ pub fn bench_tessellation(args: TessellationArgs, out: &mut BenchOutput) -> Resu
                 markers: rows
                     .iter()
                     .filter(|r| r.segments.is_none())
-                    .map(|r| {
-                        (
-                            format!("{}: {:.2} s, error 0", r.method, r.render_secs),
-                            r.render_secs,
-                        )
-                    })
+                    .map(|r| (marker_label(r), r.render_secs))
                     .collect(),
             },
         )
@@ -203,6 +203,16 @@ pub fn bench_tessellation(args: TessellationArgs, out: &mut BenchOutput) -> Resu
         out.say(format!("plot written to {}", path.display()));
     }
     Ok(())
+}
+
+/// An exact render's legend entry: its time and its RMSE against the prepared exact render
+/// (0 for that one itself; the per-ray intersector's Newton tolerance leaves a small one).
+fn marker_label(r: &Row) -> String {
+    if r.rmse == 0.0 {
+        format!("{}: {:.2} s, the reference", r.method, r.render_secs)
+    } else {
+        format!("{}: {:.2} s, RMSE {:.1e}", r.method, r.render_secs, r.rmse)
+    }
 }
 
 /// The tessellated renders as one line: render time against error, each point labelled with

@@ -74,6 +74,10 @@ pub struct RenderParams {
     /// photons deposited only after their first bounce (caustics and indirect light). On by
     /// default; off, photons carry all the light (classic PPM).
     pub direct_light: bool,
+    /// Photon mapping: photons sent where the camera looks — each light's emission density
+    /// learned from which of its photons reached a visible point (`ppm::guide`), weighted so
+    /// the image converges to the same result. On by default; off, lights emit as they shine.
+    pub guided_emission: bool,
     /// Photon mapping: the spatial index over visible points (the image does not depend on it).
     pub index: IndexKind,
 }
@@ -93,6 +97,7 @@ impl Default for RenderParams {
             light_samples: 16,
             ambient: DVec3::ZERO,
             direct_light: true,
+            guided_emission: true,
             index: IndexKind::HashGrid,
         }
     }

@@ -297,10 +297,20 @@ impl Light {
                 }
             }
             Light::Sphere { center, radius, .. } => {
-                let n = uniform_sphere(u1);
+                // A uniformly emitting sphere shines equally in every direction, and in each
+                // direction uniformly over its silhouette disk: pick the direction, then the
+                // point of the disk, and move it back onto the sphere — the same photons as a
+                // uniform point with a cosine lobe, but the first pair alone chooses where
+                // they go (what emission guiding learns).
+                let dir = uniform_sphere(u1);
+                let disk = crate::scene::camera::concentric_disk(u2);
+                let (t, b) = dir.any_orthonormal_pair();
+                let depth = (1.0 - disk.length_squared()).max(0.0).sqrt();
+                // The point of the sphere facing `dir` whose projection is `disk`.
+                let n = (disk.x * t + disk.y * b + depth * dir).normalize();
                 Emission {
                     origin: *center + n * *radius,
-                    dir: cosine_hemisphere(n, u2),
+                    dir,
                     weight: 1.0,
                     surface_normal: Some(n),
                 }

@@ -18,6 +18,7 @@
 //! chunk order, so the image is bit-identical for any number of threads.
 
 pub mod direct;
+pub mod guide;
 pub mod hash_grid;
 pub mod kd_tree;
 pub mod photon;
@@ -31,6 +32,7 @@ use glam::{DVec2, DVec3};
 use rand::Rng;
 use rayon::prelude::*;
 
+use guide::{EmissionGuide, GuideTally};
 pub use hash_grid::HashGrid;
 pub use kd_tree::KdTree;
 use photon::{PhotonCounts, PhotonSource};
@@ -58,6 +60,9 @@ const MAX_CHUNK_DEPOSITS: usize = 1 << 20;
 
 /// Flux handed to a statistics slot: `(slot, flux × point weight, photon count)`.
 type Deposit = (u32, DVec3, u32);
+
+/// What one chunk of photons left: its deposits, counts and guide tally.
+type ChunkResult = (Vec<Deposit>, PhotonCounts, Option<GuideTally>);
 
 /// Merges deposits to the same slot, keeping each slot's additions in photon order (a stable
 /// sort), so the sums depend only on the chunk's photons, not on threads.
@@ -173,6 +178,8 @@ struct Gathered {
     phi: Vec<DVec3>,
     m: Vec<u32>,
     counts: PhotonCounts,
+    /// Emitted and useful photons per light and bin, when emission is guided.
+    tally: Option<GuideTally>,
 }
 
 /// Run statistics.
@@ -186,6 +193,9 @@ pub struct PpmStats {
     pub bounces: u64,
     /// Flux deposits made.
     pub deposits: u64,
+    /// Photon paths that handed flux to at least one visible point (the share of `photons`
+    /// that did any good).
+    pub useful_paths: u64,
     /// Visible points in the last pass.
     pub visible_points: usize,
     /// Mean search radius over slots that have gathered photons (scene units).
@@ -246,6 +256,12 @@ pub struct Ppm {
     /// Area light sampled at the visible points, summed over completed passes, per pixel
     /// (empty unless direct light is on and the scene has area lights).
     area_direct: Vec<DVec3>,
+    /// Where photons are sent, learned from completed passes (`None`: uniformly, as the
+    /// lights emit).
+    guide: Option<EmissionGuide>,
+    /// Photons emitted by the pass in progress: `photons_per_pass`, divided by the guide's
+    /// gain when emission is guided.
+    pass_photons: u64,
     stats: PpmStats,
     width: u32,
     height: u32,
@@ -305,6 +321,9 @@ impl Ppm {
             } else {
                 Vec::new()
             },
+            guide: (scene.params.guided_emission && !scene.lights.is_empty())
+                .then(|| EmissionGuide::new(scene, photon::light_probabilities(scene))),
+            pass_photons: 0,
             stats: PpmStats {
                 skipped,
                 ..Default::default()
@@ -558,7 +577,7 @@ impl Ppm {
         index: &SpatialIndex,
         control: &mut dyn FnMut(&mut f64) -> Control,
     ) -> Option<Gathered> {
-        let source = PhotonSource::new(scene, self.direct_light);
+        let source = PhotonSource::new(scene, self.direct_light).with_guide(self.guide.as_ref());
         // Positions and radii packed tightly: the candidate test reads nothing else.
         let reach: Vec<[f64; 4]> = self
             .points
@@ -569,8 +588,10 @@ impl Ppm {
             phi: vec![DVec3::ZERO; self.slots.len()],
             m: vec![0u32; self.slots.len()],
             counts: PhotonCounts::default(),
+            tally: self.guide.as_ref().map(EmissionGuide::tally),
         };
-        let chunks = self.photons_per_pass.div_ceil(CHUNK);
+        self.pass_photons = self.guided_pass_photons();
+        let chunks = self.pass_photons.div_ceil(CHUNK);
         let chunks_per_batch = self.options.batch_photons.div_ceil(CHUNK).max(1);
         let mut chunk = 0;
         while chunk < chunks {
@@ -578,12 +599,15 @@ impl Ppm {
                 return None;
             }
             let end = (chunk + chunks_per_batch).min(chunks);
-            let results: Vec<(Vec<Deposit>, PhotonCounts)> = (chunk..end)
+            let results: Vec<ChunkResult> = (chunk..end)
                 .into_par_iter()
                 .map(|c| self.trace_chunk(c, &source, index, &reach))
                 .collect();
             // Fold in chunk order: the same sums whatever the thread count.
-            for (deposits, c) in results {
+            for (deposits, c, tally) in results {
+                if let (Some(all), Some(t)) = (&mut out.tally, &tally) {
+                    all.add(t);
+                }
                 for (slot, flux, count) in deposits {
                     out.phi[slot as usize] += flux;
                     out.m[slot as usize] += count;
@@ -591,10 +615,23 @@ impl Ppm {
                 }
                 out.counts.paths += c.paths;
                 out.counts.bounces += c.bounces;
+                out.counts.useful += c.useful;
             }
             chunk = end;
         }
         Some(out)
+    }
+
+    /// This pass's photons: `photons_per_pass` divided by the guide's gain (as many useful
+    /// photons, fewer lost ones; see [`guide`]), but not below one chunk (or all of them).
+    fn guided_pass_photons(&self) -> u64 {
+        match &self.guide {
+            Some(g) => {
+                let reduced = (self.photons_per_pass as f64 / g.gain()).ceil() as u64;
+                reduced.max(self.photons_per_pass.min(CHUNK))
+            }
+            None => self.photons_per_pass,
+        }
     }
 
     /// Traces photon chunk `c` of this pass: the deposits it makes and its counts.
@@ -604,14 +641,16 @@ impl Ppm {
         source: &PhotonSource,
         index: &SpatialIndex,
         reach: &[[f64; 4]],
-    ) -> (Vec<Deposit>, PhotonCounts) {
+    ) -> ChunkResult {
         let mut deposits: Vec<Deposit> = Vec::new();
         let mut counts = PhotonCounts::default();
-        let (photons, first_photon) = (self.photons_per_pass, self.stats.photons);
+        let mut tally = self.guide.as_ref().map(EmissionGuide::tally);
+        let (photons, first_photon) = (self.pass_photons, self.stats.photons);
         let points = &self.points;
         for i in c * CHUNK..((c + 1) * CHUNK).min(photons) {
             let mut rng = stream_rng(self.seed, streams::PHOTON, first_photon + i);
-            source.trace(&mut rng, &mut counts, &mut |p, n, flux| {
+            let mut useful = false;
+            let from = source.trace(&mut rng, &mut counts, &mut |p, n, flux| {
                 // Hand the flux to every visible point on this side of the surface whose
                 // search sphere holds the photon.
                 index.for_candidates(points, p, &mut |k| {
@@ -620,20 +659,33 @@ impl Ppm {
                         let vp = &points[k as usize];
                         if vp.normal.dot(n) > 1e-3 {
                             deposits.push((vp.slot, vp.weight * flux, 1));
+                            useful = true;
                         }
                     }
                 });
             });
+            counts.useful += useful as u64;
+            if let Some(t) = &mut tally {
+                t.record(from.light, from.bin, useful);
+            }
             if deposits.len() > MAX_CHUNK_DEPOSITS {
                 compact(&mut deposits);
             }
         }
-        (deposits, counts)
+        (deposits, counts, tally)
     }
 
     /// Folds a completed pass into the slots and the statistics.
     fn update(&mut self, gathered: Gathered) {
-        let Gathered { phi, m, counts } = gathered;
+        let Gathered {
+            phi,
+            m,
+            counts,
+            tally,
+        } = gathered;
+        if let (Some(guide), Some(tally)) = (&mut self.guide, &tally) {
+            guide.learn(tally);
+        }
         // Compute new photon counts, radii and flux (Hachisuka et al. 2008, eqs. 6–11).
         let alpha = self.alpha;
         for (k, s) in self.slots.iter_mut().enumerate() {
@@ -652,9 +704,10 @@ impl Ppm {
             self.stats.eye_passes += 1;
         }
         self.stats.passes += 1;
-        self.stats.photons += self.photons_per_pass;
+        self.stats.photons += self.pass_photons;
         self.stats.bounces += counts.bounces;
         self.stats.deposits += counts.deposits;
+        self.stats.useful_paths += counts.useful;
         self.stats.visible_points = self.points.len();
         let gathered: Vec<f64> = self
             .slots

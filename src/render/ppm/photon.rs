@@ -9,6 +9,7 @@ use glam::{DVec2, DVec3};
 use rand::Rng;
 use rand_pcg::Pcg64Mcg;
 
+use super::guide::EmissionGuide;
 use crate::scene::light::cosine_hemisphere;
 use crate::scene::material::{dielectric, reflect};
 use crate::scene::{MaterialKind, Scene};
@@ -22,6 +23,18 @@ pub struct PhotonCounts {
     pub bounces: u64,
     /// Deposits made (counted by the caller's gather).
     pub deposits: u64,
+    /// Paths that handed flux to at least one visible point (counted by the caller).
+    pub useful: u64,
+}
+
+/// Where a traced photon came from: its light and the bin of the light's [`EmissionGuide`]
+/// its random numbers fell in (0 without a guide).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Emitted {
+    /// Index of the light in the scene.
+    pub light: usize,
+    /// Bin of the light's guided pair of random numbers.
+    pub bin: u32,
 }
 
 /// Where the light's photons go: which light, with what flux.
@@ -41,30 +54,38 @@ pub struct PhotonSource<'a> {
     /// reached the surface through mirrors or glass (caustics) are still gathered — a shadow
     /// ray cannot see them.
     pub skip_direct: bool,
+    /// The learned emission density, when photons are guided to where the camera looks.
+    pub guide: Option<&'a EmissionGuide>,
+}
+
+/// The chance that a photon comes from each of the scene's lights: in proportion to power.
+pub fn light_probabilities(scene: &Scene) -> Vec<f64> {
+    let powers: Vec<f64> = scene
+        .lights
+        .iter()
+        .map(|l| l.power().element_sum() / 3.0)
+        .collect();
+    let total: f64 = powers.iter().sum();
+    powers.iter().map(|p| p / total).collect()
 }
 
 impl<'a> PhotonSource<'a> {
     /// Photons distributed over the scene's lights in proportion to their power.
     pub fn new(scene: &'a Scene, direct_light: bool) -> Self {
-        let powers: Vec<f64> = scene
-            .lights
-            .iter()
-            .map(|l| l.power().element_sum() / 3.0)
-            .collect();
-        let total: f64 = powers.iter().sum();
+        let pick = light_probabilities(scene);
         let mut acc = 0.0;
-        let cdf = powers
+        let cdf = pick
             .iter()
             .map(|p| {
-                acc += p / total;
+                acc += p;
                 acc
             })
             .collect();
         let flux = scene
             .lights
             .iter()
-            .zip(&powers)
-            .map(|(l, p)| l.power() / (p / total))
+            .zip(&pick)
+            .map(|(l, p)| l.power() / *p)
             .collect();
         Self {
             scene,
@@ -72,18 +93,25 @@ impl<'a> PhotonSource<'a> {
             flux,
             target: scene.geometry.bounding_sphere(),
             skip_direct: direct_light,
+            guide: None,
         }
+    }
+
+    /// The same source emitting by `guide`'s learned density (weights keep it unbiased).
+    pub fn with_guide(self, guide: Option<&'a EmissionGuide>) -> Self {
+        Self { guide, ..self }
     }
 
     /// Traces one photon path with `rng`. At every diffuse hit whose flux should be gathered
     /// (all but direct hits when direct light is computed by light sampling),
-    /// calls `gather(point, normal facing the photon, flux)`.
+    /// calls `gather(point, normal facing the photon, flux)`. Returns where the photon came
+    /// from.
     pub fn trace(
         &self,
         rng: &mut Pcg64Mcg,
         counts: &mut PhotonCounts,
         gather: &mut impl FnMut(DVec3, DVec3, DVec3),
-    ) {
+    ) -> Emitted {
         let scene = self.scene;
         let pick: f64 = rng.random();
         let light_index = self
@@ -92,22 +120,25 @@ impl<'a> PhotonSource<'a> {
             .position(|&c| pick < c)
             .unwrap_or(self.cdf.len() - 1);
         let light = &scene.lights[light_index];
-        let e = light.emit(
-            [rng.random(), rng.random(), rng.random(), rng.random()],
-            self.target,
-        );
-        let mut flux = self.flux[light_index] * e.weight;
+        let mut u = [rng.random(), rng.random(), rng.random(), rng.random()];
+        let (pdf, bin) = self.guide.map_or((1.0, 0), |g| g.warp(light_index, &mut u));
+        let emitted = Emitted {
+            light: light_index,
+            bin,
+        };
+        let e = light.emit(u, self.target);
+        let mut flux = self.flux[light_index] * (e.weight / pdf);
         let mut ray = e.ray();
         let skip_first = self.skip_direct;
         counts.paths += 1;
         let mut first_interaction = true;
         for _depth in 0..scene.params.max_depth.max(1) * 4 {
             let Some(hit) = scene.geometry.intersect(&ray, f64::INFINITY) else {
-                return;
+                return emitted;
             };
             counts.bounces += 1;
             if scene.objects[hit.object as usize].emission.is_some() {
-                return;
+                return emitted;
             }
             let surface = scene.surface(&hit, ray.dir);
             let (color, front, n) = (surface.color, surface.front, surface.normal);
@@ -119,7 +150,7 @@ impl<'a> PhotonSource<'a> {
                     // Russian roulette on the albedo, then a cosine-distributed bounce.
                     let survive = color.max_element();
                     if survive <= 0.0 || rng.random::<f64>() >= survive {
-                        return;
+                        return emitted;
                     }
                     flux *= color / survive;
                     let dir = cosine_hemisphere(n, DVec2::new(rng.random(), rng.random()));
@@ -142,8 +173,9 @@ impl<'a> PhotonSource<'a> {
             }
             first_interaction = false;
             if flux.max_element() <= 0.0 {
-                return;
+                return emitted;
             }
         }
+        emitted
     }
 }
