@@ -292,7 +292,7 @@ pub fn side_panel_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) 
                 .logarithmic(true)
                 .text("Photons per pass"),
         )
-        .on_hover_text("Photons traced per pass. Applies from the next pass, without restarting.");
+        .on_hover_text("Photons traced per pass (with photons sent where the camera looks, divided by how many times more of them arrive). Applies from the next pass, without restarting.");
         ui.add(
             egui::Slider::new(&mut p.render.min_photons_per_pixel, 0.0..=32.0)
                 .step_by(0.5)

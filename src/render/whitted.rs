@@ -20,7 +20,7 @@ use rayon::prelude::*;
 use super::film::Image;
 use super::rng::{mix64, stream_rng, streams};
 use crate::geometry::Ray;
-use crate::scene::camera::concentric_disk;
+use crate::scene::camera::{concentric_disk, EyeRays};
 use crate::scene::material::{dielectric, reflect};
 use crate::scene::{MaterialKind, Scene};
 
@@ -49,6 +49,8 @@ impl PathState<'_> {
 
 struct Tracer<'s> {
     scene: &'s Scene,
+    /// The camera's eye rays, their constants computed once.
+    eye_rays: EyeRays<'s>,
 }
 
 impl Tracer<'_> {
@@ -56,6 +58,7 @@ impl Tracer<'_> {
     /// or every lens sample (stratified) when the aperture is open.
     fn first_sample(&self, x: u32, y: u32, rays: &AtomicUsize) -> (DVec3, u64) {
         let (scene, camera) = (self.scene, &self.scene.camera);
+        let eye = &self.eye_rays;
         let index = (y as u64) * camera.width as u64 + x as u64;
         let mut rng = stream_rng(scene.params.seed, streams::WHITTED_PIXEL, index);
         if camera.aperture > 0.0 {
@@ -67,14 +70,14 @@ impl Tracer<'_> {
                 let lens = concentric_disk((cell + DVec2::new(rng.random(), rng.random())) / grid as f64);
                 let px = DVec2::new(x as f64 + rng.random::<f64>(), y as f64 + rng.random::<f64>());
                 let mut state = PathState { id: 0, rng: &mut rng };
-                sum += self.trace(&camera.ray(px, lens), 0, &mut state);
+                sum += self.trace(&eye.ray(px, lens), 0, &mut state);
             }
             rays.fetch_add(n as usize, Ordering::Relaxed);
             (sum / n as f64, 0)
         } else {
             let mut state = PathState { id: 0, rng: &mut rng };
             let px = Scene::pixel_center(x, y);
-            let c = self.trace(&camera.ray(px, DVec2::ZERO), 0, &mut state);
+            let c = self.trace(&eye.ray(px, DVec2::ZERO), 0, &mut state);
             rays.fetch_add(1, Ordering::Relaxed);
             (c, state.id)
         }
@@ -82,7 +85,6 @@ impl Tracer<'_> {
 
     /// The mean of a 4×4 grid of rays over pixel `i` = `(x, y)` (edge anti-aliasing).
     fn edge_samples(&self, i: usize, x: i64, y: i64) -> DVec3 {
-        let camera = &self.scene.camera;
         let mut rng = stream_rng(self.scene.params.seed, streams::WHITTED_EDGE, i as u64);
         let mut sum = DVec3::ZERO;
         for sy in 0..4 {
@@ -92,7 +94,7 @@ impl Tracer<'_> {
                     y as f64 + (sy as f64 + 0.5) / 4.0,
                 );
                 let mut state = PathState { id: 0, rng: &mut rng };
-                sum += self.trace(&camera.ray(px, DVec2::ZERO), 0, &mut state);
+                sum += self.trace(&self.eye_rays.ray(px, DVec2::ZERO), 0, &mut state);
             }
         }
         sum / 16.0
@@ -196,7 +198,10 @@ pub fn render_whitted_until(
     let start = Instant::now();
     let camera = &scene.camera;
     let (w, h) = (camera.width, camera.height);
-    let tracer = Tracer { scene };
+    let tracer = Tracer {
+        scene,
+        eye_rays: camera.eye_rays(),
+    };
     let dof = camera.aperture > 0.0;
     let rays = AtomicUsize::new(0);
 

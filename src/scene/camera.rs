@@ -61,36 +61,25 @@ impl Camera {
         }
     }
 
-    /// Half the image plane's height at unit distance.
-    fn half_height(&self) -> f64 {
-        (0.5 * self.fov_y).tan()
+    /// The constants of this camera's eye rays, to compute once for many rays.
+    pub fn eye_rays(&self) -> EyeRays<'_> {
+        EyeRays {
+            camera: self,
+            half_height: (0.5 * self.fov_y).tan(),
+            aspect: self.width as f64 / self.height as f64,
+        }
     }
 
     /// The un-normalised direction through image position `pixel` (in pixels, `(0,0)` the top
     /// left corner of the image) with unit component along `forward`.
     pub fn pinhole_direction(&self, pixel: DVec2) -> DVec3 {
-        let h = self.half_height();
-        let aspect = self.width as f64 / self.height as f64;
-        let sx = (2.0 * pixel.x / self.width as f64 - 1.0) * h * aspect;
-        let sy = (1.0 - 2.0 * pixel.y / self.height as f64) * h;
-        self.forward + sx * self.right + sy * self.up
+        self.eye_rays().direction(pixel)
     }
 
     /// The eye ray through image position `pixel`, leaving the lens at `lens` (a point of the
-    /// unit disk, scaled by the aperture).
+    /// unit disk, scaled by the aperture). Many rays: [`Camera::eye_rays`].
     pub fn ray(&self, pixel: DVec2, lens: DVec2) -> Ray {
-        let d = self.pinhole_direction(pixel);
-        let (origin, dir) = if self.aperture > 0.0 {
-            let focus = self.position + d * self.focal_distance;
-            let origin = self.position + self.aperture * (lens.x * self.right + lens.y * self.up);
-            (origin, focus - origin)
-        } else {
-            (self.position, d)
-        };
-        let dir = dir.normalize();
-        // Start on the near plane (measured along the view axis, like smallppm's clip).
-        let start = self.near / dir.dot(self.forward).max(1e-12);
-        Ray::new(origin + start * dir, dir)
+        self.eye_rays().ray(pixel, lens)
     }
 
     /// The pixel `(x, y)` (fractional) where the world point `p` projects, if in front.
@@ -100,14 +89,57 @@ impl Camera {
         if z <= 0.0 {
             return None;
         }
-        let h = self.half_height();
-        let aspect = self.width as f64 / self.height as f64;
+        let EyeRays {
+            half_height: h,
+            aspect,
+            ..
+        } = self.eye_rays();
         let sx = v.dot(self.right) / z / (h * aspect);
         let sy = v.dot(self.up) / z / h;
         Some(DVec2::new(
             (sx + 1.0) * 0.5 * self.width as f64,
             (1.0 - sy) * 0.5 * self.height as f64,
         ))
+    }
+}
+
+/// A camera's eye rays with the constants they share computed once (per pass), as pbrt-v4's
+/// cameras precompute their transforms: the same rays, bit for bit, as [`Camera::ray`].
+#[derive(Clone, Copy, Debug)]
+pub struct EyeRays<'a> {
+    camera: &'a Camera,
+    /// Half the image plane's height at unit distance.
+    half_height: f64,
+    /// Width over height.
+    aspect: f64,
+}
+
+impl EyeRays<'_> {
+    /// The un-normalised direction through image position `pixel` with unit component along
+    /// the view axis.
+    pub fn direction(&self, pixel: DVec2) -> DVec3 {
+        let (c, h) = (self.camera, self.half_height);
+        let sx = (2.0 * pixel.x / c.width as f64 - 1.0) * h * self.aspect;
+        let sy = (1.0 - 2.0 * pixel.y / c.height as f64) * h;
+        c.forward + sx * c.right + sy * c.up
+    }
+
+    /// The eye ray through image position `pixel`, leaving the lens at `lens` (a point of the
+    /// unit disk, scaled by the aperture).
+    pub fn ray(&self, pixel: DVec2, lens: DVec2) -> Ray {
+        let c = self.camera;
+        let d = self.direction(pixel);
+        let (origin, dir) = if c.aperture > 0.0 {
+            let focus = c.position + d * c.focal_distance;
+            let origin = c.position + c.aperture * (lens.x * c.right + lens.y * c.up);
+            (origin, focus - origin)
+        } else {
+            (c.position, d)
+        };
+        let dir = dir.normalize();
+        // Start on the near plane (measured along the view axis, like smallppm's clip).
+        let start = c.near / dir.dot(c.forward).max(1e-12);
+        Ray::new(origin + start * dir, dir)
     }
 }
 

@@ -378,6 +378,7 @@ impl Ppm {
         self.points.resize(pixels, NO_POINT);
         self.pass_direct.clear();
         self.pass_direct.resize(pixels, DVec3::ZERO);
+        let rays = scene.camera.eye_rays();
         self.points
             .par_iter_mut()
             .zip(self.pass_direct.par_iter_mut())
@@ -398,8 +399,7 @@ impl Ppm {
                 };
                 *direct = trace_eye(
                     scene,
-                    px,
-                    lens,
+                    &rays.ray(px, lens),
                     i as u32,
                     Branching::Choose,
                     direct_light,
@@ -423,6 +423,7 @@ impl Ppm {
         let (direct_light, seed) = (self.direct_light, self.seed);
         let interrupt = self.interrupt.as_deref();
         let skipped = std::sync::atomic::AtomicBool::new(false);
+        let rays = scene.camera.eye_rays();
         let rows: Vec<(Vec<DVec3>, Vec<VisiblePoint>)> = (0..h)
             .into_par_iter()
             .map(|y| {
@@ -437,8 +438,7 @@ impl Ppm {
                     let px = Scene::pixel_center(x as u32, y as u32);
                     direct.push(trace_eye(
                         scene,
-                        px,
-                        DVec2::ZERO,
+                        &rays.ray(px, DVec2::ZERO),
                         i as u32,
                         Branching::Split,
                         direct_light,

@@ -48,13 +48,11 @@ struct EyeOut<'a> {
     direct: DVec3,
 }
 
-/// Traces the eye ray for `pixel` (pixel coordinates) through `lens` (unit disk), handing each
-/// visible point, tagged with `slot`, to `points`; returns the light seen directly.
-#[allow(clippy::too_many_arguments)]
+/// Traces the eye ray `ray` (of a pixel), handing each visible point, tagged with `slot`, to
+/// `points`; returns the light seen directly.
 pub fn trace_eye(
     scene: &Scene,
-    pixel: DVec2,
-    lens: DVec2,
+    ray: &Ray,
     slot: u32,
     branching: Branching,
     direct_light: bool,
@@ -71,7 +69,7 @@ pub fn trace_eye(
         branching,
         direct_light,
     };
-    walk.walk(&scene.camera.ray(pixel, lens), DVec3::ONE, 0, rng, &mut out);
+    walk.walk(ray, DVec3::ONE, 0, rng, &mut out);
     out.direct
 }
 
