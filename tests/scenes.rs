@@ -29,6 +29,7 @@ fn every_shipped_scene_loads_and_renders() {
     names.sort();
     let expected = [
         "cornell",
+        "glass_teapot",
         "hairpin",
         "inline_patch",
         "leaf",

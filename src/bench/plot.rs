@@ -87,6 +87,9 @@ pub struct Frame<'a> {
     pub y: &'a str,
     /// Vertical marker lines: legend text and x position.
     pub markers: Vec<(String, f64)>,
+    /// Put the legend in the lower left corner (where falling error curves leave room)
+    /// instead of the upper right.
+    pub legend_lower_left: bool,
 }
 
 /// Draws RMSE against seconds, both axes logarithmic, one line per curve with its fitted slope
@@ -108,6 +111,7 @@ pub fn draw(curves: &[Curve], title: &str) -> Result<Vec<u8>, String> {
         x: "seconds",
         y: "RMSE against the reference",
         markers: Vec::new(),
+        legend_lower_left: true,
     };
     draw_series(&series, &frame)
 }
@@ -188,7 +192,11 @@ pub fn draw_series(series: &[Series], frame: &Frame) -> Result<Vec<u8>, String> 
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
             .label_font(("sans-serif", 15))
-            .position(SeriesLabelPosition::UpperRight)
+            .position(if frame.legend_lower_left {
+                SeriesLabelPosition::LowerLeft
+            } else {
+                SeriesLabelPosition::UpperRight
+            })
             .draw()
             .map_err(|e| err(&e))?;
         root.present().map_err(|e| err(&e))?;

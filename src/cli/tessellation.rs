@@ -196,6 +196,7 @@ pub fn bench_tessellation(args: TessellationArgs, out: &mut BenchOutput) -> Resu
                     .filter(|r| r.segments.is_none())
                     .map(|r| (marker_label(r), r.render_secs))
                     .collect(),
+                legend_lower_left: false,
             },
         )
         .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;

@@ -43,6 +43,11 @@ const PRIOR_PHOTONS: f64 = 16.0;
 const MIN_PHOTONS: u64 = 4 * BINS as u64;
 /// The largest gain the photons per pass are divided by.
 pub const MAX_GAIN: f64 = 64.0;
+/// A light's learned density is used only when it gains at least this much: below, as in a
+/// closed room where nearly every photon lands in view, reshaping the emission buys little and
+/// costs time (guided photons reach more points, each a deposit). Measured in the Cornell box
+/// (gain ≈ 1.2): 85 guided passes against 94 unguided in 20 s, RMSE 5.5e-2 against 5.3e-2.
+pub const MIN_GAIN: f64 = 1.5;
 
 /// Emitted and useful photons per light and bin, for one chunk or one pass.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -224,7 +229,8 @@ impl Density2D {
     /// a bin and starve the rest of what the camera sees, since every visible point's photon
     /// density follows the density of the bin its light comes through. The weights are
     /// normalised and mixed with [`UNIFORM_SHARE`] of the uniform density. `None` while too
-    /// few photons were emitted or none was useful.
+    /// few photons were emitted or none was useful, and when the density would gain less
+    /// than [`MIN_GAIN`].
     fn learned(emitted: &[u64], useful: &[u64]) -> Option<Self> {
         let total: u64 = emitted.iter().sum();
         let total_useful: u64 = useful.iter().sum();
@@ -251,7 +257,7 @@ impl Density2D {
         let mut density = Self::from_probabilities(&p);
         density.uniform_share = sum / BINS as f64;
         density.guided_share = p.iter().zip(&share).map(|(p, s)| p * s).sum();
-        Some(density)
+        (density.guided_share >= MIN_GAIN * density.uniform_share).then_some(density)
     }
 
     /// The density with bin probabilities `p` (summing to 1, all positive).
@@ -375,12 +381,17 @@ mod tests {
     }
 
     #[test]
-    fn nothing_is_learned_from_too_few_or_no_useful_photons() {
+    fn nothing_is_learned_from_too_few_useful_photons_or_for_too_little_gain() {
         assert!(Density2D::learned(&[1; BINS], &[1; BINS]).is_none());
         assert!(Density2D::learned(&[100; BINS], &[0; BINS]).is_none());
-        let uniform = Density2D::learned(&[100; BINS], &[7; BINS]).expect("learned");
-        assert!(uniform.pdf.iter().all(|p| (p - 1.0).abs() < 1e-12));
-        assert!((uniform.guided_share / uniform.uniform_share - 1.0).abs() < 1e-12);
+        // Every direction as useful: nothing to gain, uniform emission.
+        assert!(Density2D::learned(&[100; BINS], &[7; BINS]).is_none());
+        // Half the directions useful: a gain of about 1.6 (82 % of the photons to them).
+        let mut useful = vec![0u64; BINS];
+        useful[..BINS / 2].fill(500);
+        let half = Density2D::learned(&[1000; BINS], &useful).expect("learned");
+        let gain = half.guided_share / half.uniform_share;
+        assert!(gain > MIN_GAIN && gain < 1.8, "gain {gain}");
     }
 
     #[test]
