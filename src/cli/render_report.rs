@@ -194,7 +194,7 @@ fn print_text(out: &Path, image: &Image, renderer: &RendererSummary, guided: boo
             println!(
                 "  photons that reached a visible point: {:.1} %{}",
                 100.0 * s.useful_paths as f64 / s.photons.max(1) as f64,
-                if guided { " (emission guided)" } else { "" }
+                if guided { " (guided emission on)" } else { "" }
             );
             println!(
                 "  time: eye passes {:.3} s ({} of them), area-light sampling {:.3} s, index builds {:.3} s, photons {:.3} s",

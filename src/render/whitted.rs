@@ -57,8 +57,7 @@ impl Tracer<'_> {
     /// The first pass's colour of pixel `(x, y)` and its path/shadow hash: one centre ray,
     /// or every lens sample (stratified) when the aperture is open.
     fn first_sample(&self, x: u32, y: u32, rays: &AtomicUsize) -> (DVec3, u64) {
-        let (scene, camera) = (self.scene, &self.scene.camera);
-        let eye = &self.eye_rays;
+        let (scene, camera, eye) = (self.scene, &self.scene.camera, &self.eye_rays);
         let index = (y as u64) * camera.width as u64 + x as u64;
         let mut rng = stream_rng(scene.params.seed, streams::WHITTED_PIXEL, index);
         if camera.aperture > 0.0 {
@@ -85,6 +84,7 @@ impl Tracer<'_> {
 
     /// The mean of a 4×4 grid of rays over pixel `i` = `(x, y)` (edge anti-aliasing).
     fn edge_samples(&self, i: usize, x: i64, y: i64) -> DVec3 {
+        let eye = &self.eye_rays;
         let mut rng = stream_rng(self.scene.params.seed, streams::WHITTED_EDGE, i as u64);
         let mut sum = DVec3::ZERO;
         for sy in 0..4 {
@@ -94,7 +94,7 @@ impl Tracer<'_> {
                     y as f64 + (sy as f64 + 0.5) / 4.0,
                 );
                 let mut state = PathState { id: 0, rng: &mut rng };
-                sum += self.trace(&self.eye_rays.ray(px, DVec2::ZERO), 0, &mut state);
+                sum += self.trace(&eye.ray(px, DVec2::ZERO), 0, &mut state);
             }
         }
         sum / 16.0

@@ -6,8 +6,8 @@
 //! visibility"). Instead of their Markov chain, every light keeps a learned importance map in
 //! the spirit of Peter & Pietrek 1998 ("Importance driven construction of photon maps"): a
 //! 32×32 histogram over the two random numbers that choose where the light's photons go (the
-//! direction of point and spot lights, the point on a sphere light — whose cosine lobe then
-//! follows its normal — and the direction of a quad light). Each bin's share of useful
+//! direction of point, spot and sphere lights — a sphere light picks its direction first — and
+//! of a quad light). Each bin's share of useful
 //! photons, counted over all completed passes, becomes a piecewise-constant density over that
 //! pair (sampled by inverting its marginal and conditional distributions, as pbrt-v4's
 //! `PiecewiseConstant2D`), mixed with a uniform share so that every direction keeps a non-zero
@@ -98,7 +98,8 @@ struct LightGuide {
     pair: usize,
     emitted: Vec<u64>,
     useful: Vec<u64>,
-    /// `None` until enough photons were seen (and while none was useful): uniform.
+    /// `None` (uniform emission) until enough photons were seen, while none was useful, and
+    /// while the density would gain less than [`MIN_GAIN`].
     density: Option<Density2D>,
 }
 
@@ -188,14 +189,6 @@ impl EmissionGuide {
             1.0
         }
     }
-
-    /// The density of light `light`'s guided pair at `(x, y)` (1: uniform).
-    pub fn pdf(&self, light: usize, x: f64, y: f64) -> f64 {
-        self.lights[light]
-            .density
-            .as_ref()
-            .map_or(1.0, |d| d.pdf[bin_of(x, y) as usize])
-    }
 }
 
 /// The bin of a point of the unit square.
@@ -254,14 +247,15 @@ impl Density2D {
             .iter()
             .map(|w| (1.0 - UNIFORM_SHARE) * w / weights + UNIFORM_SHARE / BINS as f64)
             .collect();
-        let mut density = Self::from_probabilities(&p);
-        density.uniform_share = sum / BINS as f64;
-        density.guided_share = p.iter().zip(&share).map(|(p, s)| p * s).sum();
-        (density.guided_share >= MIN_GAIN * density.uniform_share).then_some(density)
+        let uniform_share = sum / BINS as f64;
+        let guided_share: f64 = p.iter().zip(&share).map(|(p, s)| p * s).sum();
+        (guided_share >= MIN_GAIN * uniform_share)
+            .then(|| Self::from_probabilities(&p, uniform_share, guided_share))
     }
 
-    /// The density with bin probabilities `p` (summing to 1, all positive).
-    fn from_probabilities(p: &[f64]) -> Self {
+    /// The density with bin probabilities `p` (summing to 1, all positive) and the useful
+    /// shares it was built for.
+    fn from_probabilities(p: &[f64], uniform_share: f64, guided_share: f64) -> Self {
         let n = RESOLUTION;
         let columns: Vec<f64> = p.chunks(n).map(|c| c.iter().sum()).collect();
         let total: f64 = columns.iter().sum();
@@ -286,8 +280,8 @@ impl Density2D {
             pdf: p.iter().map(|q| q / total * BINS as f64).collect(),
             marginal,
             conditional,
-            uniform_share: 1.0,
-            guided_share: 1.0,
+            uniform_share,
+            guided_share,
         }
     }
 
