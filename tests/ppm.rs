@@ -179,7 +179,7 @@ material = "black"
     for i in 0..n {
         let mut rng = stream_rng(7, 99, i);
         let before = counts.bounces;
-        source.trace(&mut rng, &mut counts, &mut |_, _, flux| total += flux);
+        source.trace(&mut rng, &mut counts, &mut |_, _, flux, _| total += flux);
         through_glass += u64::from(counts.bounces - before > 1);
     }
     let ratio = total.x / (100.0 * n as f64);
@@ -632,6 +632,89 @@ fn a_sphere_light_lights_like_a_point_light_of_equal_power() {
     );
     let [a, b] = [point, sphere].map(|scene| mean_red(&render_passes(&scene, PpmOptions::default(), 8)));
     assert!((b / a - 1.0).abs() < 0.01, "sphere / point = {}", b / a);
+}
+
+/// Stratified eye rays (the default): a sphere light seen directly, its outline crossing
+/// pixels. After 64 passes the image is much closer to a long render than with independent
+/// jitter (an outline pixel's coverage error falls nearly as 1/n, not 1/√n), and the same on
+/// average.
+#[test]
+fn stratified_eye_rays_settle_a_lights_outline_sooner() {
+    let scene = |stratified: bool, seed: u64| {
+        let mut scene = plane_lit_by(
+            "type = \"sphere\"\ncenter = [0.1, 0.6, 0.05]\nradius = 0.35\npower = 400",
+            true,
+        );
+        scene.params.antialias = true;
+        scene.params.photons_per_pass = 1000;
+        scene.params.min_photons_per_pixel = 0.0;
+        scene.params.stratified_eye_rays = stratified;
+        scene.params.seed = seed;
+        scene
+    };
+    // Another seed: other per-pixel offsets, so its error is independent of the renders'.
+    let reference = render_passes(&scene(true, 7), PpmOptions::default(), 2048);
+    let [stratified, independent] =
+        [true, false].map(|on| render_passes(&scene(on, 1), PpmOptions::default(), 64));
+    let rms = |image: &[[f32; 3]]| {
+        let sum: f64 = image
+            .iter()
+            .zip(&reference)
+            .map(|(a, b)| (a[0] as f64 - b[0] as f64).powi(2))
+            .sum();
+        (sum / image.len() as f64).sqrt()
+    };
+    let (e_stratified, e_independent) = (rms(&stratified), rms(&independent));
+    assert!(
+        e_stratified < 0.5 * e_independent,
+        "RMS error after 64 passes: stratified {e_stratified}, independent {e_independent}"
+    );
+    let mean = mean_red(&reference);
+    for (name, image) in [("stratified", &stratified), ("independent", &independent)] {
+        let ratio = mean_red(image) / mean;
+        assert!((ratio - 1.0).abs() < 0.01, "{name}: mean / reference {ratio}");
+    }
+}
+
+/// Indirect light gathered over a wider radius (the default, chosen from the first pass's
+/// photon density): sparse photons widen it, dense ones keep it, and the image is the one a
+/// single estimate for all photons converges to.
+#[test]
+fn a_wider_indirect_estimate_is_chosen_by_photon_density_and_keeps_the_image() {
+    let scale_for = |photons: u64| {
+        let mut scene = cornell_small(0.0);
+        scene.params.photons_per_pass = photons;
+        assert_eq!(scene.params.indirect_radius_scale, None, "automatic by default");
+        let mut ppm = Ppm::new(&scene, PpmOptions::default());
+        ppm.run_pass(&scene, &mut |_| Control::Continue);
+        ppm.stats().indirect_radius_scale
+    };
+    let (sparse, dense) = (scale_for(1_000), scale_for(200_000));
+    assert!(
+        sparse > 2.0 && sparse <= 4.0,
+        "1000 photons a pass: scale {sparse}"
+    );
+    assert_eq!(dense, 1.0, "200,000 photons a pass");
+
+    let render = |scale: Option<f64>| {
+        let mut scene = cornell_small(0.0);
+        // Twice cornell_small's resolution: radii half as wide, so the blur at the box's
+        // edges and corners (a disc reaching past a wall gathers less) stays small.
+        (scene.camera.width, scene.camera.height) = (80, 60);
+        scene.params.photons_per_pass = 2_000;
+        scene.params.indirect_radius_scale = scale;
+        let mut ppm = Ppm::new(&scene, PpmOptions::default());
+        for _ in 0..800 {
+            ppm.run_pass(&scene, &mut |_| Control::Continue);
+        }
+        (ppm.radiance(), ppm.stats().indirect_radius_scale)
+    };
+    let (one, k1) = render(Some(1.0));
+    let (wide, k) = render(None);
+    assert_eq!(k1, 1.0);
+    assert!(k > 1.5, "2000 photons a pass: scale {k}");
+    let ratio = mean_red(&wide) / mean_red(&one);
+    assert!((ratio - 1.0).abs() < 0.01, "wide / one estimate: {ratio}");
 }
 
 /// Irradiance at `x` (normal `n`) from a uniformly emitting parallelogram of radiance `l`, by

@@ -319,10 +319,33 @@ pub fn side_panel_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) 
         {
             p.set_auto_radius(false);
         }
+        let mut auto_indirect = p.render.indirect_radius_scale.is_none();
+        if ui
+            .checkbox(&mut auto_indirect, "Automatic indirect radius")
+            .on_hover_text("Photons that have bounced off a diffuse surface (indirect light) are gathered over a wider radius, chosen after the first pass so that each point gathers about 32 of them per pass (1× to 4× the initial radius). Changing it restarts.")
+            .changed()
+        {
+            p.set_auto_indirect_scale(auto_indirect);
+        }
+        let range = crate::render::limits::RADIUS_SCALE;
+        if ui
+            .add_enabled(
+                !auto_indirect,
+                egui::Slider::new(&mut p.manual_indirect_scale, *range.start()..=16.0)
+                    .logarithmic(true)
+                    .text("Indirect radius ×"),
+            )
+            .on_hover_text("The indirect light's initial radius over the initial radius; 1 gathers all photons in one estimate (the paper's PPM). Changing it restarts.")
+            .changed()
+        {
+            p.set_auto_indirect_scale(false);
+        }
         ui.checkbox(&mut p.render.direct_light, "Direct light by light sampling")
             .on_hover_text("Direct light from every light by shadow rays at the visible points (area lights: one sample per pass); photons carry only caustics and indirect light. Off: photons carry everything. Restarts.");
         ui.checkbox(&mut p.render.guided_emission, "Photons where the camera looks")
             .on_hover_text("Each light learns which of its photons reach what the camera sees and sends more there (weighted: the image converges to the same result). Off: lights emit as they shine. Restarts.");
+        ui.checkbox(&mut p.render.stratified_eye_rays, "Stratified eye rays")
+            .on_hover_text("When eye rays are jittered (anti-aliasing, depth of field), place each pixel's rays over passes by low-discrepancy sequences: the outlines of lights and the lens blur settle sooner. Off: independent random jitter. Restarts.");
         ui.horizontal(|ui| {
             ui.label("Index").on_hover_text("Spatial index over visible points; the image is the same, the speed differs");
             ui.selectable_value(&mut p.render.index, IndexKind::HashGrid, "Hash grid")

@@ -12,6 +12,8 @@ pub struct PanelParams {
     pub render: RenderParams,
     /// The initial radius the slider shows (used when the automatic radius is off).
     pub manual_radius: f64,
+    /// The indirect radius scale the slider shows (used when the automatic scale is off).
+    pub manual_indirect_scale: f64,
     /// Lens radius (0 = pinhole).
     pub aperture: f64,
     /// Distance to the plane in focus.
@@ -50,6 +52,7 @@ impl PanelParams {
                 .params
                 .initial_radius
                 .unwrap_or(Ranges::for_scene(scene).default_radius()),
+            manual_indirect_scale: scene.params.indirect_radius_scale.unwrap_or(2.0),
             aperture: scene.camera.aperture,
             focal_distance: scene.camera.focal_distance,
             paused: false,
@@ -64,6 +67,11 @@ impl PanelParams {
     /// Switches the automatic initial radius on or off (off: the slider's value).
     pub fn set_auto_radius(&mut self, auto: bool) {
         self.render.initial_radius = (!auto).then_some(self.manual_radius);
+    }
+
+    /// Switches the automatic indirect radius scale on or off (off: the slider's value).
+    pub fn set_auto_indirect_scale(&mut self, auto: bool) {
+        self.render.indirect_radius_scale = (!auto).then_some(self.manual_indirect_scale);
     }
 
     /// `camera` with this lens.

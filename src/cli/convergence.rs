@@ -21,15 +21,20 @@ use caustic::scene::{RendererKind, Scene};
 /// A configuration measured: the scene's parameters with one thing changed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum Config {
-    /// The defaults before light sampling, balanced passes and guided emission: photons carry
-    /// all light, lights emit as they shine and a pass traces exactly the scene's photons per
-    /// pass (the baseline).
+    /// The defaults before light sampling, balanced passes, guided emission, stratified eye
+    /// rays and the wider indirect estimate: photons carry all light in one estimate, lights
+    /// emit as they shine, a pass traces exactly the scene's photons per pass and eye rays are
+    /// jittered independently (the baseline).
     PhotonsOnly,
-    /// The defaults: direct light by light sampling, guided emission, α 0.7, automatic
-    /// radius, hash grid.
+    /// The defaults: direct light by light sampling, guided emission, stratified eye rays,
+    /// an automatic wider radius for indirect light, α 0.7, automatic radius, hash grid.
     Default,
     /// The defaults with lights emitting as they shine (no guided emission).
     Unguided,
+    /// The defaults with eye rays jittered independently (no stratification over passes).
+    Unstratified,
+    /// The defaults with one estimate for all photons (no wider indirect radius).
+    OneEstimate,
     /// α = 0.5.
     #[value(name = "alpha-0.5")]
     Alpha05,
@@ -51,8 +56,10 @@ impl Config {
     fn label(self) -> &'static str {
         match self {
             Config::PhotonsOnly => "old defaults (photons only)",
-            Config::Default => "default (light sampling and guided emission)",
+            Config::Default => "new defaults",
             Config::Unguided => "default without guided emission",
+            Config::Unstratified => "default without stratified eye rays",
+            Config::OneEstimate => "default with one estimate for all photons",
             Config::Alpha05 => "alpha 0.5",
             Config::Alpha067 => "alpha 2/3",
             Config::Alpha09 => "alpha 0.9",
@@ -67,6 +74,8 @@ impl Config {
         let mut p = RenderParams {
             direct_light: true,
             guided_emission: true,
+            stratified_eye_rays: true,
+            indirect_radius_scale: None,
             ..base.clone()
         };
         match self {
@@ -74,9 +83,13 @@ impl Config {
                 p.direct_light = false;
                 p.guided_emission = false;
                 p.min_photons_per_pixel = 0.0;
+                p.stratified_eye_rays = false;
+                p.indirect_radius_scale = Some(1.0);
             }
             Config::Default => {}
             Config::Unguided => p.guided_emission = false,
+            Config::Unstratified => p.stratified_eye_rays = false,
+            Config::OneEstimate => p.indirect_radius_scale = Some(1.0),
             Config::Alpha05 => p.alpha = 0.5,
             Config::Alpha067 => p.alpha = 2.0 / 3.0,
             Config::Alpha09 => p.alpha = 0.9,
@@ -225,11 +238,14 @@ fn check(width: &u32, seconds: f64, baseline: Option<f64>, passes: u32) -> Resul
 }
 
 /// The reference: from the cache when its record matches, else rendered (another seed, the
-/// scene's own parameters) and cached.
+/// scene's own parameters but one estimate for all photons) and cached. One estimate has the
+/// narrowest radius everywhere, so the reference does not share the blur of the wider
+/// indirect estimate that the default configurations use.
 fn reference(scene: &Scene, passes: u32, dir: Option<&Path>, out: &mut BenchOutput) -> Result<Vec<[f32; 3]>> {
     let dir = dir.map_or_else(default_cache_dir, Path::to_path_buf);
     let mut reference_scene = scene.clone();
     reference_scene.params.seed ^= 0x5eed;
+    reference_scene.params.indirect_radius_scale = Some(1.0);
     let record = ReferenceRecord::new(&reference_scene, passes);
     if let Some(pixels) = record.load(&dir) {
         out.say(format!("reference: {} (cached)", record.path_in(&dir).display()));

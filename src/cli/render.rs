@@ -107,6 +107,18 @@ pub struct PpmArgs {
     #[arg(long, value_name = "on|off", action = clap::ArgAction::Set,
           value_parser = clap::builder::BoolishValueParser::new())]
     guided_emission: Option<bool>,
+    /// Photon mapping: place each pixel's eye rays over passes by low-discrepancy sequences
+    /// rather than independently at random, when they are jittered (anti-aliasing, depth of
+    /// field) (default: the scene's `stratified_eye_rays`, on unless it says otherwise).
+    #[arg(long, value_name = "on|off", action = clap::ArgAction::Set,
+          value_parser = clap::builder::BoolishValueParser::new())]
+    stratified_eye_rays: Option<bool>,
+    /// Photon mapping: initial radius of the indirect light's estimate (photons after a
+    /// diffuse bounce) as a multiple of the initial radius; 1 for one estimate of all photons
+    /// (default: the scene's `indirect_radius_scale`, or chosen from the first pass's photon
+    /// density, 1 to 4).
+    #[arg(long, value_name = "K")]
+    indirect_radius_scale: Option<f64>,
 }
 
 impl PpmArgs {
@@ -134,12 +146,19 @@ impl PpmArgs {
         if let Some(on) = self.guided_emission {
             params.guided_emission = on;
         }
+        if let Some(on) = self.stratified_eye_rays {
+            params.stratified_eye_rays = on;
+        }
+        if let Some(k) = self.indirect_radius_scale {
+            params.indirect_radius_scale = Some(k);
+        }
         params.validate().map_err(|e| {
             let flag = match e.field {
                 "photons_per_pass" => "--photons",
                 "alpha" => "--alpha",
                 "initial_radius" => "--radius",
                 "min_photons_per_pixel" => "--min-photons-per-pixel",
+                "indirect_radius_scale" => "--indirect-radius-scale",
                 field => field,
             };
             anyhow::anyhow!("{flag} {}", e.problem)

@@ -196,6 +196,12 @@ fn print_text(out: &Path, image: &Image, renderer: &RendererSummary, guided: boo
                 100.0 * s.useful_paths as f64 / s.photons.max(1) as f64,
                 if guided { " (guided emission on)" } else { "" }
             );
+            if s.indirect_radius_scale > 1.0 {
+                println!(
+                    "  indirect light gathered over {:.2}x the radius of direct light and caustics",
+                    s.indirect_radius_scale
+                );
+            }
             println!(
                 "  time: eye passes {:.3} s ({} of them), area-light sampling {:.3} s, index builds {:.3} s, photons {:.3} s",
                 s.eye_secs, s.eye_passes, s.direct_secs, s.index_secs, s.photon_secs

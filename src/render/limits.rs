@@ -14,6 +14,8 @@ pub const MAX_DEPTH: RangeInclusive<u32> = 1..=64;
 pub const SAMPLES: RangeInclusive<u32> = 1..=4096;
 /// Least photons per pixel of a stochastic pass.
 pub const PHOTONS_PER_PIXEL: RangeInclusive<f64> = 0.0..=1000.0;
+/// The indirect estimate's initial radius as a multiple of the initial radius.
+pub const RADIUS_SCALE: RangeInclusive<f64> = 1.0..=100.0;
 /// Image width and height in pixels.
 pub const IMAGE_SIDE: RangeInclusive<u32> = 1..=16384;
 
@@ -57,6 +59,11 @@ pub fn image_side(n: u32) -> Result<u32, Invalid> {
 /// A PPM initial search radius.
 pub fn radius(r: f64) -> Result<f64, Invalid> {
     positive(r, "scene units")
+}
+
+/// The indirect estimate's radius scale.
+pub fn radius_scale(k: f64) -> Result<f64, Invalid> {
+    within(k, RADIUS_SCALE, "")
 }
 
 /// The lens radius (0 is a pinhole).

@@ -1,7 +1,7 @@
 //! Renderers and what they render into: progressive photon mapping, the Whitted ray tracer,
 //! the film (linear RGB with tonemapping and PNG/EXR output, extra EXR layers), what an image
 //! records of its render ([`provenance`]), error against a reference or estimated
-//! ([`compare`], [`error`]) and deterministic random streams.
+//! ([`compare`], [`error`]), deterministic random streams and low-discrepancy sequences.
 
 pub mod compare;
 pub mod error;
@@ -11,6 +11,7 @@ pub mod params;
 pub mod ppm;
 pub mod provenance;
 pub mod rng;
+pub mod sequence;
 pub mod session;
 pub mod whitted;
 

@@ -56,6 +56,14 @@ pub struct RenderParams {
     pub alpha: f64,
     /// PPM initial radius in scene units (`None`: from the pixel footprint).
     pub initial_radius: Option<f64>,
+    /// Photon mapping: the initial radius of the estimate of photons that have bounced off a
+    /// diffuse surface (indirect light), as a multiple of the initial radius. Indirect light
+    /// varies slowly, so where photons are sparse a wider radius gathers many more of them
+    /// for little blur, while direct light and caustics keep the narrow one. `None`
+    /// (default): chosen after the first pass so that a pass hands each point about 32
+    /// indirect photons, between 1× and 4×; 1: one estimate for all photons (the paper's
+    /// PPM).
+    pub indirect_radius_scale: Option<f64>,
     /// Maximum specular bounces of eye rays and photons.
     pub max_depth: u32,
     /// Seed of every random number.
@@ -78,6 +86,13 @@ pub struct RenderParams {
     /// learned from which of its photons reached a visible point (`ppm::guide`), weighted so
     /// the image converges to the same result. On by default; off, lights emit as they shine.
     pub guided_emission: bool,
+    /// Photon mapping: each pixel's eye rays placed over passes by low-discrepancy sequences
+    /// (`render::sequence`: Sobol's over the pixel, R4 over the lens, randomised per pixel)
+    /// instead of independently at random, so the outlines of bright lights, their
+    /// reflections and the lens blur converge nearly as 1/passes rather than 1/√passes. On by
+    /// default; matters only when the eye pass is traced every pass (anti-aliasing, depth of
+    /// field).
+    pub stratified_eye_rays: bool,
     /// Photon mapping: the spatial index over visible points (the image does not depend on it).
     pub index: IndexKind,
 }
@@ -90,6 +105,7 @@ impl Default for RenderParams {
             min_photons_per_pixel: 4.0,
             alpha: 0.7,
             initial_radius: None,
+            indirect_radius_scale: None,
             max_depth: 8,
             seed: 1,
             antialias: true,
@@ -98,6 +114,7 @@ impl Default for RenderParams {
             ambient: DVec3::ZERO,
             direct_light: true,
             guided_emission: true,
+            stratified_eye_rays: true,
             index: IndexKind::HashGrid,
         }
     }
@@ -131,6 +148,9 @@ impl RenderParams {
         )?;
         if let Some(r) = self.initial_radius {
             check("initial_radius", limits::radius(r).map(drop))?;
+        }
+        if let Some(k) = self.indirect_radius_scale {
+            check("indirect_radius_scale", limits::radius_scale(k).map(drop))?;
         }
         check("max_depth", limits::max_depth(self.max_depth).map(drop))?;
         check("dof_samples", limits::samples(self.dof_samples).map(drop))?;

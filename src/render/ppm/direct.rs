@@ -4,10 +4,11 @@
 //! skip their first diffuse deposit (that is this term), so they carry only what light
 //! sampling cannot: caustics (light → specular → diffuse) and indirect light.
 //!
-//! Samples are stratified over passes: point `k` and light `l` take the R2 sequence (Roberts
-//! 2018, "The unreasonable effectiveness of quasirandom sequences") at the pass number, shifted
-//! by a random offset fixed for `(k, l)` (Cranley–Patterson rotation), so a point that persists
-//! over passes (classic PPM) sweeps its light evenly.
+//! Samples are stratified over passes: point `k` and light `l` take the low-discrepancy
+//! sequence of [`crate::render::sequence`] (R4's light pair) at the pass number, shifted by a
+//! random offset fixed for `(k, l)` (Cranley–Patterson rotation), so a point that persists
+//! over passes (classic PPM) sweeps its light evenly, and a pixel whose eye rays are
+//! stratified too (Sobol's pair, R4's lens pair) does not tie its light samples to them.
 
 use glam::{DVec2, DVec3};
 use rand::Rng;
@@ -15,17 +16,11 @@ use rayon::prelude::*;
 
 use super::visible::VisiblePoint;
 use crate::render::rng::stream_rng;
+use crate::render::sequence;
 use crate::scene::Scene;
 
 /// Random stream of the per-point offsets.
 const OFFSET_STREAM: u64 = 12;
-
-/// The R2 sequence's `n`-th point in the unit square.
-fn r2(n: u64) -> DVec2 {
-    const G: f64 = 1.324_717_957_244_746;
-    let a = DVec2::new(1.0 / G, 1.0 / (G * G));
-    (DVec2::splat(0.5) + a * n as f64).fract()
-}
 
 /// Whether the scene has lights that [`area_light_pass`] samples.
 pub fn has_area_lights(scene: &Scene) -> bool {
@@ -53,7 +48,7 @@ pub fn area_light_pass(
             for &(l, light) in &lights {
                 let mut rng = stream_rng(seed, OFFSET_STREAM, key(k) * count + l);
                 let offset = DVec2::new(rng.random(), rng.random());
-                let u = (r2(pass) + offset).fract();
+                let u = sequence::rotated(sequence::r4(pass)[1], offset);
                 let Some(ls) = light.sample(vp.position, u) else {
                     continue;
                 };
@@ -68,21 +63,4 @@ pub fn area_light_pass(
             sum
         })
         .collect()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn r2_points_are_spread_over_the_square() {
-        // Any 64 consecutive points put some in each quarter of the square.
-        let mut quarters = [0; 4];
-        for n in 100..164 {
-            let p = r2(n);
-            assert!(p.cmpge(DVec2::ZERO).all() && p.cmplt(DVec2::ONE).all());
-            quarters[(p.x >= 0.5) as usize * 2 + (p.y >= 0.5) as usize] += 1;
-        }
-        assert!(quarters.iter().all(|&q| (12..=20).contains(&q)), "{quarters:?}");
-    }
 }

@@ -39,6 +39,7 @@ use photon::{PhotonCounts, PhotonSource};
 use visible::{trace_eye, Branching, VisiblePoint};
 
 use super::rng::stream_rng;
+use super::sequence;
 use crate::scene::camera::concentric_disk;
 use crate::scene::Scene;
 
@@ -46,7 +47,27 @@ use crate::scene::Scene;
 mod streams {
     pub const EYE: u64 = 10;
     pub const PHOTON: u64 = 11;
+    /// Each pixel's fixed offsets of its eye-ray sequences (12 is `direct`'s).
+    pub const EYE_OFFSETS: u64 = 13;
 }
+
+/// How the indirect estimate's radius is chosen ([`RenderParams::indirect_radius_scale`]).
+///
+/// [`RenderParams::indirect_radius_scale`]: crate::render::params::RenderParams::indirect_radius_scale
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum IndirectScale {
+    /// One estimate for all photons.
+    Off,
+    /// From the first pass's photon density ([`Ppm::widen_indirect`]).
+    Automatic,
+    /// This multiple of the initial radius.
+    Fixed(f64),
+}
+
+/// Indirect photons an automatic indirect radius aims to hand each point per pass.
+const INDIRECT_PHOTONS: f64 = 32.0;
+/// The widest automatic indirect radius, over the initial radius.
+const MAX_INDIRECT_SCALE: f64 = 4.0;
 
 /// Photons per chunk: the unit of parallel work and of deterministic reduction.
 const CHUNK: u64 = 4096;
@@ -60,6 +81,9 @@ const MAX_CHUNK_DEPOSITS: usize = 1 << 20;
 
 /// Flux handed to a statistics slot: `(slot, flux × point weight, photon count)`.
 type Deposit = (u32, DVec3, u32);
+
+/// A visible point's position and its estimates' radii², packed for the candidate test.
+type Reach = [f64; 5];
 
 /// What one chunk of photons left: its deposits, counts and guide tally.
 type ChunkResult = (Vec<Deposit>, PhotonCounts, Option<GuideTally>);
@@ -148,11 +172,10 @@ const NO_POINT: VisiblePoint = VisiblePoint {
     radius2: 0.0,
 };
 
-/// Accumulated statistics of one gathering point (classic PPM) or pixel (stochastic PPM).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Slot {
-    /// The pixel it contributes to.
-    pub pixel: u32,
+/// One progressive density estimate (Hachisuka et al. 2008 §4): search radius², photon
+/// count `N` and flux `τ`, updated after every pass.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Estimate {
     /// Search radius².
     pub radius2: f64,
     /// Accumulated photon count `N`.
@@ -161,19 +184,64 @@ pub struct Slot {
     pub tau: DVec3,
 }
 
-impl Slot {
-    /// An empty slot of `pixel` (its radius is set before the first pass).
-    fn new(pixel: u32) -> Self {
-        Self {
-            pixel,
-            radius2: 0.0,
-            n: 0.0,
-            tau: DVec3::ZERO,
+impl Estimate {
+    /// Folds in a pass that brought `m` photons of flux `phi` within the radius (eqs. 6–11):
+    /// the radius shrinks so that a share α of the new photons is kept.
+    fn update(&mut self, phi: DVec3, m: u32, alpha: f64) {
+        let m = m as f64;
+        if m > 0.0 {
+            let g = (self.n + alpha * m) / (self.n + m);
+            self.radius2 *= g;
+            self.tau = (self.tau + phi) * g;
+            self.n += alpha * m;
+        }
+    }
+
+    /// Reflected radiance `τ/(π R² N_emitted)`.
+    fn radiance(&self, emitted: f64) -> DVec3 {
+        if self.radius2 > 0.0 {
+            self.tau / (PI * self.radius2 * emitted)
+        } else {
+            DVec3::ZERO
         }
     }
 }
 
-/// What one pass's photons left: flux `Φ` and photon count `M` per slot, and counts.
+/// Accumulated statistics of one gathering point (classic PPM) or pixel (stochastic PPM): two
+/// estimates, since photons that have bounced off a diffuse surface carry light that varies
+/// slowly and are gathered over a wider radius ([`RenderParams::indirect_radius_scale`]).
+///
+/// [`RenderParams::indirect_radius_scale`]: crate::render::params::RenderParams::indirect_radius_scale
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Slot {
+    /// The pixel it contributes to.
+    pub pixel: u32,
+    /// Photons straight from a light or through mirrors and glass only: direct light (when
+    /// light sampling is off) and caustics — every photon when one estimate is kept
+    /// (`indirect_radius_scale = 1`).
+    pub primary: Estimate,
+    /// Photons after a diffuse bounce (indirect light), when the scale is above 1.
+    pub indirect: Estimate,
+}
+
+impl Slot {
+    /// An empty slot of `pixel` (its radii are set before the first pass).
+    fn new(pixel: u32) -> Self {
+        Self {
+            pixel,
+            primary: Estimate::default(),
+            indirect: Estimate::default(),
+        }
+    }
+
+    /// The larger search radius², which the spatial index must reach.
+    fn reach2(&self) -> f64 {
+        self.primary.radius2.max(self.indirect.radius2)
+    }
+}
+
+/// What one pass's photons left: flux `Φ` and photon count `M` per slot and estimate (index
+/// `2 × slot + estimate`, 0 primary, 1 indirect), and counts.
 struct Gathered {
     phi: Vec<DVec3>,
     m: Vec<u32>,
@@ -200,6 +268,9 @@ pub struct PpmStats {
     pub visible_points: usize,
     /// Mean search radius over slots that have gathered photons (scene units).
     pub mean_radius: f64,
+    /// The indirect estimate's initial radius over the primary's (1: one estimate for all
+    /// photons; chosen after the first pass when automatic).
+    pub indirect_radius_scale: f64,
     /// Seconds spent in completed passes.
     pub elapsed_secs: f64,
     /// Seconds spent tracing photons.
@@ -243,6 +314,10 @@ pub struct Ppm {
     /// The spatial index (from the render parameters).
     index: IndexKind,
     stochastic: bool,
+    /// Eye rays placed by low-discrepancy sequences over passes (from the render parameters).
+    stratified_eye_rays: bool,
+    /// How the indirect estimate's radius is chosen (from the render parameters).
+    indirect_scale: IndirectScale,
     /// α for the next update.
     pub alpha: f64,
     /// Photons per pass from the next pass on.
@@ -307,6 +382,12 @@ impl Ppm {
             direct_light: scene.params.direct_light,
             index: scene.params.index,
             stochastic,
+            stratified_eye_rays: scene.params.stratified_eye_rays,
+            indirect_scale: match scene.params.indirect_radius_scale {
+                None => IndirectScale::Automatic,
+                Some(k) if k > 1.0 => IndirectScale::Fixed(k),
+                Some(_) => IndirectScale::Off,
+            },
             alpha: scene.params.alpha,
             photons_per_pass: scene
                 .params
@@ -371,6 +452,9 @@ impl Ppm {
         let (w, h) = (self.width as u64, self.height as u64);
         let pass = self.stats.passes as u64;
         let (direct_light, seed) = (self.direct_light, self.seed);
+        let sequences = self
+            .stratified_eye_rays
+            .then(|| (sequence::r4(pass)[0], sequence::golden(pass)));
         let interrupt = self.interrupt.as_deref();
         let skipped = std::sync::atomic::AtomicBool::new(false);
         let pixels = (w * h) as usize;
@@ -391,8 +475,24 @@ impl Ppm {
                 let i = i as u64;
                 let (x, y) = (i % w, i / w);
                 let mut rng = stream_rng(seed, streams::EYE, pass * w * h + i);
-                let px = DVec2::new(x as f64 + rng.random::<f64>(), y as f64 + rng.random::<f64>());
-                let lens = concentric_disk(DVec2::new(rng.random(), rng.random()));
+                let (jitter, lens, first) = match sequences {
+                    // This pixel's shift and offsets, the same every pass (its own stream, so
+                    // the path's other random numbers stay as they were).
+                    Some((lens, choice)) => {
+                        let mut offsets = stream_rng(seed, streams::EYE_OFFSETS, i);
+                        let jitter = sequence::sobol(pass, offsets.random());
+                        let offset = DVec2::new(offsets.random(), offsets.random());
+                        let first = sequence::rotated_1d(choice, offsets.random());
+                        (jitter, sequence::rotated(lens, offset), Some(first))
+                    }
+                    None => (
+                        DVec2::new(rng.random(), rng.random()),
+                        DVec2::new(rng.random(), rng.random()),
+                        None,
+                    ),
+                };
+                let px = DVec2::new(x as f64, y as f64) + jitter;
+                let lens = concentric_disk(lens);
                 let mut sink = |vp: VisiblePoint| {
                     debug_assert!(point.slot == NO_POINT.slot, "a chosen path ends once");
                     *point = vp;
@@ -401,7 +501,7 @@ impl Ppm {
                     scene,
                     &rays.ray(px, lens),
                     i as u32,
-                    Branching::Choose,
+                    Branching::Choose { first },
                     direct_light,
                     &mut rng,
                     &mut sink,
@@ -487,16 +587,23 @@ impl Ppm {
                 self.slots.push(Slot::new(pixel));
             }
         }
-        if self.stats.passes == 0 && self.slots.iter().all(|s| s.radius2 == 0.0) {
+        if self.stats.passes == 0 && self.slots.iter().all(|s| s.primary.radius2 == 0.0) {
             let r0 = self
                 .initial_radius
                 .unwrap_or_else(|| self.automatic_radius(scene));
+            let indirect = match self.indirect_scale {
+                IndirectScale::Off => 0.0,
+                // The first pass measures the photon density; `update` widens it after.
+                IndirectScale::Automatic => r0,
+                IndirectScale::Fixed(k) => k * r0,
+            };
             for s in &mut self.slots {
-                s.radius2 = r0 * r0;
+                s.primary.radius2 = r0 * r0;
+                s.indirect.radius2 = indirect * indirect;
             }
         }
         for vp in &mut self.points {
-            vp.radius2 = self.slots[vp.slot as usize].radius2;
+            vp.radius2 = self.slots[vp.slot as usize].reach2();
         }
         true
     }
@@ -510,7 +617,7 @@ impl Ppm {
         if !ppm.eye_pass(&scene) {
             return 1e-3;
         }
-        ppm.slots.first().map_or(1e-3, |s| s.radius2.sqrt())
+        ppm.slots.first().map_or(1e-3, |s| s.primary.radius2.sqrt())
     }
 
     /// The automatic initial radius: twice the footprint of one pixel at the median distance
@@ -545,7 +652,7 @@ impl Ppm {
             }
         } else {
             for vp in &mut self.points {
-                vp.radius2 = self.slots[vp.slot as usize].radius2;
+                vp.radius2 = self.slots[vp.slot as usize].reach2();
             }
         }
         let index_start = Instant::now();
@@ -578,15 +685,19 @@ impl Ppm {
         control: &mut dyn FnMut(&mut f64) -> Control,
     ) -> Option<Gathered> {
         let source = PhotonSource::new(scene, self.direct_light).with_guide(self.guide.as_ref());
-        // Positions and radii packed tightly: the candidate test reads nothing else.
-        let reach: Vec<[f64; 4]> = self
+        // Positions and both radii packed tightly: the candidate test reads nothing else.
+        let reach: Vec<Reach> = self
             .points
             .iter()
-            .map(|v| [v.position.x, v.position.y, v.position.z, v.radius2])
+            .map(|v| {
+                let s = &self.slots[v.slot as usize];
+                let p = v.position;
+                [p.x, p.y, p.z, s.primary.radius2, s.indirect.radius2]
+            })
             .collect();
         let mut out = Gathered {
-            phi: vec![DVec3::ZERO; self.slots.len()],
-            m: vec![0u32; self.slots.len()],
+            phi: vec![DVec3::ZERO; 2 * self.slots.len()],
+            m: vec![0u32; 2 * self.slots.len()],
             counts: PhotonCounts::default(),
             tally: self.guide.as_ref().map(EmissionGuide::tally),
         };
@@ -640,25 +751,27 @@ impl Ppm {
         c: u64,
         source: &PhotonSource,
         index: &SpatialIndex,
-        reach: &[[f64; 4]],
+        reach: &[Reach],
     ) -> ChunkResult {
         let mut deposits: Vec<Deposit> = Vec::new();
         let mut counts = PhotonCounts::default();
         let mut tally = self.guide.as_ref().map(EmissionGuide::tally);
         let (photons, first_photon) = (self.pass_photons, self.stats.photons);
         let points = &self.points;
+        let split = self.indirect_scale != IndirectScale::Off;
         for i in c * CHUNK..((c + 1) * CHUNK).min(photons) {
             let mut rng = stream_rng(self.seed, streams::PHOTON, first_photon + i);
             let mut useful = false;
-            let from = source.trace(&mut rng, &mut counts, &mut |p, n, flux| {
+            let from = source.trace(&mut rng, &mut counts, &mut |p, n, flux, indirect| {
                 // Hand the flux to every visible point on this side of the surface whose
-                // search sphere holds the photon.
+                // search sphere (of the photon's estimate) holds the photon.
+                let estimate = usize::from(indirect && split);
                 index.for_candidates(points, p, &mut |k| {
-                    let [x, y, z, r2] = reach[k as usize];
-                    if (DVec3::new(x, y, z) - p).length_squared() <= r2 {
+                    let r = &reach[k as usize];
+                    if (DVec3::new(r[0], r[1], r[2]) - p).length_squared() <= r[3 + estimate] {
                         let vp = &points[k as usize];
                         if vp.normal.dot(n) > 1e-3 {
-                            deposits.push((vp.slot, vp.weight * flux, 1));
+                            deposits.push((2 * vp.slot + estimate as u32, vp.weight * flux, 1));
                             useful = true;
                         }
                     }
@@ -689,13 +802,11 @@ impl Ppm {
         // Compute new photon counts, radii and flux (Hachisuka et al. 2008, eqs. 6–11).
         let alpha = self.alpha;
         for (k, s) in self.slots.iter_mut().enumerate() {
-            let mk = m[k] as f64;
-            if mk > 0.0 {
-                let g = (s.n + alpha * mk) / (s.n + mk);
-                s.radius2 *= g;
-                s.tau = (s.tau + phi[k]) * g;
-                s.n += alpha * mk;
-            }
+            s.primary.update(phi[2 * k], m[2 * k], alpha);
+            s.indirect.update(phi[2 * k + 1], m[2 * k + 1], alpha);
+        }
+        if self.indirect_scale == IndirectScale::Automatic && self.stats.passes == 0 {
+            self.widen_indirect(&m);
         }
         if self.stochastic {
             for (d, p) in self.direct.iter_mut().zip(self.pass_direct.drain(..)) {
@@ -704,6 +815,10 @@ impl Ppm {
             self.stats.eye_passes += 1;
         }
         self.stats.passes += 1;
+        self.stats.indirect_radius_scale = match self.indirect_scale {
+            IndirectScale::Fixed(k) => k,
+            _ => 1.0,
+        };
         self.stats.photons += self.pass_photons;
         self.stats.bounces += counts.bounces;
         self.stats.deposits += counts.deposits;
@@ -712,10 +827,30 @@ impl Ppm {
         let gathered: Vec<f64> = self
             .slots
             .iter()
-            .filter(|s| s.n > 0.0)
-            .map(|s| s.radius2.sqrt())
+            .filter(|s| s.primary.n > 0.0)
+            .map(|s| s.primary.radius2.sqrt())
             .collect();
         self.stats.mean_radius = gathered.iter().sum::<f64>() / gathered.len().max(1) as f64;
+    }
+
+    /// After the first pass of an automatic indirect radius: widens every slot's indirect
+    /// estimate by `k = √(INDIRECT_PHOTONS / m̄)`, clamped to [1, MAX_INDIRECT_SCALE], where m̄
+    /// is the mean number of indirect photons a slot gathered in that pass — so that a pass
+    /// hands each point about `INDIRECT_PHOTONS` of them. Where photons are dense (small
+    /// closed rooms) the radius stays, where they are sparse it grows. The estimate is
+    /// scaled as PPM's update assumes, for a density uniform within the radius: N and τ by
+    /// the area. Counts are deterministic, so is `k`.
+    fn widen_indirect(&mut self, m: &[u32]) {
+        let slots = self.slots.len().max(1) as f64;
+        let mean = m.iter().skip(1).step_by(2).map(|&c| c as f64).sum::<f64>() / slots;
+        let k = (INDIRECT_PHOTONS / mean).sqrt().clamp(1.0, MAX_INDIRECT_SCALE);
+        let area = k * k;
+        for s in &mut self.slots {
+            s.indirect.radius2 *= area;
+            s.indirect.n *= area;
+            s.indirect.tau *= area;
+        }
+        self.indirect_scale = IndirectScale::Fixed(k);
     }
 
     /// Adds one light sample of every area light at each visible point of this pass to the
@@ -746,9 +881,7 @@ impl Ppm {
         if self.stats.photons > 0 {
             let emitted = self.stats.photons as f64;
             for s in &self.slots {
-                if s.radius2 > 0.0 {
-                    out[s.pixel as usize] += s.tau / (PI * s.radius2 * emitted);
-                }
+                out[s.pixel as usize] += s.primary.radiance(emitted) + s.indirect.radiance(emitted);
             }
         }
         let eye = self.stats.eye_passes.max(1) as f64;

@@ -104,13 +104,15 @@ impl<'a> PhotonSource<'a> {
 
     /// Traces one photon path with `rng`. At every diffuse hit whose flux should be gathered
     /// (all but direct hits when direct light is computed by light sampling),
-    /// calls `gather(point, normal facing the photon, flux)`. Returns where the photon came
-    /// from.
+    /// calls `gather(point, normal facing the photon, flux, indirect)`, `indirect` telling
+    /// whether the photon has bounced off a diffuse surface before (indirect light) or came
+    /// straight from the light or through mirrors and glass only (direct light, caustics).
+    /// Returns where the photon came from.
     pub fn trace(
         &self,
         rng: &mut Pcg64Mcg,
         counts: &mut PhotonCounts,
-        gather: &mut impl FnMut(DVec3, DVec3, DVec3),
+        gather: &mut impl FnMut(DVec3, DVec3, DVec3, bool),
     ) -> Emitted {
         let scene = self.scene;
         let pick: f64 = rng.random();
@@ -132,6 +134,7 @@ impl<'a> PhotonSource<'a> {
         let skip_first = self.skip_direct;
         counts.paths += 1;
         let mut first_interaction = true;
+        let mut indirect = false;
         for _depth in 0..scene.params.max_depth.max(1) * 4 {
             let Some(hit) = scene.geometry.intersect(&ray, f64::INFINITY) else {
                 return emitted;
@@ -145,8 +148,9 @@ impl<'a> PhotonSource<'a> {
             match surface.material.kind {
                 MaterialKind::Diffuse { .. } => {
                     if !(skip_first && first_interaction) {
-                        gather(hit.point, n, flux);
+                        gather(hit.point, n, flux, indirect);
                     }
+                    indirect = true;
                     // Russian roulette on the albedo, then a cosine-distributed bounce.
                     let survive = color.max_element();
                     if survive <= 0.0 || rng.random::<f64>() >= survive {

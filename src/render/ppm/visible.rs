@@ -30,14 +30,19 @@ pub struct VisiblePoint {
 }
 
 /// How the eye pass treats glass.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Branching {
     /// Follow both the reflected and the refracted ray, weighted by Fresnel (classic PPM:
     /// the eye pass runs once, so every branch must be kept).
     Split,
     /// Follow one, chosen with the Fresnel probability (stochastic PPM: a new eye pass each
-    /// pass averages the choices).
-    Choose,
+    /// pass averages the choices). `first`, when given, is the uniform number in [0, 1) that
+    /// decides the path's first choice (stratified over passes, so a light seen in glass
+    /// settles sooner); later choices are random.
+    Choose {
+        /// The first choice's number (`None`: random).
+        first: Option<f64>,
+    },
 }
 
 /// Where one eye path's outputs go: its visible points (0, 1, or several with
@@ -46,6 +51,8 @@ pub enum Branching {
 struct EyeOut<'a> {
     points: &'a mut dyn FnMut(VisiblePoint),
     direct: DVec3,
+    /// The number for the next glass choice, used once (see [`Branching::Choose`]).
+    first_choice: Option<f64>,
 }
 
 /// Traces the eye ray `ray` (of a pixel), handing each visible point, tagged with `slot`, to
@@ -62,6 +69,10 @@ pub fn trace_eye(
     let mut out = EyeOut {
         points,
         direct: DVec3::ZERO,
+        first_choice: match branching {
+            Branching::Choose { first } => first,
+            Branching::Split => None,
+        },
     };
     let walk = EyeWalk {
         scene,
@@ -142,8 +153,9 @@ impl EyeWalk<'_> {
                         self.walk(&reflected, throughput * fresnel, depth + 1, rng, out);
                         self.walk(&t, throughput * (1.0 - fresnel) * color, depth + 1, rng, out);
                     }
-                    (Branching::Choose, Some(t)) => {
-                        if rng.random::<f64>() < fresnel {
+                    (Branching::Choose { .. }, Some(t)) => {
+                        let u = out.first_choice.take().unwrap_or_else(|| rng.random());
+                        if u < fresnel {
                             self.walk(&reflected, throughput, depth + 1, rng, out);
                         } else {
                             self.walk(&t, throughput * color, depth + 1, rng, out);
