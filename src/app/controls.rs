@@ -449,6 +449,11 @@ fn statistics_ui(viewer: &Viewer, ui: &mut egui::Ui) {
                     ),
                     "Share of the photons that handed light to at least one visible point (guided emission raises it)",
                 );
+                row(
+                    "Indirect radius",
+                    format!("{:.2}x", stats.indirect_radius_scale),
+                    "The indirect light's initial radius over the initial radius (1: one estimate for all photons)",
+                );
             }
             row(
                 "Elapsed",

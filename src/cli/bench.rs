@@ -54,6 +54,11 @@ pub enum BenchCommand {
         /// Thread counts to measure.
         #[arg(long, value_delimiter = ',', default_value = "1,2")]
         threads: Vec<usize>,
+        /// The indirect estimate's radius scale (default: the scene's, automatic unless it
+        /// says otherwise); 1 gathers every photon in one estimate, as smallppm does, so the
+        /// paths per second compare with smallppm's.
+        #[arg(long, value_name = "K")]
+        indirect_radius_scale: Option<f64>,
     },
     /// Photon mapping: error against wall time for several configurations (old and new
     /// defaults, α, initial radius, index) against a long reference render, cached on disk.
@@ -139,7 +144,15 @@ pub fn bench(what: BenchCommand, json: bool) -> Result<()> {
             photons,
             passes,
             threads,
-        } => bench_ppm(scene.as_deref(), photons, passes, &threads, &mut out),
+            indirect_radius_scale,
+        } => {
+            let run = PpmRun {
+                photons,
+                passes,
+                indirect_radius_scale,
+            };
+            bench_ppm(scene.as_deref(), run, &threads, &mut out)
+        }
         BenchCommand::Convergence(args) => super::convergence::bench_convergence(args, &mut out),
     }?;
     out.finish();
@@ -154,18 +167,27 @@ pub(super) fn photon_scene(path: Option<&Path>) -> Result<Scene> {
     })
 }
 
-fn bench_ppm(
-    scene_path: Option<&Path>,
+/// What one `bench ppm` measurement renders.
+struct PpmRun {
     photons: u64,
     passes: u32,
-    threads: &[usize],
-    out: &mut BenchOutput,
-) -> Result<()> {
+    indirect_radius_scale: Option<f64>,
+}
+
+fn bench_ppm(scene_path: Option<&Path>, run: PpmRun, threads: &[usize], out: &mut BenchOutput) -> Result<()> {
+    let PpmRun { photons, passes, .. } = run;
     if photons == 0 || passes == 0 {
         bail!("--photons and --passes must be at least 1");
     }
     let mut scene = photon_scene(scene_path)?;
     scene.params.photons_per_pass = photons;
+    if let Some(k) = run.indirect_radius_scale {
+        scene.params.indirect_radius_scale = Some(k);
+        scene
+            .params
+            .validate()
+            .map_err(|e| anyhow::anyhow!("--indirect-radius-scale: {e}"))?;
+    }
     let (w, h) = (scene.camera.width, scene.camera.height);
     out.say(format!(
         "Photon mapping on {}, {w}x{h}, {passes} passes of {photons} photons",
@@ -175,6 +197,12 @@ fn bench_ppm(
     out.set("size", [w, h]);
     out.set("passes", passes);
     out.set("photons_per_pass", photons);
+    out.set("indirect_radius_scale", scene.params.indirect_radius_scale);
+    out.say(match scene.params.indirect_radius_scale {
+        Some(k) if k <= 1.0 => "one estimate for all photons (as smallppm gathers)".to_owned(),
+        Some(k) => format!("indirect photons gathered over {k}x the radius"),
+        None => "indirect radius automatic (--indirect-radius-scale 1 gathers as smallppm does)".to_owned(),
+    });
     out.say(format!(
         "{:>8} {:>12} {:>16} {:>22} {:>10}",
         "threads", "photon s", "photon paths/s", "paths per core-second", "scaling"

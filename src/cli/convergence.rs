@@ -130,7 +130,7 @@ pub struct ConvergenceArgs {
         long,
         value_enum,
         value_delimiter = ',',
-        default_value = "photons-only,default,unguided,alpha-0.5,alpha-0.667,alpha-0.9,radius-x4,kd-tree"
+        default_value = "photons-only,default,unguided,unstratified,one-estimate,alpha-0.5,alpha-0.667,alpha-0.9,radius-x4,kd-tree"
     )]
     configs: Vec<Config>,
     /// Write every (configuration, pass, seconds, RMSE, relMSE) row to this CSV file.

@@ -836,14 +836,33 @@ impl Ppm {
     /// After the first pass of an automatic indirect radius: widens every slot's indirect
     /// estimate by `k = √(INDIRECT_PHOTONS / m̄)`, clamped to [1, MAX_INDIRECT_SCALE], where m̄
     /// is the mean number of indirect photons a slot gathered in that pass — so that a pass
-    /// hands each point about `INDIRECT_PHOTONS` of them. Where photons are dense (small
-    /// closed rooms) the radius stays, where they are sparse it grows. The estimate is
-    /// scaled as PPM's update assumes, for a density uniform within the radius: N and τ by
-    /// the area. Counts are deterministic, so is `k`.
+    /// hands each point about `INDIRECT_PHOTONS` of them. Where photons are sparse it grows;
+    /// where they are dense (small closed rooms) `k` is 1 and the two estimates merge into
+    /// one. The estimate is scaled as PPM's update assumes, for a density uniform within the
+    /// radius: N and τ by the area. Counts are deterministic, so is `k`.
     fn widen_indirect(&mut self, m: &[u32]) {
         let slots = self.slots.len().max(1) as f64;
         let mean = m.iter().skip(1).step_by(2).map(|&c| c as f64).sum::<f64>() / slots;
         let k = (INDIRECT_PHOTONS / mean).sqrt().clamp(1.0, MAX_INDIRECT_SCALE);
+        if k == 1.0 {
+            // Dense photons: the two estimates would share one radius, so they become one
+            // (the second only costs memory and time). Each is brought to the smaller of the
+            // two radii — N and τ scaled by the area, as PPM's update does — and summed.
+            for s in &mut self.slots {
+                let (p, i) = (s.primary, s.indirect);
+                let r2 = p.radius2.min(i.radius2);
+                let share = |e: Estimate| if e.radius2 > 0.0 { r2 / e.radius2 } else { 0.0 };
+                let (a, b) = (share(p), share(i));
+                s.primary = Estimate {
+                    radius2: r2,
+                    n: p.n * a + i.n * b,
+                    tau: p.tau * a + i.tau * b,
+                };
+                s.indirect = Estimate::default();
+            }
+            self.indirect_scale = IndirectScale::Off;
+            return;
+        }
         let area = k * k;
         for s in &mut self.slots {
             s.indirect.radius2 *= area;
