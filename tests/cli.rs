@@ -71,6 +71,21 @@ fn render_writes_png_and_exr_with_metadata_and_refuses_to_overwrite() {
     ]);
     assert!(forced.status.success(), "{}", text(&forced));
     assert_eq!(image::open(&png).expect("PNG").width(), 8);
+    // One side given: the other follows the scene's aspect (640×480).
+    for (flag, side, expected) in [("--width", "32", (32, 24)), ("--height", "15", (20, 15))] {
+        let one_side = caustic(&[
+            "render",
+            "scenes/leaf.toml",
+            "--out",
+            png_s,
+            flag,
+            side,
+            "--force",
+        ]);
+        assert!(one_side.status.success(), "{}", text(&one_side));
+        let img = image::open(&png).expect("PNG");
+        assert_eq!((img.width(), img.height()), expected, "{flag} {side}");
+    }
 
     let exr = dir.path().join("leaf.exr");
     let out = caustic(&[

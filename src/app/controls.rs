@@ -340,6 +340,8 @@ pub fn side_panel_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) 
         {
             p.set_auto_indirect_scale(false);
         }
+        ui.checkbox(&mut p.render.adaptive_radius, "Adaptive radius")
+            .on_hover_text("After the first pass, points where photons are dense (the inside of a caustic) restart with a radius up to 4× narrower, so that a pass still hands them about 64 photons: sharp light is not blurred by the initial radius for dozens of passes. Off: every point starts at the initial radius. Restarts.");
         ui.checkbox(&mut p.render.direct_light, "Direct light by light sampling")
             .on_hover_text("Direct light from every light by shadow rays at the visible points (area lights: one sample per pass); photons carry only caustics and indirect light. Off: photons carry everything. Restarts.");
         ui.checkbox(&mut p.render.guided_emission, "Photons where the camera looks")
@@ -453,6 +455,11 @@ fn statistics_ui(viewer: &Viewer, ui: &mut egui::Ui) {
                     "Indirect radius",
                     format!("{:.2}x", stats.indirect_radius_scale),
                     "The indirect light's initial radius over the initial radius (1: one estimate for all photons)",
+                );
+                row(
+                    "Narrowed radius",
+                    format!("{:.1} %", 100.0 * stats.narrowed_share),
+                    "Share of the points whose radius was narrowed after the first pass, where photons were dense (adaptive radius)",
                 );
             }
             row(

@@ -34,10 +34,12 @@ pub struct RenderArgs {
     /// Output image: .png or .exr (EXR adds the layers radius.Y, photons.Y and error.Y).
     #[arg(short, long)]
     out: PathBuf,
-    /// Override the scene's image width.
+    /// Override the scene's image width (the height follows the scene's aspect unless
+    /// --height is given too).
     #[arg(long)]
     width: Option<u32>,
-    /// Override the scene's image height.
+    /// Override the scene's image height (the width follows the scene's aspect unless
+    /// --width is given too).
     #[arg(long)]
     height: Option<u32>,
     /// Override the scene's seed.
@@ -119,6 +121,12 @@ pub struct PpmArgs {
     /// density, 1 to 4).
     #[arg(long, value_name = "K")]
     indirect_radius_scale: Option<f64>,
+    /// Photon mapping: after the first pass, narrow the radius (up to 4×) of points where
+    /// photons are dense, such as the inside of a caustic (default: the scene's
+    /// `adaptive_radius`, on unless it says otherwise).
+    #[arg(long, value_name = "on|off", action = clap::ArgAction::Set,
+          value_parser = clap::builder::BoolishValueParser::new())]
+    adaptive_radius: Option<bool>,
 }
 
 impl PpmArgs {
@@ -151,6 +159,9 @@ impl PpmArgs {
         }
         if let Some(k) = self.indirect_radius_scale {
             params.indirect_radius_scale = Some(k);
+        }
+        if let Some(on) = self.adaptive_radius {
+            params.adaptive_radius = on;
         }
         params.validate().map_err(|e| {
             let flag = match e.field {
@@ -206,11 +217,20 @@ pub fn render(args: RenderArgs) -> Result<()> {
             flag_check(flag, limits::image_side(v))?;
         }
     }
-    if let Some(w) = args.width {
-        scene.camera.width = w;
-    }
-    if let Some(h) = args.height {
-        scene.camera.height = h;
+    // One side given: the other follows the scene's aspect (the field of view is vertical,
+    // so a width alone would widen or narrow the view instead of scaling the image).
+    let aspect = scene.camera.width as f64 / scene.camera.height as f64;
+    match (args.width, args.height) {
+        (Some(w), Some(h)) => (scene.camera.width, scene.camera.height) = (w, h),
+        (Some(w), None) => {
+            scene.camera.width = w;
+            scene.camera.height = ((w as f64 / aspect).round() as u32).max(1);
+        }
+        (None, Some(h)) => {
+            scene.camera.height = h;
+            scene.camera.width = ((h as f64 * aspect).round() as u32).max(1);
+        }
+        (None, None) => {}
     }
     if let Some(s) = args.seed {
         scene.params.seed = s;

@@ -202,6 +202,12 @@ fn print_text(out: &Path, image: &Image, renderer: &RendererSummary, guided: boo
                     s.indirect_radius_scale
                 );
             }
+            if s.narrowed_share > 0.0 {
+                println!(
+                    "  adaptive radius: {:.1} % of the points narrowed after the first pass, where photons were dense",
+                    100.0 * s.narrowed_share
+                );
+            }
             println!(
                 "  time: eye passes {:.3} s ({} of them), area-light sampling {:.3} s, index builds {:.3} s, photons {:.3} s",
                 s.eye_secs, s.eye_passes, s.direct_secs, s.index_secs, s.photon_secs

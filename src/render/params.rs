@@ -64,6 +64,13 @@ pub struct RenderParams {
     /// indirect photons, between 1× and 4×; 1: one estimate for all photons (the paper's
     /// PPM).
     pub indirect_radius_scale: Option<f64>,
+    /// Photon mapping: narrow the radius where photons are dense. After the first pass, a
+    /// point that pass handed many more photons than it needs (the inside of a caustic)
+    /// restarts its estimate with a radius that would have handed it about 64, up to 4×
+    /// narrower, so that sharp light is not blurred by the initial radius for the first dozens
+    /// of passes. On by default; off, every point starts at the initial radius (the paper's
+    /// PPM).
+    pub adaptive_radius: bool,
     /// Maximum specular bounces of eye rays and photons.
     pub max_depth: u32,
     /// Seed of every random number.
@@ -106,6 +113,7 @@ impl Default for RenderParams {
             alpha: 0.7,
             initial_radius: None,
             indirect_radius_scale: None,
+            adaptive_radius: true,
             max_depth: 8,
             seed: 1,
             antialias: true,

@@ -11,7 +11,11 @@
 //! `N' = N + αM`, `R'² = R²·(N + αM)/(N + M)`, `τ' = (τ + φ)·(N + αM)/(N + M)`;
 //!
 //! and the radiance is `L = τ / (π R² N_emitted)` plus light seen directly. No brightness
-//! factor: exposure belongs to the viewer.
+//! factor: exposure belongs to the viewer. After the first pass, two per-point choices are
+//! made from its photon counts: the indirect estimate's radius ([`Ppm::widen_indirect`]) and,
+//! where photons are dense, a narrower restart of the primary one ([`Ppm::narrow_dense`], the
+//! adaptive radius: in the spirit of classic photon mapping's k-nearest-neighbour radius,
+//! Jensen 2001, chosen once and then shrunk by the paper's rule).
 //!
 //! Determinism: photon `i` of the render uses the random stream `(seed, photon, i)`, pixels
 //! `(seed, pass, pixel)`; photons are traced in fixed chunks whose deposits are applied in
@@ -68,6 +72,12 @@ enum IndirectScale {
 const INDIRECT_PHOTONS: f64 = 32.0;
 /// The widest automatic indirect radius, over the initial radius.
 const MAX_INDIRECT_SCALE: f64 = 4.0;
+
+/// Photons a pass should hand a point after the radius is narrowed where photons are dense
+/// ([`Ppm::narrow_dense`]).
+const DENSE_PHOTONS: f64 = 64.0;
+/// The most an adaptive radius narrows a point's initial radius (in radius, not area).
+const MAX_NARROWING: f64 = 4.0;
 
 /// Photons per chunk: the unit of parallel work and of deterministic reduction.
 const CHUNK: u64 = 4096;
@@ -222,6 +232,22 @@ pub struct Slot {
     pub primary: Estimate,
     /// Photons after a diffuse bounce (indirect light), when the scale is above 1.
     pub indirect: Estimate,
+    /// Whether the primary estimate was restarted with a narrower radius after the first
+    /// pass (adaptive radius).
+    pub restart: Restart,
+}
+
+/// A primary estimate's restart with a narrower radius ([`Ppm::narrow_dense`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Restart {
+    /// Not restarted: it counts every pass.
+    #[default]
+    None,
+    /// Narrowed after the first pass: its radius is the new one, its flux the first pass's
+    /// (scaled by the area, so the image does not change) until the second pass replaces it.
+    Pending,
+    /// Restarted at the second pass: the first pass's photons do not count for it.
+    Restarted,
 }
 
 impl Slot {
@@ -231,6 +257,7 @@ impl Slot {
             pixel,
             primary: Estimate::default(),
             indirect: Estimate::default(),
+            restart: Restart::None,
         }
     }
 
@@ -273,6 +300,9 @@ pub struct PpmStats {
     /// The indirect estimate's initial radius over the primary's (1: one estimate for all
     /// photons; chosen after the first pass when automatic).
     pub indirect_radius_scale: f64,
+    /// Share of the statistics slots whose estimate restarted with a narrower radius after
+    /// the first pass (adaptive radius; 0 before it or when off).
+    pub narrowed_share: f64,
     /// Seconds spent in completed passes.
     pub elapsed_secs: f64,
     /// Seconds spent tracing photons.
@@ -320,6 +350,13 @@ pub struct Ppm {
     stratified_eye_rays: bool,
     /// How the indirect estimate's radius is chosen (from the render parameters).
     indirect_scale: IndirectScale,
+    /// Narrow the primary radius where the first pass found photons dense (from the render
+    /// parameters).
+    adaptive_radius: bool,
+    /// The initial radius², once the first eye pass has chosen it.
+    initial_radius2: f64,
+    /// Photons emitted by the first pass (a restarted estimate does not count them).
+    first_pass_photons: u64,
     /// α for the next update.
     pub alpha: f64,
     /// Photons per pass from the next pass on.
@@ -390,6 +427,9 @@ impl Ppm {
                 Some(k) if k > 1.0 => IndirectScale::Fixed(k),
                 Some(_) => IndirectScale::Off,
             },
+            adaptive_radius: scene.params.adaptive_radius,
+            initial_radius2: 0.0,
+            first_pass_photons: 0,
             alpha: scene.params.alpha,
             photons_per_pass: scene
                 .params
@@ -603,6 +643,7 @@ impl Ppm {
                 s.primary.radius2 = r0 * r0;
                 s.indirect.radius2 = indirect * indirect;
             }
+            self.initial_radius2 = r0 * r0;
         }
         for vp in &mut self.points {
             vp.radius2 = self.slots[vp.slot as usize].reach2();
@@ -804,11 +845,22 @@ impl Ppm {
         // Compute new photon counts, radii and flux (Hachisuka et al. 2008, eqs. 6–11).
         let alpha = self.alpha;
         for (k, s) in self.slots.iter_mut().enumerate() {
+            if s.restart == Restart::Pending {
+                // The first pass's flux only stood in until this pass: it was gathered over
+                // the wide radius.
+                s.primary.n = 0.0;
+                s.primary.tau = DVec3::ZERO;
+                s.restart = Restart::Restarted;
+            }
             s.primary.update(phi[2 * k].as_dvec3(), m[2 * k], alpha);
             s.indirect.update(phi[2 * k + 1].as_dvec3(), m[2 * k + 1], alpha);
         }
         if self.indirect_scale == IndirectScale::Automatic && self.stats.passes == 0 {
             self.widen_indirect(&m);
+        }
+        if self.adaptive_radius && self.stats.passes == 0 {
+            self.first_pass_photons = self.pass_photons;
+            self.narrow_dense(&m);
         }
         if self.stochastic {
             for (d, p) in self.direct.iter_mut().zip(self.pass_direct.drain(..)) {
@@ -874,6 +926,39 @@ impl Ppm {
         self.indirect_scale = IndirectScale::Fixed(k);
     }
 
+    /// After the first pass, with an adaptive radius: where that pass handed a slot's primary
+    /// estimate more than `DENSE_PHOTONS` photons (caustics, and all light when one estimate
+    /// is kept), the estimate restarts at the second pass with the initial radius narrowed so
+    /// that a pass hands it about that many: `R² = R₀² · DENSE_PHOTONS / m`, at most
+    /// `MAX_NARROWING` times narrower. PPM's bias (the blur of sharp light such as a caustic's
+    /// edge) grows with the radius and shrinks only pass by pass, while its noise depends on
+    /// photons per point: where they are dense a narrower radius removes blur at once for
+    /// little noise. The first pass's flux, gathered over the wide radius, is dropped at the
+    /// second pass (kept until then, scaled by the area, so the image does not go dark), so
+    /// that no blur of it stays in the estimate; the radius is chosen from photons the
+    /// estimate then never uses. Counts are deterministic, so are the radii.
+    fn narrow_dense(&mut self, m: &[u32]) {
+        let merged = self.indirect_scale == IndirectScale::Off;
+        let r0_2 = self.initial_radius2;
+        let mut narrowed = 0usize;
+        for (k, s) in self.slots.iter_mut().enumerate() {
+            let count = m[2 * k] as f64 + if merged { m[2 * k + 1] as f64 } else { 0.0 };
+            if count <= DENSE_PHOTONS || s.primary.radius2 <= 0.0 {
+                continue;
+            }
+            let radius2 = r0_2 * (DENSE_PHOTONS / count).max(MAX_NARROWING.powi(-2));
+            let share = radius2 / s.primary.radius2;
+            s.primary = Estimate {
+                radius2,
+                n: s.primary.n * share,
+                tau: s.primary.tau * share,
+            };
+            s.restart = Restart::Pending;
+            narrowed += 1;
+        }
+        self.stats.narrowed_share = narrowed as f64 / self.slots.len().max(1) as f64;
+    }
+
     /// Adds one light sample of every area light at each visible point of this pass to the
     /// per-pixel sums (when direct light is on; see [`direct`]).
     fn sample_area_lights(&mut self, scene: &Scene) {
@@ -901,8 +986,13 @@ impl Ppm {
         let mut out = vec![DVec3::ZERO; self.direct.len()];
         if self.stats.photons > 0 {
             let emitted = self.stats.photons as f64;
+            let restarted = (self.stats.photons - self.first_pass_photons) as f64;
             for s in &self.slots {
-                out[s.pixel as usize] += s.primary.radiance(emitted) + s.indirect.radiance(emitted);
+                let primary = match s.restart {
+                    Restart::Restarted => s.primary.radiance(restarted),
+                    _ => s.primary.radiance(emitted),
+                };
+                out[s.pixel as usize] += primary + s.indirect.radiance(emitted);
             }
         }
         let eye = self.stats.eye_passes.max(1) as f64;
