@@ -214,16 +214,17 @@ fn render_passes(scene: &Scene, options: PpmOptions, passes: u32) -> Vec<[f32; 3
     ppm.radiance()
 }
 
+/// A thread pool of `threads` threads.
+fn pool(threads: usize) -> rayon::ThreadPool {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("pool")
+}
+
 #[test]
 fn ppm_is_identical_for_one_and_two_threads() {
-    let one = rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
-        .build()
-        .expect("pool");
-    let two = rayon::ThreadPoolBuilder::new()
-        .num_threads(2)
-        .build()
-        .expect("pool");
+    let [one, two] = [1, 2].map(pool);
     for aperture in [0.0, 0.2] {
         let scene = cornell_small(aperture);
         // Its quad light is sampled at the visible points (the default) as well as photon mapped.
@@ -959,14 +960,7 @@ fn an_adaptive_radius_sharpens_a_hard_edge_towards_the_closed_form() {
     assert!((m_adaptive / expected_mean - 1.0).abs() < 0.02);
     assert!((m_fixed / expected_mean - 1.0).abs() < 0.02);
     // The radii come from photon counts: the same image for one and two threads.
-    let two = rayon::ThreadPoolBuilder::new()
-        .num_threads(2)
-        .build()
-        .expect("pool");
-    let one = rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
-        .build()
-        .expect("pool");
+    let [one, two] = [1, 2].map(pool);
     let mut short = scene.clone();
     short.params.photons_per_pass = 100_000;
     assert_eq!(
