@@ -249,9 +249,7 @@ fn bench_whitted(
     out: &mut BenchOutput,
 ) -> Result<()> {
     let mut scene = load_scene(scene_path)?;
-    let aspect = scene.camera.height as f64 / scene.camera.width as f64;
-    scene.camera.width = width.clamp(1, 16384);
-    scene.camera.height = ((width as f64 * aspect).round() as u32).max(1);
+    scene.camera.resize(Some(width.clamp(1, 16384)), None);
     out.say(format!(
         "Whitted ray tracer on {}, {}x{}",
         scene.source.display(),

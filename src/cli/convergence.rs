@@ -170,9 +170,7 @@ pub fn bench_convergence(args: ConvergenceArgs, out: &mut BenchOutput) -> Result
             );
         }
     }
-    let aspect = scene.camera.height as f64 / scene.camera.width as f64;
-    scene.camera.width = args.width;
-    scene.camera.height = ((args.width as f64 * aspect).round() as u32).max(1);
+    scene.camera.resize(Some(args.width), None);
     scene.params.renderer = RendererKind::Ppm;
     // The reference keeps the scene's own photons per pass, so runs with other --photons
     // share it.

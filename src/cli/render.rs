@@ -217,21 +217,7 @@ pub fn render(args: RenderArgs) -> Result<()> {
             flag_check(flag, limits::image_side(v))?;
         }
     }
-    // One side given: the other follows the scene's aspect (the field of view is vertical,
-    // so a width alone would widen or narrow the view instead of scaling the image).
-    let aspect = scene.camera.width as f64 / scene.camera.height as f64;
-    match (args.width, args.height) {
-        (Some(w), Some(h)) => (scene.camera.width, scene.camera.height) = (w, h),
-        (Some(w), None) => {
-            scene.camera.width = w;
-            scene.camera.height = ((w as f64 / aspect).round() as u32).max(1);
-        }
-        (None, Some(h)) => {
-            scene.camera.height = h;
-            scene.camera.width = ((h as f64 * aspect).round() as u32).max(1);
-        }
-        (None, None) => {}
-    }
+    scene.camera.resize(args.width, args.height);
     if let Some(s) = args.seed {
         scene.params.seed = s;
     }

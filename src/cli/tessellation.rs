@@ -85,9 +85,7 @@ pub fn bench_tessellation(args: TessellationArgs, out: &mut BenchOutput) -> Resu
         }
     }
     caustic::render::limits::image_side(args.width).map_err(|e| anyhow::anyhow!("--width {e}"))?;
-    let aspect = scene.camera.height as f64 / scene.camera.width as f64;
-    scene.camera.width = args.width;
-    scene.camera.height = ((args.width as f64 * aspect).round() as u32).max(1);
+    scene.camera.resize(Some(args.width), None);
     let (w, h) = (scene.camera.width, scene.camera.height);
     let patches = scene.geometry.patches().len();
     out.say(format!(

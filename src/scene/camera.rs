@@ -61,6 +61,25 @@ impl Camera {
         }
     }
 
+    /// Sets the image size: both sides as given, or one side and the other following the
+    /// current aspect (the field of view is vertical, so changing the width alone would widen
+    /// or narrow the view instead of scaling the image).
+    pub fn resize(&mut self, width: Option<u32>, height: Option<u32>) {
+        let (w, h) = (self.width as f64, self.height as f64);
+        match (width, height) {
+            (Some(width), Some(height)) => (self.width, self.height) = (width, height),
+            (Some(width), None) => {
+                self.height = ((width as f64 * (h / w)).round() as u32).max(1);
+                self.width = width;
+            }
+            (None, Some(height)) => {
+                self.width = ((height as f64 * (w / h)).round() as u32).max(1);
+                self.height = height;
+            }
+            (None, None) => {}
+        }
+    }
+
     /// The constants of this camera's eye rays, to compute once for many rays.
     pub fn eye_rays(&self) -> EyeRays<'_> {
         EyeRays {
@@ -164,6 +183,21 @@ pub fn concentric_disk(u: DVec2) -> DVec2 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn resize_keeps_the_aspect_when_one_side_is_given() {
+        let base = Camera::look_at(DVec3::Z, DVec3::ZERO, DVec3::Y, 40.0, 1024, 768, 0.0, None);
+        let sized = |w, h| {
+            let mut c = base.clone();
+            c.resize(w, h);
+            (c.width, c.height)
+        };
+        assert_eq!(sized(Some(320), None), (320, 240));
+        assert_eq!(sized(None, Some(60)), (80, 60));
+        assert_eq!(sized(Some(10), Some(10)), (10, 10));
+        assert_eq!(sized(None, None), (1024, 768));
+        assert_eq!(sized(Some(1), None), (1, 1), "never a zero side");
+    }
 
     #[test]
     fn projection_inverts_the_pinhole_ray() {
