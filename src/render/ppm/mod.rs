@@ -207,6 +207,22 @@ impl Estimate {
         }
     }
 
+    /// The estimate brought to radius² `radius2` as PPM's update assumes, for a density
+    /// uniform within the radius: N and τ scaled by the area (an estimate without a radius
+    /// holds nothing to scale).
+    fn resized(self, radius2: f64) -> Self {
+        let share = if self.radius2 > 0.0 {
+            radius2 / self.radius2
+        } else {
+            0.0
+        };
+        Self {
+            radius2,
+            n: self.n * share,
+            tau: self.tau * share,
+        }
+    }
+
     /// Reflected radiance `τ/(π R² N_emitted)`.
     fn radiance(&self, emitted: f64) -> DVec3 {
         if self.radius2 > 0.0 {
@@ -903,14 +919,12 @@ impl Ppm {
             // (the second only costs memory and time). Each is brought to the smaller of the
             // two radii — N and τ scaled by the area, as PPM's update does — and summed.
             for s in &mut self.slots {
-                let (p, i) = (s.primary, s.indirect);
-                let r2 = p.radius2.min(i.radius2);
-                let share = |e: Estimate| if e.radius2 > 0.0 { r2 / e.radius2 } else { 0.0 };
-                let (a, b) = (share(p), share(i));
+                let r2 = s.primary.radius2.min(s.indirect.radius2);
+                let (p, i) = (s.primary.resized(r2), s.indirect.resized(r2));
                 s.primary = Estimate {
                     radius2: r2,
-                    n: p.n * a + i.n * b,
-                    tau: p.tau * a + i.tau * b,
+                    n: p.n + i.n,
+                    tau: p.tau + i.tau,
                 };
                 s.indirect = Estimate::default();
             }
@@ -919,9 +933,7 @@ impl Ppm {
         }
         let area = k * k;
         for s in &mut self.slots {
-            s.indirect.radius2 *= area;
-            s.indirect.n *= area;
-            s.indirect.tau *= area;
+            s.indirect = s.indirect.resized(s.indirect.radius2 * area);
         }
         self.indirect_scale = IndirectScale::Fixed(k);
     }
@@ -947,12 +959,7 @@ impl Ppm {
                 continue;
             }
             let radius2 = r0_2 * (DENSE_PHOTONS / count).max(MAX_NARROWING.powi(-2));
-            let share = radius2 / s.primary.radius2;
-            s.primary = Estimate {
-                radius2,
-                n: s.primary.n * share,
-                tau: s.primary.tau * share,
-            };
+            s.primary = s.primary.resized(radius2);
             s.restart = Restart::Pending;
             narrowed += 1;
         }
