@@ -45,6 +45,11 @@ fn kept_obj_inputs_load_or_fail_cleanly() {
 }
 
 #[test]
+fn kept_freeform_inputs_load_or_fail_cleanly() {
+    assert!(replay("freeform", inputs::freeform) >= 4);
+}
+
+#[test]
 fn kept_texture_inputs_decode_or_fail_cleanly() {
     assert!(replay("texture", inputs::texture) >= 3);
 }

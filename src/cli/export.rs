@@ -1,4 +1,5 @@
-//! `caustic export-obj`: a scene's Bézier patches, tessellated, as a Wavefront OBJ file.
+//! `caustic export-obj`: a scene's Bézier patches as a Wavefront OBJ file, tessellated into
+//! triangles, or exactly as `cstype bezier` free-form surfaces (`--freeform`).
 
 use std::path::{Path, PathBuf};
 
@@ -6,6 +7,7 @@ use anyhow::{bail, Context, Result};
 
 use super::load_scene;
 use caustic::files::write_atomically;
+use caustic::geometry::freeform::{write_freeform_obj, DomainPatch};
 use caustic::geometry::tessellate::{tessellate, write_obj};
 
 /// `caustic export-obj`'s flags.
@@ -19,6 +21,10 @@ pub struct ExportArgs {
     /// Quads per patch side.
     #[arg(long, default_value_t = 16)]
     resolution: usize,
+    /// Write the patches exactly, as OBJ free-form `cstype bezier` surfaces (each with its
+    /// (u,v) window), instead of triangles: reading the file back gives the same control points.
+    #[arg(long, conflicts_with = "resolution")]
+    freeform: bool,
     /// Replace the output file if it exists.
     #[arg(long)]
     force: bool,
@@ -30,6 +36,7 @@ pub fn export_obj(args: ExportArgs) -> Result<()> {
         scene: scene_path,
         out,
         resolution,
+        freeform,
         force,
     } = args;
     let out = out.as_path();
@@ -43,13 +50,16 @@ pub fn export_obj(args: ExportArgs) -> Result<()> {
         );
     }
     let scene = load_scene(scene_path.as_deref())?;
+    if freeform {
+        return export_freeform(&scene, out, force);
+    }
     let meshes: Vec<(String, caustic::geometry::TriangleMesh)> = scene
         .geometry
         .patches()
         .iter()
         .enumerate()
         .map(|(k, (p, obj))| {
-            let name = format!("{}_patch{k}", scene.objects[*obj as usize].name.replace(' ', "_"));
+            let name = format!("{}_patch{k}", group_name(&scene, *obj));
             (name, tessellate(p, resolution))
         })
         .collect();
@@ -70,6 +80,43 @@ pub fn export_obj(args: ExportArgs) -> Result<()> {
         "{}: {} patches, {triangles} triangles",
         out.display(),
         meshes.len()
+    );
+    Ok(())
+}
+
+/// The object name of each patch, as an OBJ group name (no spaces).
+fn group_name(scene: &caustic::scene::Scene, object: u32) -> String {
+    scene.objects[object as usize].name.replace(char::is_whitespace, "_")
+}
+
+/// Writes the scene's patches, as the scene file holds them (edits saved into it included), as
+/// free-form surfaces, one OBJ group per object.
+fn export_freeform(scene: &caustic::scene::Scene, out: &Path, force: bool) -> Result<()> {
+    let mut groups: Vec<(String, Vec<DomainPatch>)> = Vec::new();
+    let patches = scene.geometry.patches();
+    for ((p, object), domain) in patches.iter().zip(scene.geometry.patch_domains()) {
+        let name = group_name(scene, *object);
+        match groups.last_mut() {
+            Some((last, list)) if *last == name => list.push((*p, *domain)),
+            _ => groups.push((name, vec![(*p, *domain)])),
+        }
+    }
+    if groups.is_empty() {
+        bail!(
+            "{}: the scene has no Bézier patches to export",
+            scene.source.display()
+        );
+    }
+    let write = |tmp: &Path| -> Result<(), String> {
+        let mut file = std::io::BufWriter::new(std::fs::File::create(tmp).map_err(|e| e.to_string())?);
+        write_freeform_obj(&groups, &mut file).map_err(|e| e.to_string())?;
+        std::io::Write::flush(&mut file).map_err(|e| e.to_string())
+    };
+    write_atomically(out, force, write).context("cannot write the OBJ file")?;
+    println!(
+        "{}: {} patches as free-form Bézier surfaces",
+        out.display(),
+        patches.len()
     );
     Ok(())
 }

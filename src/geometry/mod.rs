@@ -5,7 +5,9 @@
 pub mod aabb;
 pub mod bezier;
 pub mod bpt;
+pub mod bspline;
 pub mod bvh;
+pub mod freeform;
 pub mod mesh;
 pub mod patch;
 pub mod quad;
@@ -18,6 +20,7 @@ pub use aabb::Aabb;
 pub use bezier::BezierPatch;
 pub use bpt::{load_bpt, parse_bpt, BptError};
 pub use bvh::Bvh;
+pub use freeform::{load_freeform_obj, parse_freeform_obj, write_freeform_obj, FreeformError};
 pub use mesh::{MeshError, TriangleMesh};
 pub use patch::{PatchHit, PatchLeaf, SubdivisionParams, Window};
 pub use quad::{Plane, Quad};

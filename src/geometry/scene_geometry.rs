@@ -19,7 +19,7 @@ use super::aabb::Aabb;
 use super::bezier::BezierPatch;
 use super::bvh::Bvh;
 use super::mesh::TriangleMesh;
-use super::patch::{intersect_leaf, intersect_per_ray, subdivide, PatchLeaf, RayFrame, SubdivisionParams};
+use super::patch::{intersect_leaf, intersect_per_ray, subdivide, PatchLeaf, RayFrame, SubdivisionParams, Window};
 use super::quad::{Plane, Quad};
 use super::ray::{spawn_ray, Ray};
 use super::sphere::Sphere;
@@ -114,6 +114,8 @@ pub struct GeometryBuilder {
     planes: Vec<(Plane, u32)>,
     meshes: Vec<(TriangleMesh, u32)>,
     patches: Vec<(BezierPatch, u32)>,
+    /// Each patch's `(u,v)` window in the parameters of the surface it came from.
+    patch_domains: Vec<Window>,
     /// The patch intersector.
     pub patch_method: PatchMethod,
 }
@@ -147,9 +149,16 @@ impl GeometryBuilder {
         self.meshes.push((mesh, object));
         ShapeRef::Mesh(self.meshes.len() as u32 - 1)
     }
-    /// Adds a Bézier patch tagged with `object`.
+    /// Adds a Bézier patch tagged with `object`; its hits report `(u,v)` in `[0,1]²`.
     pub fn add_patch(&mut self, patch: BezierPatch, object: u32) -> ShapeRef {
+        self.add_patch_in(patch, Window::FULL, object)
+    }
+
+    /// Adds a Bézier patch that is the piece `domain` of a larger surface (a B-spline span):
+    /// its hits report `(u,v)` in the surface's parameters, so textures follow the surface.
+    pub fn add_patch_in(&mut self, patch: BezierPatch, domain: Window, object: u32) -> ShapeRef {
         self.patches.push((patch, object));
+        self.patch_domains.push(domain);
         ShapeRef::Patch(self.patches.len() as u32 - 1)
     }
 
@@ -207,6 +216,7 @@ impl GeometryBuilder {
             planes: self.planes,
             meshes: self.meshes,
             patches: self.patches,
+            patch_domains: self.patch_domains,
             patch_scales,
             leaves,
             primitives,
@@ -224,6 +234,7 @@ pub struct SceneGeometry {
     planes: Vec<(Plane, u32)>,
     meshes: Vec<(TriangleMesh, u32)>,
     patches: Vec<(BezierPatch, u32)>,
+    patch_domains: Vec<Window>,
     patch_scales: Vec<f64>,
     leaves: Vec<PatchLeaf>,
     /// Everything in the BVH; its leaves index this list. Patch leaves (or whole patches,
@@ -256,12 +267,19 @@ impl SceneGeometry {
             planes: self.planes.clone(),
             meshes: self.meshes.clone(),
             patches: Vec::new(),
+            patch_domains: Vec::new(),
             patch_method: method,
         };
-        for (p, object) in &self.patches {
+        for ((p, object), domain) in self.patches.iter().zip(&self.patch_domains) {
             match tessellate_segments {
-                Some(n) => builder.add_mesh(super::tessellate::tessellate(p, n), *object),
-                None => builder.add_patch(*p, *object),
+                Some(n) => {
+                    let mut mesh = super::tessellate::tessellate(p, n);
+                    for uv in &mut mesh.texcoords {
+                        *uv = domain.map(uv.x, uv.y);
+                    }
+                    builder.add_mesh(mesh, *object)
+                }
+                None => builder.add_patch_in(*p, *domain, *object),
             };
         }
         builder.build()
@@ -283,6 +301,12 @@ impl SceneGeometry {
     /// The patches, with their object ids.
     pub fn patches(&self) -> &[(BezierPatch, u32)] {
         &self.patches
+    }
+
+    /// Each patch's `(u,v)` window in the surface it came from (`[0,1]²` for a whole patch),
+    /// in the order of [`SceneGeometry::patches`].
+    pub fn patch_domains(&self) -> &[Window] {
+        &self.patch_domains
     }
 
     /// Moves control point `index` (0–15, `4i + j`) of patch `patch` to `position` and
@@ -528,7 +552,8 @@ impl SceneGeometry {
         let (p, obj) = &self.patches[patch as usize];
         // A patch degenerate everywhere has no normal; any unit vector keeps shading finite.
         let n = p.normal(uv.x, uv.y).unwrap_or(DVec3::Z);
-        (n, n, uv, *obj, ShapeRef::Patch(patch))
+        let surface_uv = self.patch_domains[patch as usize].map(uv.x, uv.y);
+        (n, n, surface_uv, *obj, ShapeRef::Patch(patch))
     }
 
     /// Whether anything lies on `ray` in `(0, t_max)` (shadow rays).

@@ -237,6 +237,9 @@ pub struct ObjectDesc {
     pub builtin: Option<String>,
     /// Patches written inline: each a list of 16 points `[x, y, z]`, row by row.
     pub patches: Option<Vec<Vec<Vec3>>>,
+    /// With inline `patches`: each patch's `(u,v)` window `[u0, u1, v0, v1]` in the parameters
+    /// of the surface it was cut from (a B-spline span), so textures follow that surface.
+    pub domains: Option<Vec<[Real; 4]>>,
     /// Placement (mesh, patches, quad, sphere).
     pub transform: Option<TransformDesc>,
 }

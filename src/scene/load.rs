@@ -10,13 +10,15 @@ use toml::Spanned;
 
 use super::camera::Camera;
 use super::format::{
-    CameraDesc, LightDesc, MaterialDesc, ObjectDesc, ScaleDesc, SceneFile, TextureDesc, TransformDesc, Vec3,
+    CameraDesc, LightDesc, MaterialDesc, ObjectDesc, Real, ScaleDesc, SceneFile, TextureDesc, TransformDesc, Vec3,
 };
 use super::light::Light;
 use super::material::{Material, MaterialKind};
 use super::texture::{Mapping, Texture, TextureSource};
 use super::{RenderParams, Scene, SceneObject};
-use crate::geometry::{load_bpt, BezierPatch, GeometryBuilder, Plane, Quad, Sphere, TriangleMesh};
+use crate::geometry::{
+    load_bpt, load_freeform_obj, BezierPatch, GeometryBuilder, Plane, Quad, Sphere, TriangleMesh, Window,
+};
 use crate::render::limits;
 
 /// A scene file that cannot be used: where, and why.
@@ -511,6 +513,7 @@ fn object(
         ("file", d.file.is_some()),
         ("builtin", d.builtin.is_some()),
         ("patches", d.patches.is_some()),
+        ("domains", d.domains.is_some()),
         ("transform", d.transform.is_some()),
     ];
     let id = objects.len() as u32;
@@ -575,13 +578,19 @@ fn object(
             builder.add_mesh(mesh, id);
         }
         "patches" => {
-            t.only("patches", &given, &["file", "builtin", "patches", "transform"])?;
-            let patches: Vec<BezierPatch> = match (d.file.as_deref(), d.builtin.as_deref(), &d.patches) {
+            t.only("patches", &given, &["file", "builtin", "patches", "domains", "transform"])?;
+            let whole = |patches: Vec<BezierPatch>| patches.into_iter().map(|p| (p, Window::FULL)).collect();
+            let patches: Vec<(BezierPatch, Window)> = match (d.file.as_deref(), d.builtin.as_deref(), &d.patches) {
                 (Some(file), None, None) => {
                     let path = ctx.resolve(&t.span, &format!("{label}: 'file'"), file)?;
-                    load_bpt(&path).map_err(|e| t.err(e))?
+                    let obj = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"));
+                    if obj {
+                        load_freeform_obj(&path).map_err(|e| t.err(e))?
+                    } else {
+                        whole(load_bpt(&path).map_err(|e| t.err(e))?)
+                    }
                 }
-                (None, Some("teapot"), None) => crate::assets::teapot(),
+                (None, Some("teapot"), None) => whole(crate::assets::teapot()),
                 (None, Some(other), None) => {
                     return Err(t.err(format!("unknown 'builtin' patches '{other}' (available: teapot)")))
                 }
@@ -594,17 +603,23 @@ fn object(
                                 points.len()
                             )));
                         }
-                        out.push(BezierPatch::new(std::array::from_fn(|j| v3(&points[j]))));
+                        out.push((BezierPatch::new(std::array::from_fn(|j| v3(&points[j]))), Window::FULL));
                     }
                     if out.is_empty() {
                         return Err(t.err("'patches' is empty"));
+                    }
+                    if let Some(domains) = &d.domains {
+                        patch_domains(&t, &mut out, domains)?;
                     }
                     out
                 }
                 _ => return Err(t.err("needs exactly one of 'file', 'builtin' or 'patches'")),
             };
-            for p in patches {
-                builder.add_patch(p.transformed(&m), id);
+            if d.domains.is_some() && d.patches.is_none() {
+                return Err(t.err("'domains' applies only to inline 'patches'"));
+            }
+            for (p, domain) in patches {
+                builder.add_patch_in(p.transformed(&m), domain, id);
             }
         }
         other => {
@@ -618,6 +633,27 @@ fn object(
         material,
         emission: None,
     });
+    Ok(())
+}
+
+/// Applies inline `domains` (one `[u0, u1, v0, v1]` per patch, each range increasing).
+fn patch_domains(t: &Table, patches: &mut [(BezierPatch, Window)], domains: &[[Real; 4]]) -> Result<()> {
+    if domains.len() != patches.len() {
+        return Err(t.err(format!(
+            "'domains' has {} entries for {} patches",
+            domains.len(),
+            patches.len()
+        )));
+    }
+    for (i, ((_, window), d)) in patches.iter_mut().zip(domains).enumerate() {
+        let [u0, u1, v0, v1] = d.map(|r| r.0);
+        if !(u0 < u1 && v0 < v1) {
+            return Err(t.err(format!(
+                "'domains[{i}]' must be [u0, u1, v0, v1] with u0 < u1 and v0 < v1, got [{u0}, {u1}, {v0}, {v1}]"
+            )));
+        }
+        *window = Window { u0, u1, v0, v1 };
+    }
     Ok(())
 }
 

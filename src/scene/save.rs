@@ -12,7 +12,7 @@ use toml_edit::{Array, DocumentMut, Item, Table, Value};
 
 use super::{RenderParams, Scene};
 use crate::files::{write_atomically, WriteError};
-use crate::geometry::BezierPatch;
+use crate::geometry::{BezierPatch, Window};
 
 /// Why a scene could not be saved.
 #[derive(Debug, thiserror::Error)]
@@ -185,6 +185,7 @@ fn params_table(params: &RenderParams) -> toml_edit::Table {
 
 fn write_patches(doc: &mut DocumentMut, scene: &Scene, loaded: &[BezierPatch]) {
     let patches = scene.geometry.patches();
+    let domains = scene.geometry.patch_domains();
     let Some(objects) = doc.get_mut("objects").and_then(Item::as_array_of_tables_mut) else {
         return;
     };
@@ -199,13 +200,22 @@ fn write_patches(doc: &mut DocumentMut, scene: &Scene, loaded: &[BezierPatch]) {
         if own.is_empty() || !edited {
             continue;
         }
-        for key in ["file", "builtin", "transform"] {
+        for key in ["file", "builtin", "transform", "domains"] {
             object.remove(key);
         }
         let mut list: Array = own.iter().map(|(_, p)| patch_value(p)).collect();
         list.set_trailing("\n");
         list.set_trailing_comma(true);
         object.insert("patches", toml_edit::value(list));
+        // Patches cut from a larger surface keep their (u,v) windows, so textures still follow it.
+        let windows: Vec<Window> = own.iter().map(|(i, _)| domains[*i]).collect();
+        if windows.iter().any(|w| *w != Window::FULL) {
+            let list: Array = windows
+                .iter()
+                .map(|w| Value::from(Array::from_iter([w.u0, w.u1, w.v0, w.v1])))
+                .collect();
+            object.insert("domains", toml_edit::value(list));
+        }
     }
 }
 

@@ -5,7 +5,9 @@
 
 use std::path::Path;
 
-use caustic::geometry::{parse_bpt, GeometryBuilder, Ray, TriangleMesh};
+use caustic::geometry::{
+    parse_bpt, parse_freeform_obj, write_freeform_obj, BezierPatch, GeometryBuilder, Ray, TriangleMesh, Window,
+};
 use caustic::scene::texture::TextureSource;
 use caustic::scene::Scene;
 use glam::DVec3;
@@ -36,12 +38,36 @@ pub fn bpt(data: &[u8]) {
     let Ok(patches) = parse_bpt(text, Path::new("fuzz.bpt")) else {
         return;
     };
+    let whole: Vec<(BezierPatch, Window)> = patches.iter().map(|p| (*p, Window::FULL)).collect();
+    shoot_at(&whole);
+}
+
+/// A free-form OBJ file: parse it; what it accepts has increasing windows, writes out and
+/// reads back to the same patches, and up to 8 of them intersect to finite hits.
+pub fn freeform(data: &[u8]) {
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
+    let Ok(patches) = parse_freeform_obj(text, Path::new("fuzz.obj")) else {
+        return;
+    };
+    assert!(patches.iter().all(|(_, w)| w.u0 < w.u1 && w.v0 < w.v1), "{patches:?}");
+    let mut out = Vec::new();
+    write_freeform_obj(&[("fuzz".to_owned(), patches.clone())], &mut out).expect("writes to memory");
+    let back = parse_freeform_obj(&String::from_utf8_lossy(&out), Path::new("fuzz-out.obj"));
+    assert_eq!(back.ok().as_ref(), Some(&patches), "the written surfaces read back differently");
+    shoot_at(&patches);
+}
+
+/// Prepares up to 8 patches and shoots rays through their bounds: every hit must be finite,
+/// its (u,v) too.
+fn shoot_at(patches: &[(BezierPatch, Window)]) {
     let mut builder = GeometryBuilder::default();
-    for p in patches.iter().take(8) {
-        builder.add_patch(*p, 0);
+    for (p, w) in patches.iter().take(8) {
+        builder.add_patch_in(*p, *w, 0);
     }
     let geometry = builder.build();
-    for p in patches.iter().take(8) {
+    for (p, _) in patches.iter().take(8) {
         let bounds = p.bounds();
         let centre = (bounds.min + bounds.max) * 0.5;
         let size = (bounds.max - bounds.min).length().max(1e-9);
@@ -54,7 +80,7 @@ pub fn bpt(data: &[u8]) {
             let ray = Ray::new(centre - dir * 2.0 * size, dir);
             if let Some(hit) = geometry.intersect(&ray, f64::INFINITY) {
                 assert!(
-                    hit.t.is_finite() && hit.point.is_finite(),
+                    hit.t.is_finite() && hit.point.is_finite() && hit.uv.is_finite(),
                     "non-finite hit {hit:?}"
                 );
             }

@@ -1,0 +1,288 @@
+//! Non-rational cubic B-spline surfaces turned into Bézier patches by knot insertion.
+//!
+//! Boehm's algorithm (W. Boehm, "Inserting new knots into B-spline curves", CAD 12(4), 1980)
+//! inserts a knot without changing the curve. Inserting every distinct knot of the domain until
+//! it has multiplicity 3 (the degree) makes the control polygon of each knot span the Bézier
+//! control polygon of that span (Piegl & Tiller, *The NURBS Book*, §5.6). A surface is a tensor
+//! product: its rows are converted along `u`, then the resulting columns along `v`.
+//!
+//! [`de_boor`] evaluates a curve directly (de Boor 1972): the tests check the conversion
+//! against it.
+
+use glam::DVec3;
+
+use super::bezier::BezierPatch;
+use super::patch::Window;
+
+/// The degree handled here: bicubic.
+pub const DEGREE: usize = 3;
+
+/// Why a B-spline could not be converted. The messages name the knots and counts concerned;
+/// the caller adds the file and line.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum BsplineError {
+    /// The knot vector's length does not match the control points (`points + 4` knots).
+    #[error("{points} control points along {axis} need {} knots, the 'parm {axis}' line gives {knots}", points + DEGREE + 1)]
+    KnotCount {
+        /// `u` or `v`.
+        axis: char,
+        /// Control points along the axis.
+        points: usize,
+        /// Knots given.
+        knots: usize,
+    },
+    /// Too few control points for a cubic.
+    #[error("a cubic needs at least 4 control points along {axis}, found {points}")]
+    TooFewPoints {
+        /// `u` or `v`.
+        axis: char,
+        /// Control points along the axis.
+        points: usize,
+    },
+    /// A knot smaller than the one before it, or not finite.
+    #[error("the knots along {axis} must be finite and non-decreasing: knot {index} is {value} after {previous}")]
+    Decreasing {
+        /// `u` or `v`.
+        axis: char,
+        /// 1-based position of the offending knot.
+        index: usize,
+        /// Its value.
+        value: f64,
+        /// The knot before it.
+        previous: f64,
+    },
+    /// The parameter range is empty or reaches outside the knots' valid domain.
+    #[error("the parameter range [{start}, {end}] along {axis} must be non-empty and within the knots' domain [{low}, {high}]")]
+    Range {
+        /// `u` or `v`.
+        axis: char,
+        /// Range start.
+        start: f64,
+        /// Range end.
+        end: f64,
+        /// The domain's start (knot 4).
+        low: f64,
+        /// The domain's end (knot `points + 1`).
+        high: f64,
+    },
+}
+
+/// A cubic B-spline curve's knots along one axis, checked against its control point count.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Knots {
+    values: Vec<f64>,
+}
+
+impl Knots {
+    /// Checks `values` for `points` control points along `axis` (for messages).
+    pub fn new(values: Vec<f64>, points: usize, axis: char) -> Result<Knots, BsplineError> {
+        if points < DEGREE + 1 {
+            return Err(BsplineError::TooFewPoints { axis, points });
+        }
+        if values.len() != points + DEGREE + 1 {
+            return Err(BsplineError::KnotCount {
+                axis,
+                points,
+                knots: values.len(),
+            });
+        }
+        for (i, pair) in values.windows(2).enumerate() {
+            if !(pair[1] >= pair[0]) || !pair[1].is_finite() || !pair[0].is_finite() {
+                return Err(BsplineError::Decreasing {
+                    axis,
+                    index: i + 2,
+                    value: pair[1],
+                    previous: pair[0],
+                });
+            }
+        }
+        Ok(Knots { values })
+    }
+
+    /// The knots of a piecewise cubic Bézier curve with `breakpoints` (each segment's ends):
+    /// every inner breakpoint three times, the ends four times.
+    pub fn from_breakpoints(breakpoints: &[f64]) -> Vec<f64> {
+        let mut values = Vec::with_capacity(3 * breakpoints.len() + 2);
+        for (k, b) in breakpoints.iter().enumerate() {
+            let copies = if k == 0 || k + 1 == breakpoints.len() { 4 } else { 3 };
+            values.extend(std::iter::repeat_n(*b, copies));
+        }
+        values
+    }
+
+    /// The knot values.
+    pub fn values(&self) -> &[f64] {
+        &self.values
+    }
+
+    /// The valid parameter domain `[t_3, t_n]` (0-based knots, `n` control points).
+    pub fn domain(&self) -> (f64, f64) {
+        let n = self.values.len() - DEGREE - 1;
+        (self.values[DEGREE], self.values[n])
+    }
+
+    /// Checks that `[start, end]` is a non-empty part of the domain.
+    pub fn check_range(&self, start: f64, end: f64, axis: char) -> Result<(), BsplineError> {
+        let (low, high) = self.domain();
+        if start < end && start >= low && end <= high {
+            Ok(())
+        } else {
+            Err(BsplineError::Range {
+                axis,
+                start,
+                end,
+                low,
+                high,
+            })
+        }
+    }
+}
+
+/// What knot insertion blends: a point, or a row of points converted together.
+pub trait Lerp: Copy {
+    /// `self · (1 − a) + other · a`.
+    fn lerp_to(self, other: Self, a: f64) -> Self;
+}
+
+impl Lerp for DVec3 {
+    fn lerp_to(self, other: Self, a: f64) -> Self {
+        self * (1.0 - a) + other * a
+    }
+}
+
+impl<const N: usize> Lerp for [DVec3; N] {
+    fn lerp_to(self, other: Self, a: f64) -> Self {
+        std::array::from_fn(|k| self[k].lerp_to(other[k], a))
+    }
+}
+
+/// Inserts knot `t` (within the domain) once into `knots` and `points` (Boehm 1980); the curve
+/// is unchanged.
+fn insert_knot<T: Lerp>(knots: &mut Vec<f64>, points: &mut Vec<T>, t: f64) {
+    // The span k in [3, n] with knots[k] <= t <= knots[k + 1] (the last such span for a
+    // repeated knot; at the domain's end, the last span).
+    let n = points.len() - 1;
+    let k = knots.iter().rposition(|&u| u <= t).unwrap_or(DEGREE).clamp(DEGREE, n);
+    let mut out = Vec::with_capacity(points.len() + 1);
+    for i in 0..=points.len() {
+        let q = if i + DEGREE <= k {
+            points[i]
+        } else if i > k {
+            points[i - 1]
+        } else {
+            let span = knots[i + DEGREE] - knots[i];
+            let a = if span > 0.0 { (t - knots[i]) / span } else { 0.0 };
+            points[i - 1].lerp_to(points[i], a)
+        };
+        out.push(q);
+    }
+    knots.insert(k + 1, t);
+    *points = out;
+}
+
+/// How often `t` occurs in `knots`.
+fn multiplicity(knots: &[f64], t: f64) -> usize {
+    knots.iter().filter(|&&u| u == t).count()
+}
+
+/// The Bézier segments of the cubic B-spline curve (`points`, `knots`) over `[start, end]`:
+/// each segment's four control points and its parameter interval, in order.
+pub fn bezier_segments<T: Lerp>(points: &[T], knots: &Knots, start: f64, end: f64) -> Vec<([T; 4], (f64, f64))> {
+    let mut u = knots.values.clone();
+    let mut p = points.to_vec();
+    // Every distinct knot inside the range, and the range's ends, to multiplicity 3.
+    let mut breaks: Vec<f64> = u.iter().copied().filter(|&t| t > start && t < end).collect();
+    breaks.dedup();
+    breaks.insert(0, start);
+    breaks.push(end);
+    for &t in &breaks {
+        while multiplicity(&u, t) < DEGREE {
+            insert_knot(&mut u, &mut p, t);
+        }
+    }
+    // Span [u_k, u_k+1] now has Bézier points p[k-3..=k].
+    let mut out = Vec::with_capacity(breaks.len() - 1);
+    for pair in breaks.windows(2) {
+        let k = u.iter().rposition(|&x| x == pair[0]).unwrap_or(DEGREE);
+        let k = k.min(p.len() - 1).max(DEGREE);
+        out.push(([p[k - 3], p[k - 2], p[k - 1], p[k]], (pair[0], pair[1])));
+    }
+    out
+}
+
+/// A point of the cubic B-spline curve (`points`, `knots`) at `t` in its domain, by de Boor's
+/// algorithm.
+pub fn de_boor(points: &[DVec3], knots: &Knots, t: f64) -> DVec3 {
+    let u = &knots.values;
+    let n = points.len();
+    // The non-empty span k in [3, n-1] with u[k] <= t (the last span at the domain's end).
+    let k = (DEGREE..n).rev().find(|&k| u[k] <= t && u[k] < u[k + 1]).unwrap_or(DEGREE);
+    let mut d: Vec<DVec3> = (0..=DEGREE).map(|j| points[j + k - DEGREE]).collect();
+    for r in 1..=DEGREE {
+        for j in (r..=DEGREE).rev() {
+            let i = j + k - DEGREE;
+            let a = (t - u[i]) / (u[i + DEGREE + 1 - r] - u[i]);
+            d[j] = d[j - 1].lerp_to(d[j], a);
+        }
+    }
+    d[DEGREE]
+}
+
+/// A bicubic B-spline surface: control points `points[i + nu * j]` (`i` along `u` varying
+/// fastest, as Wavefront OBJ lists them), knots along `u` and `v`, and the parameter range
+/// to convert.
+#[derive(Clone, Debug)]
+pub struct BsplineSurface {
+    /// Control points, `u` fastest.
+    pub points: Vec<DVec3>,
+    /// Knots along `u` (`nu + 4` values).
+    pub u_knots: Knots,
+    /// Knots along `v`.
+    pub v_knots: Knots,
+    /// The range `[u0, u1] × [v0, v1]` of the surface to convert.
+    pub range: Window,
+}
+
+impl BsplineSurface {
+    /// Control points along `u`.
+    pub fn nu(&self) -> usize {
+        self.u_knots.values.len() - DEGREE - 1
+    }
+
+    /// A point of the surface, by de Boor along `u` on every row, then along `v`.
+    pub fn eval(&self, u: f64, v: f64) -> DVec3 {
+        let column: Vec<DVec3> = self
+            .points
+            .chunks_exact(self.nu())
+            .map(|row| de_boor(row, &self.u_knots, u))
+            .collect();
+        de_boor(&column, &self.v_knots, v)
+    }
+
+    /// The Bézier patches of the surface over its range, each with its `(u,v)` window in the
+    /// surface's own parameters, ordered by `u` span, then `v` span.
+    pub fn to_bezier(&self) -> Vec<(BezierPatch, Window)> {
+        let nu = self.nu();
+        let r = self.range;
+        // Along u for every row of constant v: rows[j] = segments of row j.
+        let rows: Vec<Vec<([DVec3; 4], (f64, f64))>> = self
+            .points
+            .chunks_exact(nu)
+            .map(|row| bezier_segments(row, &self.u_knots, r.u0, r.u1))
+            .collect();
+        let u_spans = rows.first().map_or(0, Vec::len);
+        let mut out = Vec::new();
+        for su in 0..u_spans {
+            // The column of 4-point groups along v for this u span, converted along v.
+            let column: Vec<[DVec3; 4]> = rows.iter().map(|row| row[su].0).collect();
+            let v_segments = bezier_segments(&column, &self.v_knots, r.v0, r.v1);
+            let (u0, u1) = rows[0][su].1;
+            for (quad, (v0, v1)) in v_segments {
+                // quad[jv][iu]: BezierPatch wants points[4 * iu + jv].
+                let points = std::array::from_fn(|k| quad[k % 4][k / 4]);
+                out.push((BezierPatch::new(points), Window { u0, u1, v0, v1 }));
+            }
+        }
+        out
+    }
+}

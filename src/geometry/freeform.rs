@@ -1,0 +1,395 @@
+//! Wavefront OBJ free-form surfaces in and out: the bicubic, non-rational `cstype bezier` and
+//! `cstype bspline` surfaces that CAD programs (Rhino, for one) export, read as Bézier patches
+//! with their parameter windows, and patches written back as `cstype bezier` surfaces.
+//!
+//! The statements read (Wavefront's *Object Files* appendix B1, "Free-form curve/surface
+//! attributes" and "body statements"): `v x y z [w]`, `cstype [rat] bezier|bspline`,
+//! `deg du dv`, `surf s0 s1 t0 t1 v1 v2 …` (control points with `u` varying fastest; negative
+//! indices count back from the last `v`), `parm u …`, `parm v …` (a B-spline's knots, a Bézier
+//! surface's breakpoints) and `end`; a line ending in `\` continues on the next. Polygons,
+//! texture vertices, groups and materials are ignored, and so are free-form curves. A
+//! B-spline surface is split into one Bézier patch per knot span by knot insertion
+//! ([`super::bspline`]), each with its `(u,v)` window in the surface's own parameters, so
+//! textures follow the original parameters.
+//!
+//! ```text
+//! v 0 0 0
+//! …                      (16 points)
+//! cstype bezier
+//! deg 3 3
+//! surf 0 1 0 1 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16
+//! parm u 0 1
+//! parm v 0 1
+//! end
+//! ```
+
+use std::path::{Path, PathBuf};
+
+use glam::DVec3;
+
+use super::bezier::BezierPatch;
+use super::bspline::{BsplineSurface, Knots, DEGREE};
+use super::patch::Window;
+
+/// A free-form OBJ file that cannot be read: which file, which line, what was wrong.
+#[derive(Debug, thiserror::Error)]
+#[error("{}:{line}: {message}", path.display())]
+pub struct FreeformError {
+    /// The file (as given).
+    pub path: PathBuf,
+    /// 1-based line number (0 when the file is unreadable).
+    pub line: usize,
+    /// What was wrong.
+    pub message: String,
+}
+
+/// A Bézier patch and its `(u,v)` window in the parameters of the surface it came from.
+pub type DomainPatch = (BezierPatch, Window);
+
+/// Reads every bicubic free-form surface of an OBJ file as Bézier patches.
+pub fn load_freeform_obj(path: &Path) -> Result<Vec<DomainPatch>, FreeformError> {
+    let text = std::fs::read_to_string(path).map_err(|e| FreeformError {
+        path: path.to_owned(),
+        line: 0,
+        message: format!("cannot read the file: {e}"),
+    })?;
+    parse_freeform_obj(&text, path)
+}
+
+/// A `v` line: the point, its weight and the line it stands on.
+struct Vertex {
+    point: DVec3,
+    weight: f64,
+    line: usize,
+}
+
+/// The type set by the last `cstype`.
+#[derive(Clone, Debug)]
+struct CurveType {
+    rational: bool,
+    name: String,
+    line: usize,
+}
+
+/// A `surf` being read, until its `end`.
+struct OpenSurface {
+    line: usize,
+    range: Window,
+    indices: Vec<usize>,
+    parm_u: Option<(Vec<f64>, usize)>,
+    parm_v: Option<(Vec<f64>, usize)>,
+    cstype: Option<CurveType>,
+    degree: Option<(Vec<String>, usize)>,
+}
+
+/// The logical lines of an OBJ file: comments removed, `\` continuations joined, each with the
+/// number of its first physical line.
+fn logical_lines(text: &str) -> Vec<(usize, String)> {
+    let mut out = Vec::new();
+    let mut pending: Option<(usize, String)> = None;
+    for (i, raw) in text.lines().enumerate() {
+        let line = raw.split('#').next().unwrap_or("").trim_end();
+        let (start, mut joined) = pending.take().unwrap_or((i + 1, String::new()));
+        if let Some(head) = line.strip_suffix('\\') {
+            joined.push_str(head);
+            joined.push(' ');
+            pending = Some((start, joined));
+        } else {
+            joined.push_str(line);
+            out.push((start, joined));
+        }
+    }
+    out.extend(pending);
+    out
+}
+
+struct Reader<'a> {
+    path: &'a Path,
+    vertices: Vec<Vertex>,
+    cstype: Option<CurveType>,
+    degree: Option<(Vec<String>, usize)>,
+    surface: Option<OpenSurface>,
+    /// A free-form curve is open: its `parm` and `end` are skipped.
+    in_curve: bool,
+    patches: Vec<DomainPatch>,
+}
+
+/// Parses OBJ text; `path` only names the source in errors.
+pub fn parse_freeform_obj(text: &str, path: &Path) -> Result<Vec<DomainPatch>, FreeformError> {
+    let mut reader = Reader {
+        path,
+        vertices: Vec::new(),
+        cstype: None,
+        degree: None,
+        surface: None,
+        in_curve: false,
+        patches: Vec::new(),
+    };
+    let lines = logical_lines(text);
+    for (line, content) in &lines {
+        let mut words = content.split_whitespace();
+        let Some(keyword) = words.next() else {
+            continue;
+        };
+        let args: Vec<&str> = words.collect();
+        reader.statement(*line, keyword, &args)?;
+    }
+    if let Some(open) = &reader.surface {
+        return Err(reader.err(open.line, "the surface has no 'end' statement".to_owned()));
+    }
+    if reader.patches.is_empty() {
+        return Err(reader.err(
+            lines.last().map_or(1, |l| l.0),
+            "no free-form surfaces ('surf' … 'end') in the file; a polygon mesh is an object of type \"mesh\"".to_owned(),
+        ));
+    }
+    Ok(reader.patches)
+}
+
+impl Reader<'_> {
+    fn err(&self, line: usize, message: String) -> FreeformError {
+        FreeformError {
+            path: self.path.to_owned(),
+            line,
+            message,
+        }
+    }
+
+    fn numbers(&self, line: usize, keyword: &str, args: &[&str]) -> Result<Vec<f64>, FreeformError> {
+        args.iter()
+            .map(|a| {
+                a.parse::<f64>()
+                    .ok()
+                    .filter(|v| v.is_finite())
+                    .ok_or_else(|| self.err(line, format!("'{keyword}': '{a}' is not a finite number")))
+            })
+            .collect()
+    }
+
+    fn statement(&mut self, line: usize, keyword: &str, args: &[&str]) -> Result<(), FreeformError> {
+        match keyword {
+            "v" => {
+                let n = self.numbers(line, "v", args)?;
+                if !(3..=4).contains(&n.len()) {
+                    return Err(self.err(line, format!("'v' takes 3 or 4 numbers 'x y z [w]', found {}", n.len())));
+                }
+                self.vertices.push(Vertex {
+                    point: DVec3::new(n[0], n[1], n[2]),
+                    weight: n.get(3).copied().unwrap_or(1.0),
+                    line,
+                });
+            }
+            "cstype" => {
+                let (rational, name) = match args {
+                    ["rat", name] => (true, *name),
+                    [name] => (false, *name),
+                    _ => return Err(self.err(line, "'cstype' takes '[rat] TYPE'".to_owned())),
+                };
+                self.cstype = Some(CurveType {
+                    rational,
+                    name: name.to_owned(),
+                    line,
+                });
+            }
+            "deg" => self.degree = Some((args.iter().map(|a| a.to_string()).collect(), line)),
+            "surf" => self.open_surface(line, args)?,
+            "curv" | "curv2" => self.in_curve = true,
+            "parm" => self.parm(line, args)?,
+            "trim" | "hole" | "scrv" | "sp" if self.surface.is_some() => {
+                return Err(self.err(
+                    line,
+                    format!("'{keyword}': trimmed surfaces and curves on surfaces are not supported (only whole bicubic surfaces)"),
+                ))
+            }
+            "end" => {
+                if self.surface.is_some() {
+                    self.close_surface(line)?;
+                } else if !std::mem::take(&mut self.in_curve) {
+                    return Err(self.err(line, "'end' without a 'surf' before it".to_owned()));
+                }
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+
+    fn open_surface(&mut self, line: usize, args: &[&str]) -> Result<(), FreeformError> {
+        if self.surface.is_some() {
+            return Err(self.err(line, "'surf' before the previous surface's 'end'".to_owned()));
+        }
+        if args.len() < 5 {
+            return Err(self.err(line, "'surf' takes 's0 s1 t0 t1' and the control points' indices".to_owned()));
+        }
+        let r = self.numbers(line, "surf", &args[..4])?;
+        let mut indices = Vec::with_capacity(args.len() - 4);
+        for a in &args[4..] {
+            let first = a.split('/').next().unwrap_or("");
+            let index: i64 = first
+                .parse()
+                .map_err(|_| self.err(line, format!("'surf': '{a}' is not a vertex index")))?;
+            let count = self.vertices.len() as i64;
+            let resolved = if index < 0 { count + index } else { index - 1 };
+            if index == 0 || !(0..count).contains(&resolved) {
+                return Err(self.err(
+                    line,
+                    format!("'surf': vertex index {index} is out of range ({count} vertices 'v' so far)"),
+                ));
+            }
+            indices.push(resolved as usize);
+        }
+        self.in_curve = false;
+        self.surface = Some(OpenSurface {
+            line,
+            range: Window {
+                u0: r[0],
+                u1: r[1],
+                v0: r[2],
+                v1: r[3],
+            },
+            indices,
+            parm_u: None,
+            parm_v: None,
+            cstype: self.cstype.clone(),
+            degree: self.degree.clone(),
+        });
+        Ok(())
+    }
+
+    fn parm(&mut self, line: usize, args: &[&str]) -> Result<(), FreeformError> {
+        if self.surface.is_none() {
+            if self.in_curve {
+                return Ok(());
+            }
+            return Err(self.err(line, "'parm' without a 'surf' before it".to_owned()));
+        }
+        let (axis, values) = match args {
+            [axis, "closed", rest @ ..] | [axis, rest @ ..] => (*axis, rest),
+            [] => return Err(self.err(line, "'parm' takes 'u' or 'v' and its values".to_owned())),
+        };
+        let values = self.numbers(line, "parm", values)?;
+        let Some(open) = self.surface.as_mut() else {
+            return Ok(());
+        };
+        match axis {
+            "u" => open.parm_u = Some((values, line)),
+            "v" => open.parm_v = Some((values, line)),
+            other => return Err(self.err(line, format!("'parm': expected 'u' or 'v', found '{other}'"))),
+        }
+        Ok(())
+    }
+
+    fn close_surface(&mut self, end_line: usize) -> Result<(), FreeformError> {
+        let Some(open) = self.surface.take() else {
+            return Ok(());
+        };
+        let line = open.line;
+        let bezier = match &open.cstype {
+            None => return Err(self.err(line, "the surface has no 'cstype' before it".to_owned())),
+            Some(c) if c.rational => {
+                return Err(self.err(
+                    line,
+                    format!("rational surfaces ('cstype rat {}', line {}) are not supported; only non-rational bicubic ones", c.name, c.line),
+                ))
+            }
+            Some(c) => match c.name.as_str() {
+                "bezier" => true,
+                "bspline" => false,
+                other => {
+                    return Err(self.err(
+                        line,
+                        format!("'cstype {other}' (line {}) is not supported; only 'bezier' and 'bspline'", c.line),
+                    ))
+                }
+            },
+        };
+        match &open.degree {
+            Some((d, _)) if d == &["3", "3"] => {}
+            Some((d, dline)) => {
+                return Err(self.err(
+                    line,
+                    format!("only bicubic surfaces ('deg 3 3') are supported; 'deg {}' is set on line {dline}", d.join(" ")),
+                ))
+            }
+            None => return Err(self.err(line, "the surface has no 'deg 3 3' before it".to_owned())),
+        }
+        if let Some(v) = open.indices.iter().map(|&i| &self.vertices[i]).find(|v| v.weight != 1.0) {
+            return Err(self.err(
+                line,
+                format!("control point on line {} has weight {}: rational surfaces are not supported", v.line, v.weight),
+            ));
+        }
+        let knots = |parm: &Option<(Vec<f64>, usize)>, axis: char| -> Result<(Vec<f64>, usize), FreeformError> {
+            let (values, pline) = parm
+                .clone()
+                .ok_or_else(|| self.err(end_line, format!("the surface on line {line} has no 'parm {axis}' line")))?;
+            if !bezier {
+                return Ok((values, pline));
+            }
+            if values.len() < 2 || values.windows(2).any(|w| w[1] <= w[0]) {
+                return Err(self.err(
+                    pline,
+                    format!("a Bézier surface's 'parm {axis}' needs two or more increasing breakpoints"),
+                ));
+            }
+            Ok((Knots::from_breakpoints(&values), pline))
+        };
+        let (u_values, u_line) = knots(&open.parm_u, 'u')?;
+        let (v_values, v_line) = knots(&open.parm_v, 'v')?;
+        let nu = u_values.len().saturating_sub(DEGREE + 1);
+        let nv = v_values.len().saturating_sub(DEGREE + 1);
+        if nu * nv != open.indices.len() {
+            return Err(self.err(
+                line,
+                format!(
+                    "the surface lists {} control points; its 'parm' lines (lines {u_line} and {v_line}) need {nu} × {nv} = {}",
+                    open.indices.len(),
+                    nu * nv
+                ),
+            ));
+        }
+        let u_knots = Knots::new(u_values, nu, 'u').map_err(|e| self.err(u_line, e.to_string()))?;
+        let v_knots = Knots::new(v_values, nv, 'v').map_err(|e| self.err(v_line, e.to_string()))?;
+        let r = open.range;
+        u_knots.check_range(r.u0, r.u1, 'u').map_err(|e| self.err(line, e.to_string()))?;
+        v_knots.check_range(r.v0, r.v1, 'v').map_err(|e| self.err(line, e.to_string()))?;
+        let surface = BsplineSurface {
+            points: open.indices.iter().map(|&i| self.vertices[i].point).collect(),
+            u_knots,
+            v_knots,
+            range: r,
+        };
+        let patches = surface.to_bezier();
+        let finite = |(p, w): &DomainPatch| p.points.iter().all(|q| q.is_finite()) && w.u1 - w.u0 < f64::INFINITY && w.v1 - w.v0 < f64::INFINITY;
+        if !patches.iter().all(finite) {
+            return Err(self.err(line, "the surface's knots or points are too large to convert (the result is not finite)".to_owned()));
+        }
+        self.patches.extend(patches);
+        Ok(())
+    }
+}
+
+/// Writes named groups of patches as OBJ `cstype bezier` surfaces: 16 `v` lines and one
+/// `surf` per patch, its window as the surface's range and breakpoints, numbers in their
+/// shortest round-trip form, so [`parse_freeform_obj`] reads the same points bit for bit.
+pub fn write_freeform_obj(groups: &[(String, Vec<DomainPatch>)], out: &mut impl std::io::Write) -> std::io::Result<()> {
+    writeln!(out, "# Bicubic Bézier patches written by caustic {}", env!("CARGO_PKG_VERSION"))?;
+    let mut next = 1usize;
+    for (name, patches) in groups {
+        writeln!(out, "g {name}")?;
+        for (patch, w) in patches {
+            // OBJ lists control points with u varying fastest: point iu + 4 jv.
+            for jv in 0..4 {
+                for iu in 0..4 {
+                    let p = patch.point(iu, jv);
+                    writeln!(out, "v {} {} {}", p.x, p.y, p.z)?;
+                }
+            }
+            writeln!(out, "cstype bezier\ndeg 3 3")?;
+            let indices: Vec<String> = (next..next + 16).map(|i| i.to_string()).collect();
+            writeln!(out, "surf {} {} {} {} {}", w.u0, w.u1, w.v0, w.v1, indices.join(" "))?;
+            writeln!(out, "parm u {} {}\nparm v {} {}\nend", w.u0, w.u1, w.v0, w.v1)?;
+            next += 16;
+        }
+    }
+    Ok(())
+}
