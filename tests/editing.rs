@@ -5,6 +5,8 @@
 //! the control-net overlay over a rendered teapot.
 #![cfg(feature = "viewer")]
 
+mod common;
+
 use std::path::Path;
 
 use caustic::app::overlay::{control_points, PointRef};
@@ -355,15 +357,23 @@ fn teapot_frame() -> Frame {
     frame
 }
 
-#[test]
-fn overlay_snapshot_over_the_teapot() {
-    let render_state = egui_kittest::wgpu::create_render_state(
-        egui_kittest::wgpu::default_wgpu_setup(),
-        eframe::egui_wgpu::RendererOptions::PREDICTABLE,
-    );
+/// `camera` turned about its up vector by `yaw` radians.
+fn turned(camera: &caustic::scene::Camera, yaw: f64) -> caustic::scene::Camera {
+    let mut c = camera.clone();
+    let turn = glam::DQuat::from_axis_angle(c.up, yaw);
+    (c.forward, c.right) = (turn * c.forward, turn * c.right);
+    c
+}
+
+/// The teapot's control nets drawn with wgpu over a rendered frame, one patch selected, seen
+/// by a camera that is the frame's turned by `yaw` radians; and the backend it rendered on.
+fn overlay_app<'a>(yaw: f64) -> (App<'a>, &'static str) {
+    let (render_state, backend) = common::gpu::render_state();
     let renderer = egui_kittest::wgpu::WgpuTestRenderer::from_render_state(render_state.clone());
     let mut h = harness(Harness::builder().renderer(renderer));
-    let mut v = Viewer::with_pause(&h.ctx, teapot(), ViewerSettings::default(), true);
+    let mut scene = teapot();
+    scene.camera = turned(&scene.camera, yaw);
+    let mut v = Viewer::with_pause(&h.ctx, scene, ViewerSettings::default(), true);
     // egui_kittest's render pass has no depth attachment.
     v.install_overlay(&render_state, None);
     v.show_frame(teapot_frame());
@@ -375,5 +385,40 @@ fn overlay_snapshot_over_the_teapot() {
     pointer(&mut h, s, PointerButton::Primary, false, Modifiers::NONE);
     h.key_press(egui::Key::A);
     h.run_steps(3);
-    h.snapshot("editing_overlay");
+    (h, backend)
+}
+
+#[test]
+fn overlay_snapshot_over_the_teapot() {
+    let (mut h, backend) = overlay_app(0.0);
+    h.snapshot(common::gpu::snapshot_name("editing_overlay", backend));
+}
+
+/// The snapshot's tolerance is tight enough to see the overlay off by one pixel: the same
+/// frame, with the control nets drawn by a camera turned by one screen pixel's angle, fails
+/// the comparison with the stored snapshot.
+#[test]
+fn the_overlay_one_pixel_off_fails_the_snapshot() {
+    use caustic::app::overlay::OverlayProjection;
+    let (camera, image, view) = {
+        let (h, _) = overlay_app(0.0);
+        let p = viewer(&h).projection().expect("the overlay is projected").clone();
+        (p.camera, p.image, p.view)
+    };
+    // The angle one screen pixel (one point here) subtends at the image centre.
+    let pixel_angle = (2.0 * (0.5 * camera.fov_y).tan() / f64::from(image.height())).atan();
+    let ahead = camera.position + camera.forward * 5.0;
+    let at = |c: &caustic::scene::Camera| OverlayProjection::new(c, image, view).to_screen(ahead);
+    let moved = (at(&turned(&camera, pixel_angle)).expect("ahead") - at(&camera).expect("ahead")).length();
+    assert!((moved - 1.0).abs() < 0.01, "the turn moves the overlay {moved} px");
+
+    let (mut shifted, backend) = overlay_app(pixel_angle);
+    let picture = shifted.render().expect("renders");
+    let stored = common::gpu::snapshot_path("editing_overlay", backend);
+    let failing = common::gpu::failing_pixels(&stored, &picture);
+    assert!(
+        failing > egui_kittest::SnapshotOptions::default().max_failed_pixels,
+        "a one-pixel shift of the overlay passes the snapshot ({failing} failing pixels)"
+    );
+    eprintln!("one-pixel overlay shift: {failing} pixels fail the snapshot");
 }

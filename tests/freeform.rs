@@ -95,7 +95,12 @@ fn a_uniform_5x5_bspline_becomes_four_patches_on_the_surface() {
     windows.sort_by(|a, b| a.partial_cmp(b).expect("finite"));
     assert_eq!(
         windows,
-        [[3.0, 4.0, 3.0, 4.0], [3.0, 4.0, 4.0, 5.0], [4.0, 5.0, 3.0, 4.0], [4.0, 5.0, 4.0, 5.0]]
+        [
+            [3.0, 4.0, 3.0, 4.0],
+            [3.0, 4.0, 4.0, 5.0],
+            [4.0, 5.0, 3.0, 4.0],
+            [4.0, 5.0, 4.0, 5.0]
+        ]
     );
     let mut worst: f64 = 0.0;
     for (patch, w) in &patches {
@@ -157,8 +162,24 @@ fn bezier_surfaces_with_several_segments_and_negative_indices_read() {
     );
     let patches = parse(&text).expect("reads");
     assert_eq!(patches.len(), 2);
-    assert_eq!(patches[0].1, Window { u0: 0.0, u1: 2.0, v0: 0.0, v1: 1.0 });
-    assert_eq!(patches[1].1, Window { u0: 2.0, u1: 5.0, v0: 0.0, v1: 1.0 });
+    assert_eq!(
+        patches[0].1,
+        Window {
+            u0: 0.0,
+            u1: 2.0,
+            v0: 0.0,
+            v1: 1.0
+        }
+    );
+    assert_eq!(
+        patches[1].1,
+        Window {
+            u0: 2.0,
+            u1: 5.0,
+            v0: 0.0,
+            v1: 1.0
+        }
+    );
     // Segment 2 starts at column 3: P_00 of the second patch is vertex (3, 0).
     assert_eq!(patches[1].0.point(0, 0), DVec3::new(3.0, 0.0, 0.0));
     assert_eq!(patches[1].0.point(3, 3), DVec3::new(6.0, 3.0, 0.0));
@@ -267,10 +288,12 @@ fn malformed_surfaces_are_errors_naming_the_file_and_line() {
     ];
     for (text, expected) in cases {
         let message = error(&text);
-        assert!(message.starts_with(expected), "expected '{expected}…', got '{message}'\n{text}");
+        assert!(
+            message.starts_with(expected),
+            "expected '{expected}…', got '{message}'\n{text}"
+        );
     }
 }
-
 
 #[test]
 fn a_scene_reads_obj_surfaces_and_textures_follow_their_parameters() {
@@ -347,7 +370,11 @@ fn export_obj_freeform_reads_back_to_the_same_patches() {
     // Without --force an existing file is kept.
     let again = common::caustic(&["export-obj", "--freeform", "--out", out.to_str().expect("utf-8")]);
     assert!(!again.status.success());
-    assert!(common::text(&again).contains("--force"), "{}", common::text(&again));
+    assert!(
+        common::text(&again).contains("--force"),
+        "{}",
+        common::text(&again)
+    );
 }
 
 /// `tests/data/geomdl_wave.obj`: a 6×5 bicubic B-spline surface with uneven knots, written as
@@ -362,7 +389,10 @@ fn a_surface_from_geomdl_matches_geomdls_own_evaluation() {
     let text = std::fs::read_to_string(data.join("geomdl_wave_points.txt")).expect("reads");
     let mut checked = 0;
     for line in text.lines().filter(|l| !l.starts_with('#')) {
-        let n: Vec<f64> = line.split_whitespace().map(|w| w.parse().expect("number")).collect();
+        let n: Vec<f64> = line
+            .split_whitespace()
+            .map(|w| w.parse().expect("number"))
+            .collect();
         let (u, v, expected) = (n[0], n[1], DVec3::new(n[2], n[3], n[4]));
         let (patch, w) = patches
             .iter()

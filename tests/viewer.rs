@@ -4,6 +4,8 @@
 //! window, and a snapshot of the whole window with a fixed frame (rendered with wgpu).
 #![cfg(feature = "viewer")]
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -356,11 +358,12 @@ fn a_render_thread_panic_is_shown_and_the_renderer_can_restart() {
 }
 
 /// A harness that renders the window with wgpu (paint callbacks included), 1100×880, no
-/// viewer yet.
-fn wgpu_harness<'a>() -> App<'a> {
-    Harness::builder()
+/// viewer yet, on whatever adapter this machine has; and that adapter's backend.
+fn wgpu_harness<'a>() -> (App<'a>, &'static str) {
+    let (renderer, backend) = common::gpu::renderer();
+    let h = Harness::builder()
         .with_size(egui::Vec2::new(1100.0, 880.0))
-        .wgpu()
+        .renderer(renderer)
         .build_ui_state(
             |ui, viewer: &mut Option<Viewer>| {
                 if let Some(v) = viewer {
@@ -368,7 +371,8 @@ fn wgpu_harness<'a>() -> App<'a> {
                 }
             },
             None,
-        )
+        );
+    (h, backend)
 }
 
 /// Four deterministic passes of the test scene as frames with fixed timings.
@@ -391,7 +395,7 @@ fn fixed_frames() -> Vec<Frame> {
 
 #[test]
 fn window_snapshot_with_a_fixed_frame() {
-    let mut h = wgpu_harness();
+    let (mut h, backend) = wgpu_harness();
     let mut v = Viewer::with_pause(&h.ctx, ball(), ViewerSettings::default(), true);
     for f in fixed_frames() {
         v.show_frame(f);
@@ -399,7 +403,7 @@ fn window_snapshot_with_a_fixed_frame() {
     v.settings.exposure_stops = -1.0;
     *h.state_mut() = Some(v);
     h.run_steps(4);
-    h.snapshot("viewer_window");
+    h.snapshot(common::gpu::snapshot_name("viewer_window", backend));
 }
 
 /// Storage as eframe hands it to the app: string values by key.
@@ -494,7 +498,7 @@ fn opening_a_reference_shows_the_true_error_curve_and_the_difference_view() {
         .save(&path, 0.0, &Vec::new(), false)
         .expect("write reference");
 
-    let mut h = wgpu_harness();
+    let (mut h, _) = wgpu_harness();
     let v = Viewer::with_pause(&h.ctx, ball(), ViewerSettings::default(), true);
     *h.state_mut() = Some(v);
     h.step();

@@ -86,7 +86,9 @@ pub fn export_obj(args: ExportArgs) -> Result<()> {
 
 /// The object name of each patch, as an OBJ group name (no spaces).
 fn group_name(scene: &caustic::scene::Scene, object: u32) -> String {
-    scene.objects[object as usize].name.replace(char::is_whitespace, "_")
+    scene.objects[object as usize]
+        .name
+        .replace(char::is_whitespace, "_")
 }
 
 /// Writes the scene's patches, as the scene file holds them (edits saved into it included), as

@@ -40,7 +40,9 @@ pub enum BsplineError {
         points: usize,
     },
     /// A knot smaller than the one before it, or not finite.
-    #[error("the knots along {axis} must be finite and non-decreasing: knot {index} is {value} after {previous}")]
+    #[error(
+        "the knots along {axis} must be finite and non-decreasing: knot {index} is {value} after {previous}"
+    )]
     Decreasing {
         /// `u` or `v`.
         axis: char,
@@ -104,7 +106,11 @@ impl Knots {
     pub fn from_breakpoints(breakpoints: &[f64]) -> Vec<f64> {
         let mut values = Vec::with_capacity(3 * breakpoints.len() + 2);
         for (k, b) in breakpoints.iter().enumerate() {
-            let copies = if k == 0 || k + 1 == breakpoints.len() { 4 } else { 3 };
+            let copies = if k == 0 || k + 1 == breakpoints.len() {
+                4
+            } else {
+                3
+            };
             values.extend(std::iter::repeat_n(*b, copies));
         }
         values
@@ -162,7 +168,11 @@ fn insert_knot<T: Lerp>(knots: &mut Vec<f64>, points: &mut Vec<T>, t: f64) {
     // The span k in [3, n] with knots[k] <= t <= knots[k + 1] (the last such span for a
     // repeated knot; at the domain's end, the last span).
     let n = points.len() - 1;
-    let k = knots.iter().rposition(|&u| u <= t).unwrap_or(DEGREE).clamp(DEGREE, n);
+    let k = knots
+        .iter()
+        .rposition(|&u| u <= t)
+        .unwrap_or(DEGREE)
+        .clamp(DEGREE, n);
     let mut out = Vec::with_capacity(points.len() + 1);
     for i in 0..=points.len() {
         let q = if i + DEGREE <= k {
@@ -187,7 +197,12 @@ fn multiplicity(knots: &[f64], t: f64) -> usize {
 
 /// The Bézier segments of the cubic B-spline curve (`points`, `knots`) over `[start, end]`:
 /// each segment's four control points and its parameter interval, in order.
-pub fn bezier_segments<T: Lerp>(points: &[T], knots: &Knots, start: f64, end: f64) -> Vec<([T; 4], (f64, f64))> {
+pub fn bezier_segments<T: Lerp>(
+    points: &[T],
+    knots: &Knots,
+    start: f64,
+    end: f64,
+) -> Vec<([T; 4], (f64, f64))> {
     let mut u = knots.values.clone();
     let mut p = points.to_vec();
     // Every distinct knot inside the range, and the range's ends, to multiplicity 3.
@@ -216,7 +231,10 @@ pub fn de_boor(points: &[DVec3], knots: &Knots, t: f64) -> DVec3 {
     let u = &knots.values;
     let n = points.len();
     // The non-empty span k in [3, n-1] with u[k] <= t (the last span at the domain's end).
-    let k = (DEGREE..n).rev().find(|&k| u[k] <= t && u[k] < u[k + 1]).unwrap_or(DEGREE);
+    let k = (DEGREE..n)
+        .rev()
+        .find(|&k| u[k] <= t && u[k] < u[k + 1])
+        .unwrap_or(DEGREE);
     let mut d: Vec<DVec3> = (0..=DEGREE).map(|j| points[j + k - DEGREE]).collect();
     for r in 1..=DEGREE {
         for j in (r..=DEGREE).rev() {

@@ -218,7 +218,10 @@ impl Reader<'_> {
             return Err(self.err(line, "'surf' before the previous surface's 'end'".to_owned()));
         }
         if args.len() < 5 {
-            return Err(self.err(line, "'surf' takes 's0 s1 t0 t1' and the control points' indices".to_owned()));
+            return Err(self.err(
+                line,
+                "'surf' takes 's0 s1 t0 t1' and the control points' indices".to_owned(),
+            ));
         }
         let r = self.numbers(line, "surf", &args[..4])?;
         let mut indices = Vec::with_capacity(args.len() - 4);
@@ -307,32 +310,47 @@ impl Reader<'_> {
             Some((d, dline)) => {
                 return Err(self.err(
                     line,
-                    format!("only bicubic surfaces ('deg 3 3') are supported; 'deg {}' is set on line {dline}", d.join(" ")),
+                    format!(
+                        "only bicubic surfaces ('deg 3 3') are supported; 'deg {}' is set on line {dline}",
+                        d.join(" ")
+                    ),
                 ))
             }
             None => return Err(self.err(line, "the surface has no 'deg 3 3' before it".to_owned())),
         }
-        if let Some(v) = open.indices.iter().map(|&i| &self.vertices[i]).find(|v| v.weight != 1.0) {
+        if let Some(v) = open
+            .indices
+            .iter()
+            .map(|&i| &self.vertices[i])
+            .find(|v| v.weight != 1.0)
+        {
             return Err(self.err(
                 line,
-                format!("control point on line {} has weight {}: rational surfaces are not supported", v.line, v.weight),
+                format!(
+                    "control point on line {} has weight {}: rational surfaces are not supported",
+                    v.line, v.weight
+                ),
             ));
         }
-        let knots = |parm: &Option<(Vec<f64>, usize)>, axis: char| -> Result<(Vec<f64>, usize), FreeformError> {
-            let (values, pline) = parm
-                .clone()
-                .ok_or_else(|| self.err(end_line, format!("the surface on line {line} has no 'parm {axis}' line")))?;
-            if !bezier {
-                return Ok((values, pline));
-            }
-            if values.len() < 2 || values.windows(2).any(|w| w[1] <= w[0]) {
-                return Err(self.err(
-                    pline,
-                    format!("a Bézier surface's 'parm {axis}' needs two or more increasing breakpoints"),
-                ));
-            }
-            Ok((Knots::from_breakpoints(&values), pline))
-        };
+        let knots =
+            |parm: &Option<(Vec<f64>, usize)>, axis: char| -> Result<(Vec<f64>, usize), FreeformError> {
+                let (values, pline) = parm.clone().ok_or_else(|| {
+                    self.err(
+                        end_line,
+                        format!("the surface on line {line} has no 'parm {axis}' line"),
+                    )
+                })?;
+                if !bezier {
+                    return Ok((values, pline));
+                }
+                if values.len() < 2 || values.windows(2).any(|w| w[1] <= w[0]) {
+                    return Err(self.err(
+                        pline,
+                        format!("a Bézier surface's 'parm {axis}' needs two or more increasing breakpoints"),
+                    ));
+                }
+                Ok((Knots::from_breakpoints(&values), pline))
+            };
         let (u_values, u_line) = knots(&open.parm_u, 'u')?;
         let (v_values, v_line) = knots(&open.parm_v, 'v')?;
         let nu = u_values.len().saturating_sub(DEGREE + 1);
@@ -350,8 +368,12 @@ impl Reader<'_> {
         let u_knots = Knots::new(u_values, nu, 'u').map_err(|e| self.err(u_line, e.to_string()))?;
         let v_knots = Knots::new(v_values, nv, 'v').map_err(|e| self.err(v_line, e.to_string()))?;
         let r = open.range;
-        u_knots.check_range(r.u0, r.u1, 'u').map_err(|e| self.err(line, e.to_string()))?;
-        v_knots.check_range(r.v0, r.v1, 'v').map_err(|e| self.err(line, e.to_string()))?;
+        u_knots
+            .check_range(r.u0, r.u1, 'u')
+            .map_err(|e| self.err(line, e.to_string()))?;
+        v_knots
+            .check_range(r.v0, r.v1, 'v')
+            .map_err(|e| self.err(line, e.to_string()))?;
         let surface = BsplineSurface {
             points: open.indices.iter().map(|&i| self.vertices[i].point).collect(),
             u_knots,
@@ -359,9 +381,17 @@ impl Reader<'_> {
             range: r,
         };
         let patches = surface.to_bezier();
-        let finite = |(p, w): &DomainPatch| p.points.iter().all(|q| q.is_finite()) && w.u1 - w.u0 < f64::INFINITY && w.v1 - w.v0 < f64::INFINITY;
+        let finite = |(p, w): &DomainPatch| {
+            p.points.iter().all(|q| q.is_finite())
+                && w.u1 - w.u0 < f64::INFINITY
+                && w.v1 - w.v0 < f64::INFINITY
+        };
         if !patches.iter().all(finite) {
-            return Err(self.err(line, "the surface's knots or points are too large to convert (the result is not finite)".to_owned()));
+            return Err(self.err(
+                line,
+                "the surface's knots or points are too large to convert (the result is not finite)"
+                    .to_owned(),
+            ));
         }
         self.patches.extend(patches);
         Ok(())
@@ -371,8 +401,15 @@ impl Reader<'_> {
 /// Writes named groups of patches as OBJ `cstype bezier` surfaces: 16 `v` lines and one
 /// `surf` per patch, its window as the surface's range and breakpoints, numbers in their
 /// shortest round-trip form, so [`parse_freeform_obj`] reads the same points bit for bit.
-pub fn write_freeform_obj(groups: &[(String, Vec<DomainPatch>)], out: &mut impl std::io::Write) -> std::io::Result<()> {
-    writeln!(out, "# Bicubic Bézier patches written by caustic {}", env!("CARGO_PKG_VERSION"))?;
+pub fn write_freeform_obj(
+    groups: &[(String, Vec<DomainPatch>)],
+    out: &mut impl std::io::Write,
+) -> std::io::Result<()> {
+    writeln!(
+        out,
+        "# Bicubic Bézier patches written by caustic {}",
+        env!("CARGO_PKG_VERSION")
+    )?;
     let mut next = 1usize;
     for (name, patches) in groups {
         writeln!(out, "g {name}")?;
@@ -386,7 +423,15 @@ pub fn write_freeform_obj(groups: &[(String, Vec<DomainPatch>)], out: &mut impl 
             }
             writeln!(out, "cstype bezier\ndeg 3 3")?;
             let indices: Vec<String> = (next..next + 16).map(|i| i.to_string()).collect();
-            writeln!(out, "surf {} {} {} {} {}", w.u0, w.u1, w.v0, w.v1, indices.join(" "))?;
+            writeln!(
+                out,
+                "surf {} {} {} {} {}",
+                w.u0,
+                w.u1,
+                w.v0,
+                w.v1,
+                indices.join(" ")
+            )?;
             writeln!(out, "parm u {} {}\nparm v {} {}\nend", w.u0, w.u1, w.v0, w.v1)?;
             next += 16;
         }

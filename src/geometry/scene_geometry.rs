@@ -19,7 +19,9 @@ use super::aabb::Aabb;
 use super::bezier::BezierPatch;
 use super::bvh::Bvh;
 use super::mesh::TriangleMesh;
-use super::patch::{intersect_leaf, intersect_per_ray, subdivide, PatchLeaf, RayFrame, SubdivisionParams, Window};
+use super::patch::{
+    intersect_leaf, intersect_per_ray, subdivide, PatchLeaf, RayFrame, SubdivisionParams, Window,
+};
 use super::quad::{Plane, Quad};
 use super::ray::{spawn_ray, Ray};
 use super::sphere::Sphere;

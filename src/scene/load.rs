@@ -10,7 +10,8 @@ use toml::Spanned;
 
 use super::camera::Camera;
 use super::format::{
-    CameraDesc, LightDesc, MaterialDesc, ObjectDesc, Real, ScaleDesc, SceneFile, TextureDesc, TransformDesc, Vec3,
+    CameraDesc, LightDesc, MaterialDesc, ObjectDesc, Real, ScaleDesc, SceneFile, TextureDesc, TransformDesc,
+    Vec3,
 };
 use super::light::Light;
 use super::material::{Material, MaterialKind};
@@ -578,43 +579,51 @@ fn object(
             builder.add_mesh(mesh, id);
         }
         "patches" => {
-            t.only("patches", &given, &["file", "builtin", "patches", "domains", "transform"])?;
+            t.only(
+                "patches",
+                &given,
+                &["file", "builtin", "patches", "domains", "transform"],
+            )?;
             let whole = |patches: Vec<BezierPatch>| patches.into_iter().map(|p| (p, Window::FULL)).collect();
-            let patches: Vec<(BezierPatch, Window)> = match (d.file.as_deref(), d.builtin.as_deref(), &d.patches) {
-                (Some(file), None, None) => {
-                    let path = ctx.resolve(&t.span, &format!("{label}: 'file'"), file)?;
-                    let obj = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"));
-                    if obj {
-                        load_freeform_obj(&path).map_err(|e| t.err(e))?
-                    } else {
-                        whole(load_bpt(&path).map_err(|e| t.err(e))?)
-                    }
-                }
-                (None, Some("teapot"), None) => whole(crate::assets::teapot()),
-                (None, Some(other), None) => {
-                    return Err(t.err(format!("unknown 'builtin' patches '{other}' (available: teapot)")))
-                }
-                (None, None, Some(list)) => {
-                    let mut out = Vec::new();
-                    for (i, points) in list.iter().enumerate() {
-                        if points.len() != 16 {
-                            return Err(t.err(format!(
-                                "'patches[{i}]' must have 16 control points, has {}",
-                                points.len()
-                            )));
+            let patches: Vec<(BezierPatch, Window)> =
+                match (d.file.as_deref(), d.builtin.as_deref(), &d.patches) {
+                    (Some(file), None, None) => {
+                        let path = ctx.resolve(&t.span, &format!("{label}: 'file'"), file)?;
+                        let obj = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"));
+                        if obj {
+                            load_freeform_obj(&path).map_err(|e| t.err(e))?
+                        } else {
+                            whole(load_bpt(&path).map_err(|e| t.err(e))?)
                         }
-                        out.push((BezierPatch::new(std::array::from_fn(|j| v3(&points[j]))), Window::FULL));
                     }
-                    if out.is_empty() {
-                        return Err(t.err("'patches' is empty"));
+                    (None, Some("teapot"), None) => whole(crate::assets::teapot()),
+                    (None, Some(other), None) => {
+                        return Err(t.err(format!("unknown 'builtin' patches '{other}' (available: teapot)")))
                     }
-                    if let Some(domains) = &d.domains {
-                        patch_domains(&t, &mut out, domains)?;
+                    (None, None, Some(list)) => {
+                        let mut out = Vec::new();
+                        for (i, points) in list.iter().enumerate() {
+                            if points.len() != 16 {
+                                return Err(t.err(format!(
+                                    "'patches[{i}]' must have 16 control points, has {}",
+                                    points.len()
+                                )));
+                            }
+                            out.push((
+                                BezierPatch::new(std::array::from_fn(|j| v3(&points[j]))),
+                                Window::FULL,
+                            ));
+                        }
+                        if out.is_empty() {
+                            return Err(t.err("'patches' is empty"));
+                        }
+                        if let Some(domains) = &d.domains {
+                            patch_domains(&t, &mut out, domains)?;
+                        }
+                        out
                     }
-                    out
-                }
-                _ => return Err(t.err("needs exactly one of 'file', 'builtin' or 'patches'")),
-            };
+                    _ => return Err(t.err("needs exactly one of 'file', 'builtin' or 'patches'")),
+                };
             if d.domains.is_some() && d.patches.is_none() {
                 return Err(t.err("'domains' applies only to inline 'patches'"));
             }

@@ -103,3 +103,6 @@ pub fn shared_edges(patches: &[BezierPatch]) -> Vec<SharedEdge> {
     }
     out
 }
+
+#[cfg(feature = "viewer")]
+pub mod gpu;

@@ -6,7 +6,8 @@
 use std::path::Path;
 
 use caustic::geometry::{
-    parse_bpt, parse_freeform_obj, write_freeform_obj, BezierPatch, GeometryBuilder, Ray, TriangleMesh, Window,
+    parse_bpt, parse_freeform_obj, write_freeform_obj, BezierPatch, GeometryBuilder, Ray, TriangleMesh,
+    Window,
 };
 use caustic::scene::texture::TextureSource;
 use caustic::scene::Scene;
@@ -51,11 +52,18 @@ pub fn freeform(data: &[u8]) {
     let Ok(patches) = parse_freeform_obj(text, Path::new("fuzz.obj")) else {
         return;
     };
-    assert!(patches.iter().all(|(_, w)| w.u0 < w.u1 && w.v0 < w.v1), "{patches:?}");
+    assert!(
+        patches.iter().all(|(_, w)| w.u0 < w.u1 && w.v0 < w.v1),
+        "{patches:?}"
+    );
     let mut out = Vec::new();
     write_freeform_obj(&[("fuzz".to_owned(), patches.clone())], &mut out).expect("writes to memory");
     let back = parse_freeform_obj(&String::from_utf8_lossy(&out), Path::new("fuzz-out.obj"));
-    assert_eq!(back.ok().as_ref(), Some(&patches), "the written surfaces read back differently");
+    assert_eq!(
+        back.ok().as_ref(),
+        Some(&patches),
+        "the written surfaces read back differently"
+    );
     shoot_at(&patches);
 }
 
