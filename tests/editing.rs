@@ -410,7 +410,10 @@ fn the_overlay_one_pixel_off_fails_the_snapshot() {
     let ahead = camera.position + camera.forward * 5.0;
     let at = |c: &caustic::scene::Camera| OverlayProjection::new(c, image, view).to_screen(ahead);
     let moved = (at(&turned(&camera, pixel_angle)).expect("ahead") - at(&camera).expect("ahead")).length();
-    assert!((moved - 1.0).abs() < 0.01, "the turn moves the overlay {moved} px");
+    assert!(
+        (moved - 1.0).abs() < 0.01,
+        "the turn moves the overlay {moved} px"
+    );
 
     let (mut shifted, backend) = overlay_app(pixel_angle);
     let picture = shifted.render().expect("renders");

@@ -291,6 +291,64 @@ fn save_writes_readable_png_and_exr_and_asks_before_replacing() {
     }
 }
 
+/// What rfd answers on a desktop with neither xdg-desktop-portal nor zenity: nothing, at once.
+fn no_native_dialog(_: &caustic::app::file_dialog::FileRequest) -> Option<PathBuf> {
+    None
+}
+
+#[test]
+fn without_a_native_dialog_the_frame_saves_through_the_window_s_own() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = harness(ball(), true);
+    for f in fixed_frames() {
+        viewer_mut(&mut h).show_frame(f);
+    }
+    viewer_mut(&mut h).set_native_dialog(no_native_dialog);
+    viewer_mut(&mut h).settings.last_directory = Some(dir.path().to_path_buf());
+    h.step();
+    h.get_by_role_and_label(Role::Button, "Save frame...").click();
+    step_until(&mut h, "the in-window dialog", Viewer::file_dialog_in_window);
+    h.run_steps(2);
+    // It never reports a cancel for the dialog that did not open.
+    assert!(
+        !matches!(viewer(&h).status(), Some(Status::Info(s)) if s.contains("cancelled")),
+        "{:?}",
+        viewer(&h).status()
+    );
+    assert!(h
+        .query_by_label("Types: PNG image (as displayed) (.png); OpenEXR image (linear radiance) (.exr)")
+        .is_some());
+    // The proposed name is there; replace it by typing, then Save.
+    let field = h.get_by_role_and_label(Role::TextInput, "File name:");
+    field.focus();
+    h.step();
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    h.get_by_role_and_label(Role::TextInput, "File name:")
+        .type_text("fallback.png");
+    h.step();
+    h.get_by_role_and_label(Role::Button, "Save").click();
+    let status = wait_saved(&mut h);
+    let saved = dir.path().join("fallback.png");
+    let Status::Info(text) = status else {
+        panic!("{status:?}");
+    };
+    assert!(text.contains("fallback.png"), "{text}");
+    let img = image::open(&saved).expect("the PNG reads back");
+    assert_eq!((img.width(), img.height()), (96, 72));
+    assert!(!viewer(&h).file_dialog_in_window());
+
+    // Escape closes the window's dialog as a cancel.
+    h.get_by_role_and_label(Role::Button, "Save frame...").click();
+    step_until(
+        &mut h,
+        "the in-window dialog again",
+        Viewer::file_dialog_in_window,
+    );
+    h.key_press(egui::Key::Escape);
+    step_until(&mut h, "the dialog to close", |v| !v.busy());
+    assert!(matches!(viewer(&h).status(), Some(Status::Info(s)) if s == "Save cancelled"));
+}
+
 #[test]
 fn bad_scene_shows_its_error_and_the_old_scene_keeps_rendering() {
     let dir = tempfile::tempdir().expect("temp dir");

@@ -15,7 +15,8 @@
 //! - [`convergence`]: the error estimate (and the true error against a reference) plotted
 //!   against time; [`reference`], [`difference`]: the reference image, the difference views
 //!   and the A/B toggle.
-//! - [`save`], [`job`]: dialogs and file writes off the UI thread; [`tev_send`]: the frame
+//! - [`save`], [`job`], [`file_dialog`]: dialogs (native, or inside the window where no native
+//!   one can be shown) and file writes off the UI thread; [`tev_send`]: the frame
 //!   to a running tev.
 //! - [`keys`], [`settings`], [`automation`]: shortcuts, stored preferences, scripted runs.
 
@@ -26,6 +27,7 @@ pub mod convergence;
 pub mod difference;
 pub mod edit_panel;
 pub mod editor;
+pub mod file_dialog;
 pub mod image_view;
 pub mod job;
 pub mod keys;

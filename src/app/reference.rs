@@ -6,6 +6,7 @@
 
 use std::path::PathBuf;
 
+use super::file_dialog::{FileDialog, FileRequest};
 use super::job::{Job, Poll};
 use super::viewer::{Status, Viewer};
 use crate::render::compare::{Reference, ReferenceErrors};
@@ -17,7 +18,7 @@ pub struct ReferenceState {
     pub(super) open: Option<Reference>,
     /// Shows the reference instead of the render (the A/B toggle).
     pub(super) show_reference: bool,
-    picking: Option<Job<Option<PathBuf>>>,
+    pub(super) picking: Option<FileDialog>,
     loading: Option<(Job<Result<Reference, String>>, PathBuf)>,
 }
 
@@ -66,16 +67,20 @@ impl Viewer {
         if self.reference.picking.is_some() {
             return;
         }
-        let dir = self.settings.last_directory.clone();
-        self.reference.picking = Some(Job::spawn("caustic-reference-dialog", &self.ctx, move || {
-            let mut dialog = rfd::FileDialog::new()
-                .set_title("Open reference image")
-                .add_filter("OpenEXR or PFM", &["exr", "pfm"]);
-            if let Some(d) = dir {
-                dialog = dialog.set_directory(d);
-            }
-            dialog.pick_file()
-        }));
+        let request = FileRequest {
+            title: "Open reference image".into(),
+            filters: vec![("OpenEXR or PFM".into(), vec!["exr".into(), "pfm".into()])],
+            directory: self.settings.last_directory.clone(),
+            file_name: None,
+            save: false,
+        };
+        let native = self.native_dialog();
+        self.reference.picking = Some(FileDialog::open(
+            "caustic-reference-dialog",
+            &self.ctx,
+            native,
+            request,
+        ));
     }
 
     /// Closes the reference (the difference views fall back to the radiance).

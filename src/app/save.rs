@@ -3,6 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
+use super::file_dialog::{FileDialog, FileRequest, NativeDialog};
 use super::job::{Job, Poll};
 use crate::render::film::Format;
 use crate::render::{Image, Metadata};
@@ -26,7 +27,7 @@ type Write = (Job<Result<(), String>>, PathBuf, u32);
 /// Where a save stands.
 #[derive(Default)]
 pub struct SaveFlow {
-    dialog: Option<(Job<Option<PathBuf>>, Snapshot)>,
+    dialog: Option<(FileDialog, Snapshot)>,
     /// A path that exists, waiting for the user to confirm replacing it.
     pub confirm: Option<(PathBuf, Snapshot)>,
     writing: Option<Write>,
@@ -63,10 +64,11 @@ impl SaveFlow {
         self.dialog.is_some() || self.confirm.is_some() || self.writing.is_some()
     }
 
-    /// Opens the save dialog for `snapshot`.
+    /// Opens the save dialog (shown by `native`, or inside the window) for `snapshot`.
     pub fn open_dialog(
         &mut self,
         ctx: &egui::Context,
+        native: NativeDialog,
         snapshot: Snapshot,
         directory: Option<PathBuf>,
         file_name: String,
@@ -74,18 +76,23 @@ impl SaveFlow {
         if self.busy() {
             return;
         }
-        let job = Job::spawn("caustic-save-dialog", ctx, move || {
-            let mut dialog = rfd::FileDialog::new()
-                .set_title("Save frame")
-                .add_filter("PNG image (as displayed)", &["png"])
-                .add_filter("OpenEXR image (linear radiance)", &["exr"])
-                .set_file_name(file_name);
-            if let Some(dir) = directory {
-                dialog = dialog.set_directory(dir);
-            }
-            dialog.save_file()
-        });
-        self.dialog = Some((job, snapshot));
+        let request = FileRequest {
+            title: "Save frame".into(),
+            filters: vec![
+                ("PNG image (as displayed)".into(), vec!["png".into()]),
+                ("OpenEXR image (linear radiance)".into(), vec!["exr".into()]),
+            ],
+            directory,
+            file_name: Some(file_name),
+            save: true,
+        };
+        let dialog = FileDialog::open("caustic-save-dialog", ctx, native, request);
+        self.dialog = Some((dialog, snapshot));
+    }
+
+    /// The open file dialog, if any (the viewer draws it when it is the window's own).
+    pub fn file_dialog(&self) -> Option<&FileDialog> {
+        self.dialog.as_ref().map(|(d, _)| d)
     }
 
     /// Saves `snapshot` to `path` (what happens once the dialog returned a path): asks before

@@ -5,7 +5,8 @@
 use std::path::PathBuf;
 
 use super::action::AfterDiscard;
-use super::job::{Job, Poll};
+use super::file_dialog::{FileDialog, FileRequest};
+use super::job::Poll;
 use super::viewer::{Status, Viewer};
 use crate::scene::save::save_scene;
 
@@ -70,21 +71,24 @@ impl Viewer {
         if self.scene_dialog.is_some() {
             return;
         }
-        let dir = self.settings.last_directory.clone();
         let name = match self.scene.source.file_stem() {
             Some(stem) if self.scene.base_dir.is_some() => format!("{}-edited.toml", stem.to_string_lossy()),
             _ => "scene.toml".to_owned(),
         };
-        self.scene_dialog = Some(Job::spawn("caustic-scene-dialog", &self.ctx, move || {
-            let mut dialog = rfd::FileDialog::new()
-                .set_title("Save scene")
-                .add_filter("caustic scene", &["toml"])
-                .set_file_name(name);
-            if let Some(d) = dir {
-                dialog = dialog.set_directory(d);
-            }
-            dialog.save_file()
-        }));
+        let request = FileRequest {
+            title: "Save scene".into(),
+            filters: vec![("caustic scene".into(), vec!["toml".into()])],
+            directory: self.settings.last_directory.clone(),
+            file_name: Some(name),
+            save: true,
+        };
+        let native = self.native_dialog();
+        self.scene_dialog = Some(FileDialog::open(
+            "caustic-scene-dialog",
+            &self.ctx,
+            native,
+            request,
+        ));
     }
 
     /// Takes the answer of the "save scene as" dialog.

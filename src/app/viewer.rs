@@ -10,6 +10,7 @@ use super::action::{Action, AfterDiscard};
 use super::controls;
 use super::convergence::Convergence;
 use super::editor::Editor;
+use super::file_dialog::{self, FileDialog, FileRequest, NativeDialog};
 use super::image_view::{frame_image, Comparison, ImageView, Probe};
 use super::job::{Job, Poll};
 use super::keys;
@@ -68,7 +69,9 @@ pub struct Viewer {
     /// Seconds from the last restart-type change to its first image.
     pub(super) restart_latency_secs: Option<f64>,
     pub(super) save: SaveFlow,
-    picking: Option<Job<Option<PathBuf>>>,
+    picking: Option<FileDialog>,
+    /// How native file dialogs are shown.
+    native_dialog: NativeDialog,
     loading: Option<(Job<Result<Scene, String>>, PathBuf)>,
     /// A scene that failed to open, with its error (shown in a window).
     pub(super) scene_error: Option<String>,
@@ -87,7 +90,7 @@ pub struct Viewer {
     /// Whether the wgpu overlay was installed in the renderer (else it is not drawn).
     pub(super) overlay_installed: bool,
     /// The "save scene as" dialog.
-    pub(super) scene_dialog: Option<Job<Option<PathBuf>>>,
+    pub(super) scene_dialog: Option<FileDialog>,
     /// A scene file waiting for the user to confirm replacing it.
     pub(super) confirm_scene_overwrite: Option<PathBuf>,
     /// What waits on the unsaved-edits question.
@@ -163,6 +166,7 @@ impl Viewer {
             restart_latency_secs: None,
             save: SaveFlow::default(),
             picking: None,
+            native_dialog: file_dialog::rfd_dialog,
             loading: None,
             scene_error: None,
             render_failure: None,
@@ -366,16 +370,19 @@ impl Viewer {
         if self.picking.is_some() {
             return;
         }
-        let dir = self.settings.last_directory.clone();
-        self.picking = Some(Job::spawn("caustic-open-dialog", &self.ctx, move || {
-            let mut dialog = rfd::FileDialog::new()
-                .set_title("Open scene")
-                .add_filter("caustic scene", &["toml"]);
-            if let Some(d) = dir {
-                dialog = dialog.set_directory(d);
-            }
-            dialog.pick_file()
-        }));
+        let request = FileRequest {
+            title: "Open scene".into(),
+            filters: vec![("caustic scene".into(), vec!["toml".into()])],
+            directory: self.settings.last_directory.clone(),
+            file_name: None,
+            save: false,
+        };
+        self.picking = Some(FileDialog::open(
+            "caustic-open-dialog",
+            &self.ctx,
+            self.native_dialog,
+            request,
+        ));
     }
 
     /// The current frame as something to save, with its metadata.
@@ -418,7 +425,8 @@ impl Viewer {
         };
         let name = default_file_name(&self.scene.source, snapshot.pass);
         let dir = self.settings.last_directory.clone();
-        self.save.open_dialog(&self.ctx, snapshot, dir, name);
+        self.save
+            .open_dialog(&self.ctx, self.native_dialog, snapshot, dir, name);
     }
 
     /// Saves the current frame to `path` (.png as displayed, .exr linear), asking before
@@ -560,7 +568,10 @@ impl Viewer {
     pub fn ui(&mut self, ui: &mut egui::Ui) {
         self.poll();
         let mut actions = Vec::new();
-        keys::handle(self, ui.ctx(), &mut actions);
+        // The window's own file dialog takes the keyboard (Enter, Escape) while it is open.
+        if !self.file_dialog_in_window() {
+            keys::handle(self, ui.ctx(), &mut actions);
+        }
         // Files dropped on the window open as scenes (the first one); images (.exr, .pfm)
         // open as the reference.
         let dropped: Option<PathBuf> = ui.input(|i| {
@@ -607,9 +618,40 @@ impl Viewer {
         }
         egui::CentralPanel::no_frame().show(ui, |ui| self.central_ui(ui, &mut actions));
         controls::dialogs_ui(self, ui.ctx(), &mut actions);
+        for dialog in self.file_dialogs() {
+            dialog.ui(ui.ctx());
+        }
         for action in actions {
             self.apply(action);
         }
+    }
+
+    /// The file dialogs under way (at most one of each kind).
+    fn file_dialogs(&self) -> impl Iterator<Item = &FileDialog> {
+        [
+            self.picking.as_ref(),
+            self.scene_dialog.as_ref(),
+            self.reference.picking.as_ref(),
+            self.save.file_dialog(),
+        ]
+        .into_iter()
+        .flatten()
+    }
+
+    /// Whether a file dialog is showing inside the window (no native one could be shown).
+    pub fn file_dialog_in_window(&self) -> bool {
+        self.file_dialogs().any(FileDialog::in_window)
+    }
+
+    /// How native file dialogs are shown.
+    pub(super) fn native_dialog(&self) -> NativeDialog {
+        self.native_dialog
+    }
+
+    /// Shows file dialogs with `native` instead of the desktop's (rfd). A dialog that returns
+    /// nothing at once counts as one that could not be shown, and the window's own opens.
+    pub fn set_native_dialog(&mut self, native: NativeDialog) {
+        self.native_dialog = native;
     }
 
     /// Whether the overlay is shown and can be edited.

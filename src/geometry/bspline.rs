@@ -89,7 +89,8 @@ impl Knots {
             });
         }
         for (i, pair) in values.windows(2).enumerate() {
-            if !(pair[1] >= pair[0]) || !pair[1].is_finite() || !pair[0].is_finite() {
+            let ordered = pair[0].is_finite() && pair[1].is_finite() && pair[1] >= pair[0];
+            if !ordered {
                 return Err(BsplineError::Decreasing {
                     axis,
                     index: i + 2,
@@ -195,6 +196,9 @@ fn multiplicity(knots: &[f64], t: f64) -> usize {
     knots.iter().filter(|&&u| u == t).count()
 }
 
+/// One Bézier segment of a curve: its four control points and its parameter interval.
+pub type Segment<T> = ([T; 4], (f64, f64));
+
 /// The Bézier segments of the cubic B-spline curve (`points`, `knots`) over `[start, end]`:
 /// each segment's four control points and its parameter interval, in order.
 pub fn bezier_segments<T: Lerp>(
@@ -283,7 +287,7 @@ impl BsplineSurface {
         let nu = self.nu();
         let r = self.range;
         // Along u for every row of constant v: rows[j] = segments of row j.
-        let rows: Vec<Vec<([DVec3; 4], (f64, f64))>> = self
+        let rows: Vec<Vec<Segment<DVec3>>> = self
             .points
             .chunks_exact(nu)
             .map(|row| bezier_segments(row, &self.u_knots, r.u0, r.u1))

@@ -39,7 +39,10 @@ pub fn render_state() -> (RenderState, &'static str) {
 /// A harness renderer on a fresh render state, and the backend it uses.
 pub fn renderer() -> (egui_kittest::wgpu::WgpuTestRenderer, &'static str) {
     let (state, backend) = render_state();
-    (egui_kittest::wgpu::WgpuTestRenderer::from_render_state(state), backend)
+    (
+        egui_kittest::wgpu::WgpuTestRenderer::from_render_state(state),
+        backend,
+    )
 }
 
 /// The snapshot name for `name` on `backend`: `tests/snapshots/{name}.{backend}.png`.

@@ -1,0 +1,270 @@
+#!/usr/bin/env python3
+"""Writes the Bézier-patch example scenes: scenes/pool.toml with assets/pool_water.obj (a
+bicubic B-spline water surface, 7×7 control points, so 4×4 Bézier patches), scenes/ring.toml (a
+mirror ring of 4 patches) and scenes/lens.toml (a biconvex lens of 2 patches).
+Run from the project folder: python3 assets/make_example_scenes.py"""
+import math
+
+K = 4 * (math.sqrt(2) - 1) / 3  # cubic Bézier quarter-circle handle length
+
+
+def fmt(v):
+    return "%.6g" % v
+
+
+def point(p):
+    return "[" + ", ".join(fmt(c) for c in p) + "]"
+
+
+def patch_toml(points):
+    """16 points, row i (along u) of four points (along v) per line."""
+    rows = [", ".join(point(points[4 * i + j]) for j in range(4)) for i in range(4)]
+    return "[\n    " + ",\n    ".join(rows) + ",\n]"
+
+
+# --- pool: gentle waves as a uniform bicubic B-spline, 11 x 11 control points 0.6 apart ---
+n = 11
+heights = []
+for j in range(n):
+    for i in range(n):
+        x, z = -3 + 0.6 * i, -3 + 0.6 * j
+        h = 1.7 * (0.16 * math.sin(3.3 * x + 0.7) * math.cos(2.9 * z - 0.4)
+             + 0.12 * math.sin(2.6 * z + 1.7 * x + 0.5) + 0.08 * math.cos(3.7 * x - 2.2 * z))
+        heights.append((x, h, z))
+lines = ["# Gentle waves: a bicubic B-spline surface (11 x 11 control points, uniform knots),",
+         "# 8 x 8 Bezier patches once read, over [-2.4, 2.4] in x and z.",
+         "# Made by assets/make_example_scenes.py."]
+for p in heights:
+    lines.append("v %s %s %s" % tuple(fmt(c) for c in p))
+lines += ["cstype bspline", "deg 3 3",
+          # u runs along z (j), v along x (i), so dP/du x dP/dv = +z x +x = +y: up, out of
+          # the water. OBJ lists u fastest: list position j + 11 i holds vertex (i, j).
+          "surf 3 11 3 11 " + " ".join(str(1 + j * n + i) for i in range(n) for j in range(n)),
+          "parm u " + " ".join(str(k) for k in range(n + 4)),
+          "parm v " + " ".join(str(k) for k in range(n + 4)), "end"]
+open("assets/pool_water.obj", "w").write("\n".join(lines) + "\n")
+
+# --- ring: a mirror cylinder of radius 1, height 0.6, 4 patches (one per quarter) ---
+ring = []
+for q in range(4):
+    a0, a1 = q * math.pi / 2, (q + 1) * math.pi / 2
+    c0, s0, c1, s1 = math.cos(a0), math.sin(a0), math.cos(a1), math.sin(a1)
+    arc = [(c0, s0), (c0 - K * s0, s0 + K * c0), (c1 + K * s1, s1 - K * c1), (c1, s1)]
+    pts = []
+    for i in range(4):              # u: up the wall
+        y = 0.6 * i / 3
+        for (x, z) in arc:          # v: around
+            pts.append((x, y, z))
+    ring.append(pts)
+
+# --- lens: two pillow-shaped patches sharing their square boundary, in the plane x = 0 ---
+def lens_patch(sign):
+    pts = []
+    for i in range(4):              # u along z
+        for j in range(4):          # v along y
+            y, z = -1 + 2 * j / 3, -1 + 2 * i / 3
+            inner = 0 < i < 3 and 0 < j < 3
+            pts.append((sign * 0.62 if inner else 0.0, y + 1.6, z))
+    return pts
+
+front = lens_patch(-1.0)   # faces the light (-x)
+back = lens_patch(1.0)
+# Normal = dP/du x dP/dv = +z x +y = -x for this order: right for the front; the back's rows
+# are reversed (u runs down) so that its normal faces +x, out of the glass.
+back = [back[4 * (3 - i) + j] for i in range(4) for j in range(4)]
+
+HEADER = "# Made by assets/make_example_scenes.py; edit that script, not this file, to change the\n# geometry (or edit the control points in the viewer and save).\n"
+
+open("scenes/pool.toml", "w").write(HEADER + """# A pool at noon: gentle waves (a bicubic B-spline surface from assets/pool_water.obj, read as
+# 8 x 8 Bezier patches of water, ior 1.33) over a tiled floor, lit by a small distant sphere
+# light. Each wave crest focuses the light: the floor shows the familiar network of bright
+# lines. Drag a wave's control point in the viewer and the network follows.
+
+[camera]
+position = [0.0, 4.2, 5.4]
+look_at = [0.0, -1.2, -0.2]
+fov = 42
+width = 640
+height = 480
+
+[render]
+renderer = "ppm"
+photons_per_pass = 400000
+max_depth = 10
+
+[materials.water]
+type = "glass"
+ior = 1.33
+color = [0.85, 0.95, 1.0]
+
+[materials.tiles]
+type = "diffuse"
+texture = { checker = [[0.8, 0.86, 0.88], [0.62, 0.74, 0.82]], mapping = "planar", normal = [0, 1, 0], scale = 2.0 }
+
+[materials.wall]
+type = "diffuse"
+color = [0.55, 0.75, 0.85]
+
+[[lights]]
+type = "sphere"
+center = [1.5, 9.0, -3.0]
+radius = 0.12
+power = 3500
+
+[[objects]]
+type = "patches"
+name = "water"
+file = "../assets/pool_water.obj"
+material = "water"
+
+[[objects]]
+type = "quad"
+name = "floor"
+corner = [-2.4, -1.5, -2.4]
+edge_u = [0, 0, 4.8]
+edge_v = [4.8, 0, 0]
+material = "tiles"
+
+[[objects]]
+type = "quad"
+name = "back wall"
+corner = [-2.4, -1.5, -2.4]
+edge_u = [4.8, 0, 0]
+edge_v = [0, 1.7, 0]
+material = "wall"
+
+[[objects]]
+type = "quad"
+name = "left wall"
+corner = [-2.4, -1.5, -2.4]
+edge_u = [0, 1.7, 0]
+edge_v = [0, 0, 4.8]
+material = "wall"
+
+[[objects]]
+type = "quad"
+name = "right wall"
+corner = [2.4, -1.5, -2.4]
+edge_u = [0, 0, 4.8]
+edge_v = [0, 1.7, 0]
+material = "wall"
+
+[[objects]]
+type = "quad"
+name = "front wall"
+corner = [-2.4, -1.5, 2.4]
+edge_u = [0, 1.7, 0]
+edge_v = [4.8, 0, 0]
+material = "wall"
+""")
+
+ring_text = ",\n".join(patch_toml(p) for p in ring)
+open("scenes/ring.toml", "w").write(HEADER + """# The coffee-cup caustic: a mirror ring (a cylinder of 4 bicubic patches, each a quarter
+# circle) on a table, lit by a point light low and off to one side. Light reflected inside the
+# ring gathers into a cardioid-like cusp on the table. Drag the ring's control points to bend
+# the cusp.
+
+[camera]
+position = [0.0, 4.0, 1.6]
+look_at = [0.0, 0.0, 0.05]
+fov = 40
+width = 640
+height = 480
+
+[render]
+renderer = "ppm"
+photons_per_pass = 400000
+
+[materials.mirror]
+type = "mirror"
+color = [0.95, 0.9, 0.8]
+
+[materials.table]
+type = "diffuse"
+color = [0.45, 0.4, 0.35]
+
+[[lights]]
+type = "point"
+position = [4.0, 1.6, 0.8]
+power = 1100
+
+[[objects]]
+type = "plane"
+name = "table"
+point = [0, 0, 0]
+normal = [0, 1, 0]
+material = "table"
+
+# Each line is one row of four control points at fixed u (height), running around the ring.
+[[objects]]
+type = "patches"
+name = "ring"
+material = "mirror"
+patches = [
+""" + ring_text + """,
+]
+""")
+
+open("scenes/lens.toml", "w").write(HEADER + """# A biconvex glass lens (two bicubic patches sharing their square rim) in front of a spot
+# light: the light is focused to a bright point on the wall behind it. Drag the lens's inner
+# control points to change its power and watch the spot sharpen or blur.
+
+[camera]
+position = [-2.2, 3.0, 5.0]
+look_at = [1.0, 1.3, 0.0]
+fov = 45
+width = 640
+height = 480
+
+[render]
+renderer = "ppm"
+photons_per_pass = 300000
+max_depth = 10
+
+[materials.glass]
+type = "glass"
+ior = 1.5
+
+[materials.wall]
+type = "diffuse"
+color = [0.8, 0.8, 0.8]
+
+[materials.floor]
+type = "diffuse"
+color = [0.5, 0.45, 0.4]
+
+[[lights]]
+type = "spot"
+position = [-4.0, 1.6, 0.0]
+direction = [1, 0, 0]
+cone_angle = 22
+power = 400
+
+[[lights]]
+type = "point"
+position = [-1.0, 4.5, 3.0]
+power = 60
+
+[[objects]]
+type = "plane"
+name = "wall"
+point = [2.5, 0, 0]
+normal = [-1, 0, 0]
+material = "wall"
+
+[[objects]]
+type = "plane"
+name = "floor"
+point = [0, 0, 0]
+normal = [0, 1, 0]
+material = "floor"
+
+# The face towards the light, then the back; each line one row of four control points.
+[[objects]]
+type = "patches"
+name = "lens"
+material = "glass"
+patches = [
+""" + patch_toml(front) + ",\n" + patch_toml(back) + """,
+]
+""")
