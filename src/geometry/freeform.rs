@@ -281,17 +281,19 @@ impl Reader<'_> {
         Ok(())
     }
 
-    fn close_surface(&mut self, end_line: usize) -> Result<(), FreeformError> {
-        let Some(open) = self.surface.take() else {
-            return Ok(());
-        };
+    /// Whether the open surface is a Bézier surface (else a B-spline): checks its type,
+    /// degree and weights.
+    fn check_kind(&self, open: &OpenSurface) -> Result<bool, FreeformError> {
         let line = open.line;
         let bezier = match &open.cstype {
             None => return Err(self.err(line, "the surface has no 'cstype' before it".to_owned())),
             Some(c) if c.rational => {
                 return Err(self.err(
                     line,
-                    format!("rational surfaces ('cstype rat {}', line {}) are not supported; only non-rational bicubic ones", c.name, c.line),
+                    format!(
+                        "rational surfaces ('cstype rat {}', line {}) are not supported; only non-rational bicubic ones",
+                        c.name, c.line
+                    ),
                 ))
             }
             Some(c) => match c.name.as_str() {
@@ -332,27 +334,45 @@ impl Reader<'_> {
                 ),
             ));
         }
-        let knots =
-            |parm: &Option<(Vec<f64>, usize)>, axis: char| -> Result<(Vec<f64>, usize), FreeformError> {
-                let (values, pline) = parm.clone().ok_or_else(|| {
-                    self.err(
-                        end_line,
-                        format!("the surface on line {line} has no 'parm {axis}' line"),
-                    )
-                })?;
-                if !bezier {
-                    return Ok((values, pline));
-                }
-                if values.len() < 2 || values.windows(2).any(|w| w[1] <= w[0]) {
-                    return Err(self.err(
-                        pline,
-                        format!("a Bézier surface's 'parm {axis}' needs two or more increasing breakpoints"),
-                    ));
-                }
-                Ok((Knots::from_breakpoints(&values), pline))
-            };
-        let (u_values, u_line) = knots(&open.parm_u, 'u')?;
-        let (v_values, v_line) = knots(&open.parm_v, 'v')?;
+        Ok(bezier)
+    }
+
+    /// The knot values of one `parm` line (a Bézier surface's breakpoints made knots), with
+    /// the line they stand on.
+    fn knot_values(
+        &self,
+        open: &OpenSurface,
+        axis: char,
+        bezier: bool,
+        end_line: usize,
+    ) -> Result<(Vec<f64>, usize), FreeformError> {
+        let parm = if axis == 'u' { &open.parm_u } else { &open.parm_v };
+        let (values, pline) = parm.clone().ok_or_else(|| {
+            self.err(
+                end_line,
+                format!("the surface on line {} has no 'parm {axis}' line", open.line),
+            )
+        })?;
+        if !bezier {
+            return Ok((values, pline));
+        }
+        if values.len() < 2 || values.windows(2).any(|w| w[1] <= w[0]) {
+            return Err(self.err(
+                pline,
+                format!("a Bézier surface's 'parm {axis}' needs two or more increasing breakpoints"),
+            ));
+        }
+        Ok((Knots::from_breakpoints(&values), pline))
+    }
+
+    fn close_surface(&mut self, end_line: usize) -> Result<(), FreeformError> {
+        let Some(open) = self.surface.take() else {
+            return Ok(());
+        };
+        let line = open.line;
+        let bezier = self.check_kind(&open)?;
+        let (u_values, u_line) = self.knot_values(&open, 'u', bezier, end_line)?;
+        let (v_values, v_line) = self.knot_values(&open, 'v', bezier, end_line)?;
         let nu = u_values.len().saturating_sub(DEGREE + 1);
         let nv = v_values.len().saturating_sub(DEGREE + 1);
         if nu * nv != open.indices.len() {
@@ -382,9 +402,7 @@ impl Reader<'_> {
         };
         let patches = surface.to_bezier();
         let finite = |(p, w): &DomainPatch| {
-            p.points.iter().all(|q| q.is_finite())
-                && w.u1 - w.u0 < f64::INFINITY
-                && w.v1 - w.v0 < f64::INFINITY
+            p.points.iter().all(|q| q.is_finite()) && (w.u1 - w.u0).is_finite() && (w.v1 - w.v0).is_finite()
         };
         if !patches.iter().all(finite) {
             return Err(self.err(
