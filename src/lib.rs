@@ -6,6 +6,8 @@
 //! * [`geometry`]: rays, bounds, Bézier patch maths, exact ray/patch intersection (prepared
 //!   sub-patches + Newton, and the seed's per-ray subdivision as a reference), spheres, quads,
 //!   planes, triangle meshes and the SAH BVH holding them.
+//! * [`settings`]: the render settings and their ranges, below both scene and render;
+//!   [`color`]: the sRGB transfer pair.
 //! * [`scene`]: the TOML scene format, validation, camera, materials, textures, lights.
 //! * [`render`]: the Whitted ray tracer, the film and its PNG/EXR output, random streams.
 //! * [`assets`]: the data the binary carries built in (Newell's teapot).
@@ -23,10 +25,12 @@
 pub mod app;
 pub mod assets;
 pub mod bench;
+pub mod color;
 pub mod files;
 pub mod geometry;
 #[cfg(feature = "viewer")]
 pub mod gpu;
 pub mod render;
 pub mod scene;
+pub mod settings;
 pub mod tev;

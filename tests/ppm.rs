@@ -6,10 +6,11 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use caustic::render::ppm::photon::{PhotonCounts, PhotonSource};
-use caustic::render::ppm::{Control, IndexKind, PassOutcome, Ppm, PpmOptions};
+use caustic::render::ppm::{Control, PassOutcome, Ppm, PpmOptions};
 use caustic::render::rng::stream_rng;
 use caustic::render::session::{Command, Frame, RenderSession, SessionOptions};
 use caustic::scene::Scene;
+use caustic::settings::IndexKind;
 use glam::{DVec2, DVec3};
 
 const PLANE: &str = r#"

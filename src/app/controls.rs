@@ -9,8 +9,8 @@ use super::keys::HELP;
 use super::params::{ALPHA_RANGE, DEPTH_RANGE, PHOTONS_RANGE};
 use super::settings::{DisplayMode, Zoom};
 use super::viewer::{Status, Viewer};
-use crate::render::ppm::IndexKind;
 use crate::scene::RendererKind;
+use crate::settings::IndexKind;
 
 /// Seconds as `1.23 s` or `4 min 05 s`.
 fn duration(secs: f64) -> String {
@@ -327,7 +327,7 @@ pub fn side_panel_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) 
         {
             p.set_auto_indirect_scale(auto_indirect);
         }
-        let range = crate::render::limits::RADIUS_SCALE;
+        let range = crate::settings::limits::RADIUS_SCALE;
         if ui
             .add_enabled(
                 !auto_indirect,

@@ -1,9 +1,9 @@
 //! What the side panel edits — the render parameters, the lens, pause — their slider
 //! ranges, and the commands a change sends to the render session.
 
-use crate::render::params::RenderParams;
 use crate::render::session::Command;
 use crate::scene::{Camera, Scene};
+use crate::settings::RenderParams;
 
 /// Values shown by the side panel (start from the scene file).
 #[derive(Clone, Debug, PartialEq)]
@@ -39,8 +39,8 @@ pub const PHOTONS_RANGE: (u64, u64) = (1_000, 10_000_000);
 pub const ALPHA_RANGE: (f64, f64) = (0.05, 1.0);
 /// Depth slider range: all the session accepts.
 pub const DEPTH_RANGE: (u32, u32) = (
-    *crate::render::limits::MAX_DEPTH.start(),
-    *crate::render::limits::MAX_DEPTH.end(),
+    *crate::settings::limits::MAX_DEPTH.start(),
+    *crate::settings::limits::MAX_DEPTH.end(),
 );
 
 impl PanelParams {

@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::render::params::RenderParams;
 use crate::scene::Scene;
+use crate::settings::RenderParams;
 
 /// What a reference render was made from.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

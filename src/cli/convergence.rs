@@ -13,10 +13,11 @@ use super::photon_map;
 use caustic::bench::convergence::{errors, write_csv, Checkpoint, Curve};
 use caustic::bench::plot::write_plot;
 use caustic::bench::reference::{default_cache_dir, ReferenceRecord};
-use caustic::render::params::RenderParams;
-use caustic::render::ppm::{IndexKind, Ppm};
+use caustic::render::ppm::Ppm;
 use caustic::render::session::SessionOptions;
 use caustic::scene::{RendererKind, Scene};
+use caustic::settings::IndexKind;
+use caustic::settings::RenderParams;
 
 /// A configuration measured: the scene's parameters with one thing changed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -227,7 +228,7 @@ pub fn bench_convergence(args: ConvergenceArgs, out: &mut BenchOutput) -> Result
 }
 
 fn check(width: &u32, seconds: f64, baseline: Option<f64>, passes: u32) -> Result<()> {
-    caustic::render::limits::image_side(*width).map_err(|e| anyhow::anyhow!("--width {e}"))?;
+    caustic::settings::limits::image_side(*width).map_err(|e| anyhow::anyhow!("--width {e}"))?;
     for (flag, s) in [("--seconds", Some(seconds)), ("--baseline-seconds", baseline)] {
         if let Some(s) = s {
             if !(s.is_finite() && s > 0.0 && s <= 86_400.0) {

@@ -57,7 +57,7 @@ pub fn bench_memory(args: MemoryArgs, out: &mut BenchOutput) -> Result<()> {
     }
     let mut scene = load_scene(args.scene.as_deref())?;
     for (flag, v) in [("--width", args.width), ("--height", args.height)] {
-        caustic::render::limits::image_side(v).map_err(|e| anyhow::anyhow!("{flag} {e}"))?;
+        caustic::settings::limits::image_side(v).map_err(|e| anyhow::anyhow!("{flag} {e}"))?;
     }
     (scene.camera.width, scene.camera.height) = (args.width, args.height);
     // An open aperture: stochastic PPM, a new eye pass (and new visible points) every pass.

@@ -12,12 +12,13 @@ use super::render_report::{RendererSummary, Report};
 use super::{load_scene, photon_map, ppm_stats};
 use caustic::render::compare::Reference;
 use caustic::render::error::pixel_error_estimate;
-use caustic::render::params::RenderParams;
-use caustic::render::ppm::IndexKind;
 use caustic::render::provenance::{self, software, Recorded};
 use caustic::render::session::{Frame, SessionOptions};
-use caustic::render::{image_metadata, limits, render_whitted, Image, Layer};
+use caustic::render::{image_metadata, render_whitted, Image, Layer};
 use caustic::scene::{RendererKind, Scene};
+use caustic::settings::limits;
+use caustic::settings::IndexKind;
+use caustic::settings::RenderParams;
 use caustic::tev::TevStream;
 
 /// `caustic render`'s flags.

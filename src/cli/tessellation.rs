@@ -84,7 +84,7 @@ pub fn bench_tessellation(args: TessellationArgs, out: &mut BenchOutput) -> Resu
             );
         }
     }
-    caustic::render::limits::image_side(args.width).map_err(|e| anyhow::anyhow!("--width {e}"))?;
+    caustic::settings::limits::image_side(args.width).map_err(|e| anyhow::anyhow!("--width {e}"))?;
     scene.camera.resize(Some(args.width), None);
     let (w, h) = (scene.camera.width, scene.camera.height);
     let patches = scene.geometry.patches().len();

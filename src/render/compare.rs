@@ -137,10 +137,10 @@ pub fn read_pfm(bytes: &[u8]) -> Result<Image, String> {
     };
     let side = |s: &str, what: &str| -> Result<u32, String> {
         match s.parse::<u32>() {
-            Ok(v) if super::limits::IMAGE_SIDE.contains(&v) => Ok(v),
+            Ok(v) if crate::settings::limits::IMAGE_SIDE.contains(&v) => Ok(v),
             _ => Err(format!(
                 "the PFM {what} {s:?} is not a whole number between 1 and {}",
-                super::limits::IMAGE_SIDE.end()
+                crate::settings::limits::IMAGE_SIDE.end()
             )),
         }
     };

@@ -3,6 +3,7 @@
 //! custom string attributes) carrying the render's metadata. Files are written to a temporary
 //! name beside the target and renamed, so a failed write never leaves half a file.
 
+use crate::color::linear_to_srgb;
 use std::path::{Path, PathBuf};
 
 /// A linear RGB image, rows from the top.
@@ -46,24 +47,6 @@ pub enum FilmError {
         /// What failed.
         message: String,
     },
-}
-
-/// The sRGB transfer pair (IEC 61966-2-1): the encoded value of a linear one in [0, 1]...
-pub fn linear_to_srgb(v: f32) -> f32 {
-    if v <= 0.003_130_8 {
-        12.92 * v
-    } else {
-        1.055 * v.powf(1.0 / 2.4) - 0.055
-    }
-}
-
-/// ...and the linear value of an encoded one in [0, 1] (texture images are read with it).
-pub fn srgb_to_linear(c: f64) -> f64 {
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
 }
 
 /// The output formats.
@@ -271,8 +254,6 @@ mod tests {
 
     #[test]
     fn srgb_curve_endpoints() {
-        assert_eq!(linear_to_srgb(0.0), 0.0);
-        assert!((linear_to_srgb(1.0) - 1.0).abs() < 1e-6);
         let img = Image {
             width: 1,
             height: 1,

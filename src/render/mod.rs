@@ -6,8 +6,6 @@
 pub mod compare;
 pub mod error;
 pub mod film;
-pub mod limits;
-pub mod params;
 pub mod ppm;
 pub mod provenance;
 pub mod rng;

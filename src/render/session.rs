@@ -25,12 +25,12 @@ use std::time::{Duration, Instant};
 use crossbeam_channel::{bounded, unbounded, Receiver, Sender, TryRecvError};
 use glam::DVec3;
 
-use super::limits;
-use super::params::RenderParams;
 use super::ppm::{Control, Interrupt, PassOutcome, Ppm, PpmOptions, PpmStats};
 use super::whitted::{render_whitted_until, WhittedStats};
 use crate::geometry::BezierPatch;
 use crate::scene::{Camera, RendererKind, Scene};
+use crate::settings::limits;
+use crate::settings::RenderParams;
 
 /// What the UI (or a test) asks of the renderer.
 #[derive(Clone, Debug, PartialEq)]

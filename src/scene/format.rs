@@ -82,7 +82,7 @@ pub struct SceneFile {
     pub camera: Spanned<CameraDesc>,
     /// `[render]`: the render parameters themselves (defaults for what it leaves out).
     #[serde(default)]
-    pub render: Option<Spanned<crate::render::params::RenderParams>>,
+    pub render: Option<Spanned<crate::settings::RenderParams>>,
     /// Radiance of rays that leave the scene (default black).
     #[serde(default)]
     pub background: Option<Vec3>,

@@ -20,7 +20,7 @@ use super::{RenderParams, Scene, SceneObject};
 use crate::geometry::{
     load_bpt, load_freeform_obj, BezierPatch, GeometryBuilder, Plane, Quad, Sphere, TriangleMesh, Window,
 };
-use crate::render::limits;
+use crate::settings::limits;
 
 /// A scene file that cannot be used: where, and why.
 #[derive(Debug, thiserror::Error)]

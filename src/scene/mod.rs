@@ -14,7 +14,7 @@ use std::path::PathBuf;
 
 use glam::{DVec2, DVec3};
 
-pub use crate::render::params::{RenderParams, RendererKind};
+pub use crate::settings::{RenderParams, RendererKind};
 
 pub use camera::Camera;
 pub use light::Light;

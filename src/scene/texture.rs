@@ -69,7 +69,7 @@ pub struct TextureError {
 
 /// An 8-bit sRGB-encoded channel as linear.
 fn srgb_to_linear(c: u8) -> f64 {
-    crate::render::film::srgb_to_linear(c as f64 / 255.0)
+    crate::color::srgb_to_linear(c as f64 / 255.0)
 }
 
 impl TextureSource {

@@ -12,7 +12,7 @@ use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
 use super::limits;
-use super::ppm::IndexKind;
+use super::IndexKind;
 
 /// Which renderer makes the image (`--renderer whitted|ppm` on the command line,
 /// `renderer = "whitted"|"ppm"` in a scene file).

@@ -46,6 +46,7 @@ use super::rng::stream_rng;
 use super::sequence;
 use crate::scene::camera::concentric_disk;
 use crate::scene::Scene;
+use crate::settings::IndexKind;
 
 /// Random stream ids of photon mapping.
 mod streams {
@@ -57,7 +58,7 @@ mod streams {
 
 /// How the indirect estimate's radius is chosen ([`RenderParams::indirect_radius_scale`]).
 ///
-/// [`RenderParams::indirect_radius_scale`]: crate::render::params::RenderParams::indirect_radius_scale
+/// [`RenderParams::indirect_radius_scale`]: crate::settings::RenderParams::indirect_radius_scale
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum IndirectScale {
     /// One estimate for all photons.
@@ -113,23 +114,6 @@ fn compact(deposits: &mut Vec<Deposit>) {
         }
     }
     *deposits = merged;
-}
-
-/// Which spatial index finds the visible points near a photon (`--index grid|kd` on the
-/// command line; stored by name in the viewer's preferences).
-#[derive(
-    Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum,
-)]
-pub enum IndexKind {
-    /// Hashed uniform grid, rebuilt per pass (default).
-    #[default]
-    #[value(name = "grid")]
-    #[serde(rename = "grid")]
-    HashGrid,
-    /// The seed report's kd-tree with per-subtree maximum radius.
-    #[value(name = "kd")]
-    #[serde(rename = "kd")]
-    KdTree,
 }
 
 /// How photon mapping runs, beyond the scene's render parameters (which hold every setting
@@ -237,7 +221,7 @@ impl Estimate {
 /// estimates, since photons that have bounced off a diffuse surface carry light that varies
 /// slowly and are gathered over a wider radius ([`RenderParams::indirect_radius_scale`]).
 ///
-/// [`RenderParams::indirect_radius_scale`]: crate::render::params::RenderParams::indirect_radius_scale
+/// [`RenderParams::indirect_radius_scale`]: crate::settings::RenderParams::indirect_radius_scale
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Slot {
     /// The pixel it contributes to.
