@@ -1,0 +1,169 @@
+//! One progressive density estimate and its update rule (Hachisuka et al. 2008 §4:
+//! `N' = N + αM`, `R'² = R²·(N + αM)/(N + M)`, `τ' = (τ + Φ)·(N + αM)/(N + M)`), the statistics
+//! slot that holds a point's two estimates, and the update of every slot after a pass.
+
+use std::f64::consts::PI;
+
+use super::photon_pass::Gathered;
+use super::radius::IndirectScale;
+use super::Ppm;
+use glam::DVec3;
+
+/// One progressive density estimate (Hachisuka et al. 2008 §4): search radius², photon
+/// count `N` and flux `τ`, updated after every pass.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Estimate {
+    /// Search radius².
+    pub radius2: f64,
+    /// Accumulated photon count `N`.
+    pub n: f64,
+    /// Accumulated flux `τ`.
+    pub tau: DVec3,
+}
+
+impl Estimate {
+    /// Folds in a pass that brought `m` photons of flux `phi` within the radius (eqs. 6–11):
+    /// the radius shrinks so that a share α of the new photons is kept.
+    pub(super) fn update(&mut self, phi: DVec3, m: u32, alpha: f64) {
+        let m = m as f64;
+        if m > 0.0 {
+            let g = (self.n + alpha * m) / (self.n + m);
+            self.radius2 *= g;
+            self.tau = (self.tau + phi) * g;
+            self.n += alpha * m;
+        }
+    }
+
+    /// The estimate brought to radius² `radius2` as PPM's update assumes, for a density
+    /// uniform within the radius: N and τ scaled by the area (an estimate without a radius
+    /// holds nothing to scale).
+    pub(super) fn resized(self, radius2: f64) -> Self {
+        let share = if self.radius2 > 0.0 {
+            radius2 / self.radius2
+        } else {
+            0.0
+        };
+        Self {
+            radius2,
+            n: self.n * share,
+            tau: self.tau * share,
+        }
+    }
+
+    /// Reflected radiance `τ/(π R² N_emitted)`.
+    pub(super) fn radiance(&self, emitted: f64) -> DVec3 {
+        if self.radius2 > 0.0 {
+            self.tau / (PI * self.radius2 * emitted)
+        } else {
+            DVec3::ZERO
+        }
+    }
+}
+
+/// Accumulated statistics of one gathering point (classic PPM) or pixel (stochastic PPM): two
+/// estimates, since photons that have bounced off a diffuse surface carry light that varies
+/// slowly and are gathered over a wider radius ([`RenderParams::indirect_radius_scale`]).
+///
+/// [`RenderParams::indirect_radius_scale`]: crate::settings::RenderParams::indirect_radius_scale
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Slot {
+    /// The pixel it contributes to.
+    pub pixel: u32,
+    /// Photons straight from a light or through mirrors and glass only: direct light (when
+    /// light sampling is off) and caustics — every photon when one estimate is kept
+    /// (`indirect_radius_scale = 1`).
+    pub primary: Estimate,
+    /// Photons after a diffuse bounce (indirect light), when the scale is above 1.
+    pub indirect: Estimate,
+    /// Whether the primary estimate was restarted with a narrower radius after the first
+    /// pass (adaptive radius).
+    pub restart: Restart,
+}
+
+/// A primary estimate's restart with a narrower radius ([`Ppm::narrow_dense`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Restart {
+    /// Not restarted: it counts every pass.
+    #[default]
+    None,
+    /// Narrowed after the first pass: its radius is the new one, its flux the first pass's
+    /// (scaled by the area, so the image does not change) until the second pass replaces it.
+    Pending,
+    /// Restarted at the second pass: the first pass's photons do not count for it.
+    Restarted,
+}
+
+impl Slot {
+    /// An empty slot of `pixel` (its radii are set before the first pass).
+    pub(super) fn new(pixel: u32) -> Self {
+        Self {
+            pixel,
+            primary: Estimate::default(),
+            indirect: Estimate::default(),
+            restart: Restart::None,
+        }
+    }
+
+    /// The larger search radius², which the spatial index must reach.
+    pub(super) fn reach2(&self) -> f64 {
+        self.primary.radius2.max(self.indirect.radius2)
+    }
+}
+
+impl Ppm {
+    /// Folds a completed pass into the slots and the statistics.
+    pub(super) fn update(&mut self, gathered: Gathered) {
+        let Gathered {
+            phi,
+            m,
+            counts,
+            tally,
+        } = gathered;
+        if let (Some(guide), Some(tally)) = (&mut self.guide, &tally) {
+            guide.learn(tally);
+        }
+        // Compute new photon counts, radii and flux (Hachisuka et al. 2008, eqs. 6–11).
+        let alpha = self.alpha;
+        for (k, s) in self.slots.iter_mut().enumerate() {
+            if s.restart == Restart::Pending {
+                // The first pass's flux only stood in until this pass: it was gathered over
+                // the wide radius.
+                s.primary.n = 0.0;
+                s.primary.tau = DVec3::ZERO;
+                s.restart = Restart::Restarted;
+            }
+            s.primary.update(phi[2 * k].as_dvec3(), m[2 * k], alpha);
+            s.indirect.update(phi[2 * k + 1].as_dvec3(), m[2 * k + 1], alpha);
+        }
+        if self.indirect_scale == IndirectScale::Automatic && self.stats.passes == 0 {
+            self.widen_indirect(&m);
+        }
+        if self.adaptive_radius && self.stats.passes == 0 {
+            self.first_pass_photons = self.pass_photons;
+            self.narrow_dense(&m);
+        }
+        if self.stochastic {
+            for (d, p) in self.direct.iter_mut().zip(self.pass_direct.drain(..)) {
+                *d += p;
+            }
+            self.stats.eye_passes += 1;
+        }
+        self.stats.passes += 1;
+        self.stats.indirect_radius_scale = match self.indirect_scale {
+            IndirectScale::Fixed(k) => k,
+            _ => 1.0,
+        };
+        self.stats.photons += self.pass_photons;
+        self.stats.bounces += counts.bounces;
+        self.stats.deposits += counts.deposits;
+        self.stats.useful_paths += counts.useful;
+        self.stats.visible_points = self.points.len();
+        let gathered: Vec<f64> = self
+            .slots
+            .iter()
+            .filter(|s| s.primary.n > 0.0)
+            .map(|s| s.primary.radius2.sqrt())
+            .collect();
+        self.stats.mean_radius = gathered.iter().sum::<f64>() / gathered.len().max(1) as f64;
+    }
+}

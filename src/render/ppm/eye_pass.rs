@@ -1,0 +1,218 @@
+//! The eye pass: visible points traced through the pixels — once for classic PPM (pinhole,
+//! no anti-aliasing; glass paths split), every pass for stochastic PPM (Hachisuka & Jensen
+//! 2009: one jittered point per pixel) — and light sampled at them for direct light.
+
+use std::time::Instant;
+
+use glam::{DVec2, DVec3};
+use rand::Rng;
+use rayon::prelude::*;
+
+use super::visible::{trace_eye, Branching, VisiblePoint};
+
+use super::radius::IndirectScale;
+use super::{direct, streams, Ppm, Slot};
+use crate::render::rng::stream_rng;
+use crate::render::sequence;
+use crate::scene::camera::concentric_disk;
+use crate::scene::Scene;
+
+/// The empty visible point (no slot): a stochastic eye pass's placeholder for a pixel whose
+/// path found no diffuse surface.
+pub(super) const NO_POINT: VisiblePoint = VisiblePoint {
+    slot: u32::MAX,
+    position: DVec3::ZERO,
+    normal: DVec3::ZERO,
+    weight: DVec3::ZERO,
+    radius2: 0.0,
+};
+
+impl Ppm {
+    /// Stochastic PPM's eye pass: one eye ray per pixel (jittered, through the lens), in
+    /// parallel, written in place: each pixel's visible point (at most one: glass is chosen,
+    /// not split) into `points` at the pixel's index, its directly seen light into
+    /// `pass_direct`; pixels without a point are then squeezed out. Nothing is allocated per
+    /// pixel, and the buffers keep their capacity from pass to pass. `false` when interrupted
+    /// (the pass is then traced again, so the half-written buffers do not matter).
+    pub(super) fn trace_stochastic_eye_pass(&mut self, scene: &Scene) -> bool {
+        let (w, h) = (self.width as u64, self.height as u64);
+        let pass = self.stats.passes as u64;
+        let (direct_light, seed) = (self.direct_light, self.seed);
+        let sequences = self
+            .stratified_eye_rays
+            .then(|| (sequence::r4(pass)[0], sequence::golden(pass)));
+        let interrupt = self.interrupt.as_deref();
+        let skipped = std::sync::atomic::AtomicBool::new(false);
+        let pixels = (w * h) as usize;
+        self.points.clear();
+        self.points.resize(pixels, NO_POINT);
+        self.pass_direct.clear();
+        self.pass_direct.resize(pixels, DVec3::ZERO);
+        let rays = scene.camera.eye_rays();
+        self.points
+            .par_iter_mut()
+            .zip(self.pass_direct.par_iter_mut())
+            .enumerate()
+            .for_each(|(i, (point, direct))| {
+                if interrupt.is_some_and(|f| f()) {
+                    skipped.store(true, std::sync::atomic::Ordering::Relaxed);
+                    return;
+                }
+                let i = i as u64;
+                let (x, y) = (i % w, i / w);
+                let mut rng = stream_rng(seed, streams::EYE, pass * w * h + i);
+                let (jitter, lens, first) = match sequences {
+                    // This pixel's shift and offsets, the same every pass (its own stream, so
+                    // the path's other random numbers stay as they were).
+                    Some((lens, choice)) => {
+                        let mut offsets = stream_rng(seed, streams::EYE_OFFSETS, i);
+                        let jitter = sequence::sobol(pass, offsets.random());
+                        let offset = DVec2::new(offsets.random(), offsets.random());
+                        let first = sequence::rotated_1d(choice, offsets.random());
+                        (jitter, sequence::rotated(lens, offset), Some(first))
+                    }
+                    None => (
+                        DVec2::new(rng.random(), rng.random()),
+                        DVec2::new(rng.random(), rng.random()),
+                        None,
+                    ),
+                };
+                let px = DVec2::new(x as f64, y as f64) + jitter;
+                let lens = concentric_disk(lens);
+                let mut sink = |vp: VisiblePoint| {
+                    debug_assert!(point.slot == NO_POINT.slot, "a chosen path ends once");
+                    *point = vp;
+                };
+                *direct = trace_eye(
+                    scene,
+                    &rays.ray(px, lens),
+                    i as u32,
+                    Branching::Choose { first },
+                    direct_light,
+                    &mut rng,
+                    &mut sink,
+                );
+            });
+        if skipped.into_inner() {
+            return false;
+        }
+        self.points.retain(|p| p.slot != NO_POINT.slot);
+        true
+    }
+
+    /// Classic PPM's one eye pass: an eye ray through each pixel centre, split at glass, rows
+    /// in parallel. Per pixel: the directly seen light; per visible point: the point, its
+    /// `slot` holding its pixel. `None` when interrupted.
+    pub(super) fn trace_classic_eye_pass(&self, scene: &Scene) -> Option<(Vec<DVec3>, Vec<VisiblePoint>)> {
+        let (w, h) = (self.width as u64, self.height as u64);
+        let pass = self.stats.passes as u64;
+        let (direct_light, seed) = (self.direct_light, self.seed);
+        let interrupt = self.interrupt.as_deref();
+        let skipped = std::sync::atomic::AtomicBool::new(false);
+        let rays = scene.camera.eye_rays();
+        let rows: Vec<(Vec<DVec3>, Vec<VisiblePoint>)> = (0..h)
+            .into_par_iter()
+            .map(|y| {
+                let (mut direct, mut points) = (Vec::with_capacity(w as usize), Vec::new());
+                if interrupt.is_some_and(|f| f()) {
+                    skipped.store(true, std::sync::atomic::Ordering::Relaxed);
+                    return (direct, points);
+                }
+                for x in 0..w {
+                    let i = y * w + x;
+                    let mut rng = stream_rng(seed, streams::EYE, pass * w * h + i);
+                    let px = Scene::pixel_center(x as u32, y as u32);
+                    direct.push(trace_eye(
+                        scene,
+                        &rays.ray(px, DVec2::ZERO),
+                        i as u32,
+                        Branching::Split,
+                        direct_light,
+                        &mut rng,
+                        &mut |vp| points.push(vp),
+                    ));
+                }
+                (direct, points)
+            })
+            .collect();
+        if skipped.into_inner() {
+            return None;
+        }
+        let mut direct = Vec::with_capacity((w * h) as usize);
+        let mut points = Vec::new();
+        for (d, p) in rows {
+            direct.extend(d);
+            points.extend(p);
+        }
+        Some((direct, points))
+    }
+
+    /// Traces the eye pass; `false` when interrupted (nothing the next pass needs changed then).
+    pub(super) fn eye_pass(&mut self, scene: &Scene) -> bool {
+        if self.stochastic {
+            // A stochastic pass's directly seen light counts only when the pass completes.
+            if !self.trace_stochastic_eye_pass(scene) {
+                return false;
+            }
+            if self.slots.is_empty() {
+                self.slots = (0..self.width * self.height).map(Slot::new).collect();
+            }
+        } else {
+            // Classic PPM keeps its one eye pass at once: a slot per visible point.
+            let Some((direct, points)) = self.trace_classic_eye_pass(scene) else {
+                return false;
+            };
+            self.stats.eye_passes += 1;
+            for (d, p) in self.direct.iter_mut().zip(direct) {
+                *d += p;
+            }
+            self.points = points;
+            for vp in &mut self.points {
+                let pixel = vp.slot;
+                vp.slot = self.slots.len() as u32;
+                self.slots.push(Slot::new(pixel));
+            }
+        }
+        if self.stats.passes == 0 && self.slots.iter().all(|s| s.primary.radius2 == 0.0) {
+            let r0 = self
+                .initial_radius
+                .unwrap_or_else(|| self.automatic_radius(scene));
+            let indirect = match self.indirect_scale {
+                IndirectScale::Off => 0.0,
+                // The first pass measures the photon density; `update` widens it after.
+                IndirectScale::Automatic => r0,
+                IndirectScale::Fixed(k) => k * r0,
+            };
+            for s in &mut self.slots {
+                s.primary.radius2 = r0 * r0;
+                s.indirect.radius2 = indirect * indirect;
+            }
+            self.initial_radius2 = r0 * r0;
+        }
+        for vp in &mut self.points {
+            vp.radius2 = self.slots[vp.slot as usize].reach2();
+        }
+        true
+    }
+
+    /// Adds one light sample of every area light at each visible point of this pass to the
+    /// per-pixel sums (when direct light is on; see [`direct`]).
+    pub(super) fn sample_area_lights(&mut self, scene: &Scene) {
+        if self.area_direct.is_empty() {
+            return;
+        }
+        let start = Instant::now();
+        let slots = &self.slots;
+        let light = direct::area_light_pass(
+            scene,
+            &self.points,
+            |k| self.points[k].slot as u64,
+            self.stats.passes as u64,
+            self.seed,
+        );
+        for (vp, l) in self.points.iter().zip(light) {
+            self.area_direct[slots[vp.slot as usize].pixel as usize] += l;
+        }
+        self.stats.direct_secs += start.elapsed().as_secs_f64();
+    }
+}

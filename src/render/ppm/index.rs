@@ -1,0 +1,26 @@
+//! The spatial index over visible points a photon searches: the hashed grid or the seed's
+//! kd-tree ([`IndexKind`]); the image does not depend on which.
+
+use glam::DVec3;
+
+use super::visible::VisiblePoint;
+use super::{HashGrid, KdTree};
+
+/// A built spatial index.
+pub enum SpatialIndex {
+    /// Hash grid.
+    Grid(HashGrid),
+    /// kd-tree.
+    Kd(KdTree),
+}
+
+impl SpatialIndex {
+    /// Calls `f` with candidate points near `p` (the caller checks the radius).
+    #[inline]
+    pub fn for_candidates(&self, points: &[VisiblePoint], p: DVec3, f: &mut impl FnMut(u32)) {
+        match self {
+            SpatialIndex::Grid(g) => g.candidates(p).iter().for_each(|&k| f(k)),
+            SpatialIndex::Kd(t) => t.for_candidates(points, p, f),
+        }
+    }
+}

@@ -1,0 +1,177 @@
+//! The photon pass: photons traced in fixed chunks in parallel, their deposits reduced in
+//! chunk order (so the image is the same for any thread count), batch by batch with the
+//! caller asked between batches.
+
+use glam::{DVec3, Vec3};
+use rayon::prelude::*;
+
+use super::guide::{EmissionGuide, GuideTally};
+use super::photon::{PhotonCounts, PhotonSource};
+
+use super::radius::IndirectScale;
+use super::{streams, Control, Ppm, SpatialIndex};
+use crate::render::rng::stream_rng;
+use crate::scene::Scene;
+
+/// Photons per chunk: the unit of parallel work and of deterministic reduction.
+pub(super) const CHUNK: u64 = 4096;
+
+/// Photons per batch unless [`PpmOptions::batch_photons`] says otherwise: the caller's
+/// control callback is asked between batches.
+pub const DEFAULT_BATCH_PHOTONS: u64 = 16 * CHUNK;
+
+/// Deposits one chunk may hold before they are merged per slot: bounds memory when radii are
+/// large (every photon then reaches thousands of points).
+pub(super) const MAX_CHUNK_DEPOSITS: usize = 1 << 20;
+
+/// Flux handed to a statistics slot: `(slot, flux × point weight, photon count)`.
+pub(super) type Deposit = (u32, DVec3, u32);
+
+/// A visible point's position and its estimates' radii², packed for the candidate test.
+pub(super) type Reach = [f64; 5];
+
+/// What one chunk of photons left: its deposits, counts and guide tally.
+pub(super) type ChunkResult = (Vec<Deposit>, PhotonCounts, Option<GuideTally>);
+
+/// Merges deposits to the same slot, keeping each slot's additions in photon order (a stable
+/// sort), so the sums depend only on the chunk's photons, not on threads.
+pub(super) fn compact(deposits: &mut Vec<Deposit>) {
+    deposits.sort_by_key(|d| d.0);
+    let mut merged: Vec<Deposit> = Vec::with_capacity(deposits.len() / 4);
+    for &(slot, flux, count) in deposits.iter() {
+        match merged.last_mut() {
+            Some(last) if last.0 == slot => {
+                last.1 += flux;
+                last.2 += count;
+            }
+            _ => merged.push((slot, flux, count)),
+        }
+    }
+    *deposits = merged;
+}
+
+/// What one pass's photons left: flux `Φ` and photon count `M` per slot and estimate (index
+/// `2 × slot + estimate`, 0 primary, 1 indirect), and counts. A pass's flux is summed in f32
+/// (12 bytes instead of 24 per estimate: at 1920×1080 this keeps the peak under 1 GiB with
+/// two estimates per slot); τ accumulates the passes in f64.
+pub(super) struct Gathered {
+    pub(super) phi: Vec<Vec3>,
+    pub(super) m: Vec<u32>,
+    pub(super) counts: PhotonCounts,
+    /// Emitted and useful photons per light and bin, when emission is guided.
+    pub(super) tally: Option<GuideTally>,
+}
+
+impl Ppm {
+    /// Traces this pass's photons in batches and gathers their flux at the visible points;
+    /// `None` when `control` aborts the pass.
+    pub(super) fn photon_pass(
+        &mut self,
+        scene: &Scene,
+        index: &SpatialIndex,
+        control: &mut dyn FnMut(&mut f64) -> Control,
+    ) -> Option<Gathered> {
+        let source = PhotonSource::new(scene, self.direct_light).with_guide(self.guide.as_ref());
+        // Positions and both radii packed tightly: the candidate test reads nothing else.
+        let reach: Vec<Reach> = self
+            .points
+            .iter()
+            .map(|v| {
+                let s = &self.slots[v.slot as usize];
+                let p = v.position;
+                [p.x, p.y, p.z, s.primary.radius2, s.indirect.radius2]
+            })
+            .collect();
+        let mut out = Gathered {
+            phi: vec![Vec3::ZERO; 2 * self.slots.len()],
+            m: vec![0u32; 2 * self.slots.len()],
+            counts: PhotonCounts::default(),
+            tally: self.guide.as_ref().map(EmissionGuide::tally),
+        };
+        self.pass_photons = self.guided_pass_photons();
+        let chunks = self.pass_photons.div_ceil(CHUNK);
+        let chunks_per_batch = self.options.batch_photons.div_ceil(CHUNK).max(1);
+        let mut chunk = 0;
+        while chunk < chunks {
+            if control(&mut self.alpha) == Control::Abort {
+                return None;
+            }
+            let end = (chunk + chunks_per_batch).min(chunks);
+            let results: Vec<ChunkResult> = (chunk..end)
+                .into_par_iter()
+                .map(|c| self.trace_chunk(c, &source, index, &reach))
+                .collect();
+            // Fold in chunk order: the same sums whatever the thread count.
+            for (deposits, c, tally) in results {
+                if let (Some(all), Some(t)) = (&mut out.tally, &tally) {
+                    all.add(t);
+                }
+                for (slot, flux, count) in deposits {
+                    out.phi[slot as usize] += flux.as_vec3();
+                    out.m[slot as usize] += count;
+                    out.counts.deposits += count as u64;
+                }
+                out.counts.paths += c.paths;
+                out.counts.bounces += c.bounces;
+                out.counts.useful += c.useful;
+            }
+            chunk = end;
+        }
+        Some(out)
+    }
+
+    /// This pass's photons: `photons_per_pass` divided by the guide's gain (as many useful
+    /// photons, fewer lost ones; see [`guide`]), but not below one chunk (or all of them).
+    pub(super) fn guided_pass_photons(&self) -> u64 {
+        match &self.guide {
+            Some(g) => {
+                let reduced = (self.photons_per_pass as f64 / g.gain()).ceil() as u64;
+                reduced.max(self.photons_per_pass.min(CHUNK))
+            }
+            None => self.photons_per_pass,
+        }
+    }
+
+    /// Traces photon chunk `c` of this pass: the deposits it makes and its counts.
+    pub(super) fn trace_chunk(
+        &self,
+        c: u64,
+        source: &PhotonSource,
+        index: &SpatialIndex,
+        reach: &[Reach],
+    ) -> ChunkResult {
+        let mut deposits: Vec<Deposit> = Vec::new();
+        let mut counts = PhotonCounts::default();
+        let mut tally = self.guide.as_ref().map(EmissionGuide::tally);
+        let (photons, first_photon) = (self.pass_photons, self.stats.photons);
+        let points = &self.points;
+        let split = self.indirect_scale != IndirectScale::Off;
+        for i in c * CHUNK..((c + 1) * CHUNK).min(photons) {
+            let mut rng = stream_rng(self.seed, streams::PHOTON, first_photon + i);
+            let mut useful = false;
+            let from = source.trace(&mut rng, &mut counts, &mut |p, n, flux, indirect| {
+                // Hand the flux to every visible point on this side of the surface whose
+                // search sphere (of the photon's estimate) holds the photon.
+                let estimate = usize::from(indirect && split);
+                index.for_candidates(points, p, &mut |k| {
+                    let r = &reach[k as usize];
+                    if (DVec3::new(r[0], r[1], r[2]) - p).length_squared() <= r[3 + estimate] {
+                        let vp = &points[k as usize];
+                        if vp.normal.dot(n) > 1e-3 {
+                            deposits.push((2 * vp.slot + estimate as u32, vp.weight * flux, 1));
+                            useful = true;
+                        }
+                    }
+                });
+            });
+            counts.useful += useful as u64;
+            if let Some(t) = &mut tally {
+                t.record(from.light, from.bin, useful);
+            }
+            if deposits.len() > MAX_CHUNK_DEPOSITS {
+                compact(&mut deposits);
+            }
+        }
+        (deposits, counts, tally)
+    }
+}

@@ -1,0 +1,41 @@
+//! What a photon-mapping render measured ([`PpmStats`]).
+
+/// Run statistics.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct PpmStats {
+    /// Completed passes.
+    pub passes: u32,
+    /// Photons emitted in completed passes.
+    pub photons: u64,
+    /// Photon bounces traced.
+    pub bounces: u64,
+    /// Flux deposits made.
+    pub deposits: u64,
+    /// Photon paths that handed flux to at least one visible point (the share of `photons`
+    /// that did any good).
+    pub useful_paths: u64,
+    /// Visible points in the last pass.
+    pub visible_points: usize,
+    /// Mean search radius over slots that have gathered photons (scene units).
+    pub mean_radius: f64,
+    /// The indirect estimate's initial radius over the primary's (1: one estimate for all
+    /// photons; chosen after the first pass when automatic).
+    pub indirect_radius_scale: f64,
+    /// Share of the statistics slots whose estimate restarted with a narrower radius after
+    /// the first pass (adaptive radius; 0 before it or when off).
+    pub narrowed_share: f64,
+    /// Seconds spent in completed passes.
+    pub elapsed_secs: f64,
+    /// Seconds spent tracing photons.
+    pub photon_secs: f64,
+    /// Seconds spent in eye passes (tracing and setting up visible points).
+    pub eye_secs: f64,
+    /// Seconds spent building the spatial index over visible points.
+    pub index_secs: f64,
+    /// Seconds spent sampling area lights at the visible points.
+    pub direct_secs: f64,
+    /// Eye passes run.
+    pub eye_passes: u32,
+    /// Work the scene did not need, in words.
+    pub skipped: Vec<String>,
+}
