@@ -63,6 +63,59 @@ pub struct LightSample {
 }
 
 impl Light {
+    /// A point light of total power `power` (W, per channel): intensity `Φ/4π`.
+    pub fn point(position: DVec3, power: DVec3) -> Light {
+        Light::Point {
+            position,
+            intensity: power / (4.0 * std::f64::consts::PI),
+        }
+    }
+
+    /// A spot light of total power `power` into a cone of full angle `cone_degrees`, fading
+    /// over its outer `falloff_degrees` (clamped to the cone): the intensity is the power over
+    /// the cone's solid angle, counting the fade at its mean.
+    pub fn spot(
+        position: DVec3,
+        direction: DVec3,
+        power: DVec3,
+        cone_degrees: f64,
+        falloff_degrees: f64,
+    ) -> Light {
+        let falloff = falloff_degrees.clamp(0.0, cone_degrees);
+        let cos_outer = (0.5 * cone_degrees).to_radians().cos();
+        let cos_inner = (0.5 * (cone_degrees - falloff)).to_radians().cos();
+        let solid = 2.0 * std::f64::consts::PI * (1.0 - 0.5 * (cos_inner + cos_outer));
+        Light::Spot {
+            position,
+            direction: direction.normalize(),
+            intensity: power / solid,
+            cos_inner,
+            cos_outer,
+        }
+    }
+
+    /// A diffusely emitting sphere of total power `power`: radiance `Φ/(π · 4πr²)`.
+    pub fn sphere(center: DVec3, radius: f64, power: DVec3) -> Light {
+        use std::f64::consts::PI;
+        Light::Sphere {
+            center,
+            radius,
+            radiance: power / (4.0 * PI * PI * radius * radius),
+        }
+    }
+
+    /// A one-sided diffuse quad of total power `power`, emitting on the side of
+    /// `edge_u × edge_v`: radiance `Φ/(πA)`.
+    pub fn quad(corner: DVec3, edge_u: DVec3, edge_v: DVec3, power: DVec3) -> Light {
+        let area = edge_u.cross(edge_v).length();
+        Light::Quad {
+            corner,
+            edge_u,
+            edge_v,
+            radiance: power / (std::f64::consts::PI * area),
+        }
+    }
+
     /// Total emitted power, RGB.
     pub fn power(&self) -> DVec3 {
         use std::f64::consts::PI;

@@ -1,0 +1,133 @@
+//! `[materials.NAME]` tables and their textures.
+
+use glam::{DVec2, DVec3};
+use toml::Spanned;
+
+use super::diagnostics::{v3, Ctx, Result, Table};
+use crate::scene::format::{MaterialDesc, ScaleDesc, TextureDesc};
+use crate::scene::material::{Material, MaterialKind};
+use crate::scene::texture::{Mapping, Texture, TextureSource};
+
+pub(super) fn material(
+    ctx: &Ctx,
+    name: &str,
+    desc: &Spanned<MaterialDesc>,
+    textures: &mut Vec<Texture>,
+) -> Result<Material> {
+    let d = desc.get_ref();
+    let t = Table {
+        ctx,
+        span: desc.span(),
+        name: format!("[materials.{name}] ({})", d.kind),
+    };
+    let given = [
+        ("color", d.color.is_some()),
+        ("texture", d.texture.is_some()),
+        ("specular", d.specular.is_some()),
+        ("shininess", d.shininess.is_some()),
+        ("ior", d.ior.is_some()),
+    ];
+    let color = d
+        .color
+        .as_ref()
+        .map(v3)
+        .map(|c| t.reflectance("color", c))
+        .transpose()?;
+    let kind = match d.kind.as_str() {
+        "diffuse" => {
+            t.only("diffuse", &given, &["color", "texture"])?;
+            MaterialKind::Diffuse {
+                specular: 0.0,
+                shininess: 0.0,
+            }
+        }
+        "phong" => {
+            t.only("phong", &given, &["color", "texture", "specular", "shininess"])?;
+            let specular = d.specular.map_or(0.2, |r| r.0);
+            if !(0.0..=1.0).contains(&specular) {
+                return Err(t.err(format!("'specular' must be between 0 and 1, got {specular}")));
+            }
+            MaterialKind::Diffuse {
+                specular,
+                shininess: t.non_negative("shininess", d.shininess.map_or(32.0, |r| r.0))?,
+            }
+        }
+        "mirror" => {
+            t.only("mirror", &given, &["color"])?;
+            MaterialKind::Mirror
+        }
+        "glass" => {
+            t.only("glass", &given, &["color", "ior"])?;
+            MaterialKind::Glass {
+                ior: t.positive("ior", d.ior.map_or(1.5, |r| r.0))?,
+            }
+        }
+        other => {
+            return Err(t.err(format!(
+                "unknown material type '{other}' (expected diffuse, phong, mirror or glass)"
+            )))
+        }
+    };
+    let texture = match &d.texture {
+        Some(desc) => {
+            textures.push(texture(&t, desc)?);
+            Some(textures.len() - 1)
+        }
+        None => None,
+    };
+    Ok(Material {
+        name: name.to_owned(),
+        kind,
+        color: color.unwrap_or(DVec3::splat(0.75)),
+        texture,
+    })
+}
+
+pub(super) fn texture(t: &Table, d: &TextureDesc) -> Result<Texture> {
+    let source = match (&d.file, &d.checker) {
+        (Some(file), None) => {
+            let path = t
+                .ctx
+                .resolve(&t.span, &format!("{}: 'texture.file'", t.name), file)?;
+            TextureSource::load(&path).map_err(|e| t.err(format!("'texture.file': {e}")))?
+        }
+        (None, Some([a, b])) => TextureSource::Checker([
+            t.reflectance("texture.checker", v3(a))?,
+            t.reflectance("texture.checker", v3(b))?,
+        ]),
+        _ => return Err(t.err("'texture' needs exactly one of 'file' or 'checker'")),
+    };
+    let mapping = match d.mapping.as_deref() {
+        None | Some("uv") => Mapping::Uv,
+        Some("planar") => {
+            let n = t
+                .nonzero("texture.normal", d.normal.as_ref().map(v3).unwrap_or(DVec3::Z))?
+                .normalize();
+            let (axis_u, axis_v) = n.any_orthonormal_pair();
+            Mapping::Planar { axis_u, axis_v }
+        }
+        Some("spherical") => Mapping::Spherical {
+            center: d.center.as_ref().map(v3).unwrap_or(DVec3::ZERO),
+        },
+        Some(other) => {
+            return Err(t.err(format!(
+                "'texture.mapping' must be \"uv\", \"planar\" or \"spherical\", got \"{other}\""
+            )))
+        }
+    };
+    let scale = match d.scale {
+        None => DVec2::ONE,
+        Some(ScaleDesc::Uniform(s)) => DVec2::splat(s.0),
+        Some(ScaleDesc::PerAxis2([a, b])) => DVec2::new(a.0, b.0),
+        Some(ScaleDesc::PerAxis3(_)) => return Err(t.err("'texture.scale' takes one or two numbers")),
+    };
+    if scale.x == 0.0 || scale.y == 0.0 {
+        return Err(t.err("'texture.scale' must not be zero"));
+    }
+    Ok(Texture {
+        source,
+        mapping,
+        scale,
+        offset: d.offset.map_or(DVec2::ZERO, |[a, b]| DVec2::new(a.0, b.0)),
+    })
+}

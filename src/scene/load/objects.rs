@@ -1,0 +1,259 @@
+//! `[[objects]]`: spheres, planes, quads, meshes and Bézier patches, placed by their
+//! transform into the geometry.
+
+use std::collections::BTreeMap;
+
+use glam::{DAffine3, DMat3, DVec3};
+use toml::Spanned;
+
+use super::diagnostics::{v3, Ctx, Result, Table};
+use crate::geometry::{
+    load_bpt, load_freeform_obj, BezierPatch, GeometryBuilder, Plane, Quad, Sphere, TriangleMesh, Window,
+};
+use crate::scene::format::{ObjectDesc, Real, ScaleDesc, TransformDesc};
+use crate::scene::SceneObject;
+
+pub(super) fn transform(t: &Table, d: Option<&TransformDesc>) -> Result<(DAffine3, Option<f64>)> {
+    let Some(d) = d else {
+        return Ok((DAffine3::IDENTITY, Some(1.0)));
+    };
+    let scale = match d.scale {
+        None => DVec3::ONE,
+        Some(ScaleDesc::Uniform(s)) => DVec3::splat(s.0),
+        Some(ScaleDesc::PerAxis3(s)) => v3(&s),
+        Some(ScaleDesc::PerAxis2(_)) => return Err(t.err("'transform.scale' takes one or three numbers")),
+    };
+    if scale.cmpeq(DVec3::ZERO).any() {
+        return Err(t.err(format!(
+            "'transform.scale' must not be zero on any axis, got {scale}"
+        )));
+    }
+    let r = d.rotate.as_ref().map(v3).unwrap_or(DVec3::ZERO);
+    let rotation = DMat3::from_rotation_z(r.z.to_radians())
+        * DMat3::from_rotation_y(r.y.to_radians())
+        * DMat3::from_rotation_x(r.x.to_radians());
+    let translate = d.translate.as_ref().map(v3).unwrap_or(DVec3::ZERO);
+    let m = DAffine3::from_mat3_translation(rotation * DMat3::from_diagonal(scale), translate);
+    let uniform = (scale.x.abs() == scale.y.abs() && scale.y.abs() == scale.z.abs()).then_some(scale.x.abs());
+    Ok((m, uniform))
+}
+
+pub(super) fn object(
+    ctx: &Ctx,
+    k: usize,
+    desc: &Spanned<ObjectDesc>,
+    materials: &BTreeMap<String, usize>,
+    builder: &mut GeometryBuilder,
+    objects: &mut Vec<SceneObject>,
+) -> Result<()> {
+    let d = desc.get_ref();
+    let label = match &d.name {
+        Some(n) => format!("objects[{k}] ({} \"{n}\")", d.kind),
+        None => format!("objects[{k}] ({})", d.kind),
+    };
+    let t = Table {
+        ctx,
+        span: desc.span(),
+        name: label.clone(),
+    };
+    let material = material_index(&t, &d.material, materials)?;
+    let id = objects.len() as u32;
+    add_shape(&t, d, &label, builder, id)?;
+    objects.push(SceneObject {
+        name: d.name.clone().unwrap_or_else(|| format!("{} {k}", d.kind)),
+        material,
+        emission: None,
+    });
+    Ok(())
+}
+
+/// Adds the shape of object `id` (its `type`'s keys checked, placed by its transform).
+fn add_shape(t: &Table, d: &ObjectDesc, label: &str, builder: &mut GeometryBuilder, id: u32) -> Result<()> {
+    let given = given_keys(d);
+    let (m, uniform_scale) = transform(t, d.transform.as_ref())?;
+    match d.kind.as_str() {
+        "sphere" => {
+            t.only("sphere", &given, &["center", "radius", "transform"])?;
+            let center = v3(t.required("center", d.center.as_ref())?);
+            let radius = t.positive("radius", t.required("radius", d.radius)?.0)?;
+            let Some(s) = uniform_scale else {
+                return Err(t.err("a sphere's 'transform.scale' must be uniform"));
+            };
+            builder.add_sphere(
+                Sphere {
+                    center: m.transform_point3(center),
+                    radius: radius * s,
+                },
+                id,
+            );
+        }
+        "plane" => {
+            t.only("plane", &given, &["point", "normal"])?;
+            let point = v3(t.required("point", d.point.as_ref())?);
+            let normal = t.nonzero("normal", v3(t.required("normal", d.normal.as_ref())?))?;
+            builder.add_plane(
+                Plane {
+                    point,
+                    normal: normal.normalize(),
+                },
+                id,
+            );
+        }
+        "quad" => {
+            t.only("quad", &given, &["corner", "edge_u", "edge_v", "transform"])?;
+            let corner = v3(t.required("corner", d.corner.as_ref())?);
+            let edge_u = v3(t.required("edge_u", d.edge_u.as_ref())?);
+            let edge_v = v3(t.required("edge_v", d.edge_v.as_ref())?);
+            if edge_u.cross(edge_v).length_squared() == 0.0 {
+                return Err(t.err("'edge_u' and 'edge_v' are parallel (or zero): the quad has no area"));
+            }
+            builder.add_quad(
+                Quad {
+                    corner: m.transform_point3(corner),
+                    edge_u: m.transform_vector3(edge_u),
+                    edge_v: m.transform_vector3(edge_v),
+                },
+                id,
+            );
+        }
+        "mesh" => {
+            t.only("mesh", &given, &["file", "transform"])?;
+            let file = t.required("file", d.file.as_deref())?;
+            let path = t.ctx.resolve(&t.span, &format!("{label}: 'file'"), file)?;
+            builder.add_mesh(placed_mesh(t, &path, &m)?, id);
+        }
+        "patches" => {
+            t.only(
+                "patches",
+                &given,
+                &["file", "builtin", "patches", "domains", "transform"],
+            )?;
+            for (p, domain) in patch_list(t, d, label)? {
+                builder.add_patch_in(p.transformed(&m), domain, id);
+            }
+        }
+        other => {
+            return Err(t.err(format!(
+                "unknown object type '{other}' (expected sphere, plane, quad, mesh or patches)"
+            )))
+        }
+    }
+    Ok(())
+}
+
+/// Applies inline `domains` (one `[u0, u1, v0, v1]` per patch, each range increasing).
+pub(super) fn patch_domains(
+    t: &Table,
+    patches: &mut [(BezierPatch, Window)],
+    domains: &[[Real; 4]],
+) -> Result<()> {
+    if domains.len() != patches.len() {
+        return Err(t.err(format!(
+            "'domains' has {} entries for {} patches",
+            domains.len(),
+            patches.len()
+        )));
+    }
+    for (i, ((_, window), d)) in patches.iter_mut().zip(domains).enumerate() {
+        let [u0, u1, v0, v1] = d.map(|r| r.0);
+        if !(u0 < u1 && v0 < v1) {
+            return Err(t.err(format!(
+                "'domains[{i}]' must be [u0, u1, v0, v1] with u0 < u1 and v0 < v1, got [{u0}, {u1}, {v0}, {v1}]"
+            )));
+        }
+        *window = Window { u0, u1, v0, v1 };
+    }
+    Ok(())
+}
+
+/// The index of material `name`, or an error listing the defined ones.
+fn material_index(t: &Table, name: &str, materials: &BTreeMap<String, usize>) -> Result<usize> {
+    materials.get(name).copied().ok_or_else(|| {
+        let known: Vec<&str> = materials.keys().map(String::as_str).collect();
+        t.err(format!(
+            "unknown material '{name}' (defined: {})",
+            if known.is_empty() {
+                "none".to_owned()
+            } else {
+                known.join(", ")
+            }
+        ))
+    })
+}
+
+/// The keys an `[[objects]]` table gave, for [`Table::only`].
+fn given_keys(d: &ObjectDesc) -> [(&'static str, bool); 12] {
+    [
+        ("center", d.center.is_some()),
+        ("radius", d.radius.is_some()),
+        ("point", d.point.is_some()),
+        ("normal", d.normal.is_some()),
+        ("corner", d.corner.is_some()),
+        ("edge_u", d.edge_u.is_some()),
+        ("edge_v", d.edge_v.is_some()),
+        ("file", d.file.is_some()),
+        ("builtin", d.builtin.is_some()),
+        ("patches", d.patches.is_some()),
+        ("domains", d.domains.is_some()),
+        ("transform", d.transform.is_some()),
+    ]
+}
+
+/// A triangle mesh read from `path`, placed by `m` (normals by its inverse transpose).
+fn placed_mesh(t: &Table, path: &std::path::Path, m: &DAffine3) -> Result<TriangleMesh> {
+    let mut mesh = TriangleMesh::load_obj(path).map_err(|e| t.err(e))?;
+    let normal_matrix = m.matrix3.inverse().transpose();
+    for p in &mut mesh.positions {
+        *p = m.transform_point3(*p);
+    }
+    for n in &mut mesh.normals {
+        *n = (normal_matrix * *n).normalize_or_zero();
+    }
+    Ok(mesh)
+}
+
+/// The patches of a `patches` object, each with its `(u,v)` window: from a `.bpt` or a
+/// free-form `.obj` file, built in, or written inline (with optional `domains`).
+fn patch_list(t: &Table, d: &ObjectDesc, label: &str) -> Result<Vec<(BezierPatch, Window)>> {
+    if d.domains.is_some() && d.patches.is_none() {
+        return Err(t.err("'domains' applies only to inline 'patches'"));
+    }
+    let whole = |patches: Vec<BezierPatch>| patches.into_iter().map(|p| (p, Window::FULL)).collect();
+    match (d.file.as_deref(), d.builtin.as_deref(), &d.patches) {
+        (Some(file), None, None) => {
+            let path = t.ctx.resolve(&t.span, &format!("{label}: 'file'"), file)?;
+            if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj")) {
+                load_freeform_obj(&path).map_err(|e| t.err(e))
+            } else {
+                Ok(whole(load_bpt(&path).map_err(|e| t.err(e))?))
+            }
+        }
+        (None, Some("teapot"), None) => Ok(whole(crate::assets::teapot())),
+        (None, Some(other), None) => {
+            Err(t.err(format!("unknown 'builtin' patches '{other}' (available: teapot)")))
+        }
+        (None, None, Some(list)) => {
+            let mut out = Vec::new();
+            for (i, points) in list.iter().enumerate() {
+                if points.len() != 16 {
+                    return Err(t.err(format!(
+                        "'patches[{i}]' must have 16 control points, has {}",
+                        points.len()
+                    )));
+                }
+                out.push((
+                    BezierPatch::new(std::array::from_fn(|j| v3(&points[j]))),
+                    Window::FULL,
+                ));
+            }
+            if out.is_empty() {
+                return Err(t.err("'patches' is empty"));
+            }
+            if let Some(domains) = &d.domains {
+                patch_domains(t, &mut out, domains)?;
+            }
+            Ok(out)
+        }
+        _ => Err(t.err("needs exactly one of 'file', 'builtin' or 'patches'")),
+    }
+}
