@@ -43,7 +43,7 @@ fn flat_frame() -> Frame {
         pass: 1,
         photons: 1,
         elapsed_secs: 0.1,
-        stats: FrameStats::PhotonMapping(PpmStats::default()),
+        stats: FrameStats::from(PpmStats::default()),
         width: SIZE.0,
         height: SIZE.1,
         radiance: vec![[0.2f32; 3]; n].into(),
@@ -349,7 +349,7 @@ fn teapot_frame() -> Frame {
         ppm.run_pass(&scene, &mut |_| Control::Continue);
     }
     let mut frame = Frame::from_ppm(&ppm, 0, 1.0);
-    frame.stats = FrameStats::PhotonMapping(PpmStats {
+    frame.stats = FrameStats::from(PpmStats {
         elapsed_secs: 1.0,
         photon_secs: 0.5,
         ..ppm.stats().clone()

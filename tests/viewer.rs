@@ -441,7 +441,7 @@ fn fixed_frames() -> Vec<Frame> {
     for pass in 1..=4u32 {
         ppm.run_pass(&scene, &mut |_| Control::Continue);
         let mut frame = Frame::from_ppm(&ppm, 0, pass as f64 * 0.25);
-        frame.stats = FrameStats::PhotonMapping(PpmStats {
+        frame.stats = FrameStats::from(PpmStats {
             elapsed_secs: pass as f64 * 0.25,
             photon_secs: pass as f64 * 0.2,
             ..ppm.stats().clone()

@@ -306,10 +306,8 @@ impl Automation {
             return;
         };
         let passes = viewer.frame().map_or(0, |f| f.pass);
-        let whitted = viewer
-            .frame()
-            .is_some_and(|f| f.stats.renderer() == crate::scene::RendererKind::Whitted);
-        if !*requested && (passes >= self.options.screenshot_after_passes || whitted) {
+        let single_frame = viewer.frame().is_some_and(|f| !f.stats.renderer().progressive());
+        if !*requested && (passes >= self.options.screenshot_after_passes || single_frame) {
             *requested = true;
             let result = self.screenshot_result.clone();
             let force = self.options.force;

@@ -34,19 +34,6 @@ fn percent(fraction: f64) -> String {
     format!("{p:.decimals$} %")
 }
 
-/// A count with thousands separators.
-fn count(n: u64) -> String {
-    let s = n.to_string();
-    let mut out = String::new();
-    for (i, c) in s.chars().enumerate() {
-        if i > 0 && (s.len() - i).is_multiple_of(3) {
-            out.push(',');
-        }
-        out.push(c);
-    }
-    out
-}
-
 /// File, View and Help menus.
 pub fn menu_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) {
     egui::MenuBar::new().ui(ui, |ui| {
@@ -239,10 +226,13 @@ pub fn side_panel_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) 
     ui.heading("Render");
     ui.horizontal(|ui| {
         ui.label("Renderer");
-        ui.selectable_value(&mut p.render.renderer, RendererKind::Ppm, "Photon mapping")
-            .on_hover_text("Progressive photon mapping: converges to caustics and indirect light");
-        ui.selectable_value(&mut p.render.renderer, RendererKind::Whitted, "Ray tracer")
-            .on_hover_text("Whitted ray tracer: one fast frame, direct light, mirrors and glass only");
+        // Progressive renderers first (the viewer's own), then single-frame ones.
+        let mut kinds = RendererKind::ALL.to_vec();
+        kinds.sort_by_key(|k| !k.progressive());
+        for kind in kinds {
+            ui.selectable_value(&mut p.render.renderer, kind, kind.label())
+                .on_hover_text(kind.description());
+        }
     });
     ui.horizontal(|ui| {
         let label = if p.paused { "Resume" } else { "Pause" };
@@ -391,9 +381,10 @@ pub fn side_panel_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) 
 fn statistics_ui(viewer: &Viewer, ui: &mut egui::Ui) {
     ui.heading("Statistics");
     if viewer.restart_pending() {
-        let what = match viewer.params.render.renderer {
-            RendererKind::Ppm => "Restarting: first pass of the new settings...",
-            RendererKind::Whitted => "Ray tracing the frame...",
+        let what = if viewer.params.render.renderer.progressive() {
+            "Restarting: first pass of the new settings..."
+        } else {
+            "Rendering the frame..."
         };
         ui.label(RichText::new(what).italics());
     }
@@ -425,42 +416,8 @@ fn statistics_ui(viewer: &Viewer, ui: &mut egui::Ui) {
                 pass,
                 "Completed passes in this epoch; a new epoch first shows a quick low-resolution preview",
             );
-            if let Some(stats) = frame.stats.photon_mapping() {
-                row("Photons", count(frame.photons), "Photons emitted in this epoch");
-                let rate = frame.photons as f64 / stats.elapsed_secs.max(1e-9);
-                row(
-                    "Photons/s",
-                    count(rate as u64),
-                    "Photons per second of render time in this epoch",
-                );
-                row(
-                    "Mean radius",
-                    format!("{:.4e}", stats.mean_radius),
-                    "Mean search radius of points that have gathered photons (scene units)",
-                );
-                row(
-                    "Visible points",
-                    count(stats.visible_points as u64),
-                    "Gathering points of the last eye pass",
-                );
-                row(
-                    "Useful photons",
-                    format!(
-                        "{:.1} %",
-                        100.0 * stats.useful_paths as f64 / stats.photons.max(1) as f64
-                    ),
-                    "Share of the photons that handed light to at least one visible point (guided emission raises it)",
-                );
-                row(
-                    "Indirect radius",
-                    format!("{:.2}x", stats.indirect_radius_scale),
-                    "The indirect light's initial radius over the initial radius (1: one estimate for all photons)",
-                );
-                row(
-                    "Narrowed radius",
-                    format!("{:.1} %", 100.0 * stats.narrowed_share),
-                    "Share of the points whose radius was narrowed after the first pass, where photons were dense (adaptive radius)",
-                );
+            for r in &frame.stats.rows {
+                row(&r.label, r.value.clone(), &r.tip);
             }
             row(
                 "Elapsed",
@@ -475,7 +432,7 @@ fn statistics_ui(viewer: &Viewer, ui: &mut egui::Ui) {
                 );
             }
         });
-    let skipped = frame.stats.photon_mapping().map_or(&[][..], |s| &s.skipped[..]);
+    let skipped = &frame.stats.skipped;
     if !skipped.is_empty() {
         ui.label("Skipped work:")
             .on_hover_text("Work this scene does not need, left out");
@@ -483,7 +440,7 @@ fn statistics_ui(viewer: &Viewer, ui: &mut egui::Ui) {
             ui.label(RichText::new(format!("- {s}")).small());
         }
     }
-    if frame.stats.renderer() == RendererKind::Ppm {
+    if frame.stats.renderer().progressive() {
         convergence_plot_ui(viewer, ui);
     }
 }

@@ -388,10 +388,7 @@ impl Viewer {
     /// The current frame as something to save, with its metadata.
     fn snapshot(&self) -> Option<Snapshot> {
         let frame = self.frame.as_ref()?;
-        let renderer = match frame.stats.renderer() {
-            RendererKind::Ppm => "ppm",
-            RendererKind::Whitted => "whitted",
-        };
+        let renderer = frame.stats.renderer().name();
         // The parameters the panel changes are added below; the base pairs (scene file, seed,
         // size) do not depend on them.
         let scene = self.edited_scene();
@@ -543,7 +540,7 @@ impl Viewer {
                 self.pending_restart = None;
             }
         }
-        if frame.stats.renderer() == RendererKind::Ppm && !frame.preview {
+        if frame.stats.renderer().progressive() && !frame.preview {
             self.convergence
                 .add(frame.photons, frame.elapsed_secs, &frame.radiance);
         }

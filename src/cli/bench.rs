@@ -7,7 +7,7 @@ use anyhow::{bail, Result};
 use clap::{Subcommand, ValueEnum};
 
 use super::bench_output::BenchOutput;
-use super::{load_scene, photon_map, ppm_stats};
+use super::{load_scene, ppm_stats, render_session};
 use caustic::assets::SMALLPPM_SCENE;
 use caustic::bench::{teapot_geometry, teapot_view, time_intersect};
 use caustic::geometry::{PatchMethod, SubdivisionParams};
@@ -218,7 +218,7 @@ fn bench_ppm(scene_path: Option<&Path>, run: PpmRun, threads: &[usize], out: &mu
             threads: Some(n),
             ..Default::default()
         };
-        let frame = photon_map(scene.clone(), session, |_| {})?;
+        let frame = render_session(scene.clone(), session, |_| {})?;
         let stats = ppm_stats(&frame)?;
         let rate = stats.photons as f64 / stats.photon_secs;
         let scaling = base.map_or(1.0, |b: f64| rate / b);

@@ -9,7 +9,7 @@ use anyhow::{bail, Context, Result};
 use clap::ValueEnum;
 
 use super::bench_output::BenchOutput;
-use super::photon_map;
+use super::render_session;
 use caustic::bench::convergence::{errors, write_csv, Checkpoint, Curve};
 use caustic::bench::plot::write_plot;
 use caustic::bench::reference::{default_cache_dir, ReferenceRecord};
@@ -270,7 +270,7 @@ fn reference(scene: &Scene, passes: u32, dir: Option<&Path>, out: &mut BenchOutp
         max_passes: Some(passes),
         ..Default::default()
     };
-    let frame = photon_map(reference_scene, options, |_| bar.inc(1))?;
+    let frame = render_session(reference_scene, options, |_| bar.inc(1))?;
     bar.finish_and_clear();
     let path = record
         .store(&dir, &frame.radiance)
@@ -288,7 +288,7 @@ fn measure(scene: Scene, name: &str, seconds: f64, reference: &[[f32; 3]]) -> Re
         ..Default::default()
     };
     let mut points = Vec::new();
-    photon_map(scene, options, |f| {
+    render_session(scene, options, |f| {
         let (rmse, rel_mse) = errors(&f.radiance, reference);
         points.push(Checkpoint {
             pass: f.pass,

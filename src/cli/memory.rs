@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use anyhow::{bail, Result};
 
 use super::bench_output::BenchOutput;
-use super::{load_scene, photon_map};
+use super::{load_scene, render_session};
 use caustic::render::session::SessionOptions;
 use caustic::scene::RendererKind;
 
@@ -94,7 +94,7 @@ pub fn bench_memory(args: MemoryArgs, out: &mut BenchOutput) -> Result<()> {
         ..Default::default()
     };
     let mut samples = Vec::new();
-    photon_map(scene, options, |f| {
+    render_session(scene, options, |f| {
         if f.pass % args.every == 0 || f.pass == 1 {
             if let Some((rss, peak)) = resident_mib() {
                 out.say(format!(

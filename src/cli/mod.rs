@@ -107,7 +107,7 @@ fn load_scene(path: Option<&Path>) -> Result<Scene> {
 /// Photon-maps `scene` (its renderer must be photon mapping) on a headless render session —
 /// the viewer's render loop — until the session's limits end it; `on_frame` sees every
 /// completed pass. Returns the last frame.
-fn photon_map(scene: Scene, options: SessionOptions, mut on_frame: impl FnMut(&Frame)) -> Result<Frame> {
+fn render_session(scene: Scene, options: SessionOptions, mut on_frame: impl FnMut(&Frame)) -> Result<Frame> {
     let options = SessionOptions {
         every_frame: true,
         ..options

@@ -8,13 +8,13 @@ use std::time::Duration;
 
 use anyhow::{bail, Result};
 
-use super::render_report::{RendererSummary, Report};
-use super::{load_scene, photon_map, ppm_stats};
+use super::render_report::Report;
+use super::{load_scene, render_session};
 use caustic::render::compare::Reference;
 use caustic::render::error::pixel_error_estimate;
-use caustic::render::provenance::{self, software, Recorded};
-use caustic::render::session::{Frame, SessionOptions};
-use caustic::render::{image_metadata, render_whitted, Image, Layer};
+use caustic::render::provenance::{software, Recorded};
+use caustic::render::session::{Frame, FrameStats, SessionOptions};
+use caustic::render::{image_metadata, Image, Layer};
 use caustic::scene::{RendererKind, Scene};
 use caustic::settings::limits;
 use caustic::settings::IndexKind;
@@ -246,17 +246,15 @@ pub fn render(args: RenderArgs) -> Result<()> {
         tev: &mut tev,
         report: &mut report,
     };
-    let rendered = match scene.params.renderer {
-        RendererKind::Ppm => {
-            let passes = args
-                .ppm
-                .passes
-                .or(recorded.as_ref().and_then(|r| r.passes))
-                .unwrap_or(16);
-            render_ppm(&mut scene, passes, &args.ppm, &mut output)?
-        }
-        RendererKind::Whitted => render_ray_traced(&scene, &mut output),
+    let passes = if scene.params.renderer.progressive() {
+        args.ppm
+            .passes
+            .or(recorded.as_ref().and_then(|r| r.passes))
+            .unwrap_or(16)
+    } else {
+        1
     };
+    let rendered = render_passes(&mut scene, passes, &args.ppm, &mut output)?;
     let layers: Vec<Layer> = rendered
         .layers
         .iter()
@@ -265,7 +263,7 @@ pub fn render(args: RenderArgs) -> Result<()> {
     rendered
         .image
         .save_with_layers(out, exposure, &rendered.metadata, &layers, args.force)?;
-    report.finish(out, &scene, rendered.summary, reference.as_ref(), &rendered.image);
+    report.finish(out, &scene, &rendered.stats, reference.as_ref(), &rendered.image);
     Ok(())
 }
 
@@ -297,34 +295,11 @@ struct Rendered {
     image: Image,
     layers: Vec<(&'static str, Vec<f32>)>,
     metadata: caustic::render::Metadata,
-    summary: RendererSummary,
+    stats: FrameStats,
 }
 
-fn render_ray_traced(scene: &Scene, output: &mut Output) -> Rendered {
-    let (w, h) = (scene.camera.width, scene.camera.height);
-    let bar = output.report.bar(
-        h as u64,
-        "{msg} [{bar:40}] {pos}/{len} rows, {elapsed} (eta {eta})",
-        format!("ray tracing {w}x{h}"),
-    );
-    let (image, stats) = render_whitted(scene, &|rows| bar.inc(rows as u64));
-    bar.finish_and_clear();
-    output.pass(1, stats.elapsed_secs, &image, &[]);
-    let mut metadata = image_metadata(scene, "whitted", None);
-    metadata.push(("caustic:camera_rays".into(), stats.camera_rays.to_string()));
-    metadata.push((
-        "caustic:elapsed_secs".into(),
-        format!("{:.3}", stats.elapsed_secs),
-    ));
-    Rendered {
-        image,
-        layers: Vec::new(),
-        metadata,
-        summary: RendererSummary::Whitted(stats),
-    }
-}
-
-fn render_ppm(scene: &mut Scene, passes: u32, args: &PpmArgs, output: &mut Output) -> Result<Rendered> {
+/// Renders `passes` passes (one frame for a renderer that makes one) on a headless session.
+fn render_passes(scene: &mut Scene, passes: u32, args: &PpmArgs, output: &mut Output) -> Result<Rendered> {
     if passes == 0 {
         bail!("--passes must be at least 1");
     }
@@ -335,10 +310,12 @@ fn render_ppm(scene: &mut Scene, passes: u32, args: &PpmArgs, output: &mut Outpu
     }
     args.overlay(&mut scene.params)?;
     let (w, h) = (scene.camera.width, scene.camera.height);
+    let kind = scene.params.renderer;
+    let what = format!("{} {w}x{h}", kind.label().to_lowercase());
     let bar = output.report.bar(
         passes as u64,
         "{msg} [{bar:40}] pass {pos}/{len}, {elapsed} (eta {eta})",
-        format!("photon mapping {w}x{h}"),
+        what.clone(),
     );
     output.report.set_bar(Some(bar.clone()));
     let session = SessionOptions {
@@ -348,45 +325,36 @@ fn render_ppm(scene: &mut Scene, passes: u32, args: &PpmArgs, output: &mut Outpu
     };
     let mut previous: Option<Frame> = None;
     let mut last: Option<Frame> = None;
-    let frame = photon_map(scene.clone(), session, |f| {
-        let Some(s) = f.stats.photon_mapping() else {
-            return;
-        };
-        bar.set_message(format!(
-            "photon mapping {w}x{h}, {:.2} M photons/s",
-            s.photons as f64 / s.photon_secs.max(1e-9) / 1e6
-        ));
-        bar.set_position(s.passes as u64);
+    let frame = render_session(scene.clone(), session, |f| {
+        if let Some(s) = f.stats.photon_mapping() {
+            let rate = s.photons as f64 / s.photon_secs.max(1e-9) / 1e6;
+            bar.set_message(format!("{what}, {rate:.2} M photons/s"));
+        }
+        bar.set_position(f.pass as u64);
         let image = frame_image(f);
         output.pass(f.pass, f.elapsed_secs, &image, &frame_layers(f));
         previous = last.replace(f.clone());
     })?;
     bar.finish_and_clear();
     output.report.set_bar(None);
-    let s = ppm_stats(&frame)?.clone();
-    let mut layers = vec![
-        ("radius", frame.radius.to_vec()),
-        ("photons", frame.gathered.to_vec()),
-    ];
+    let mut layers = Vec::new();
+    if frame.stats.photon_mapping().is_some() {
+        layers.push(("radius", frame.radius.to_vec()));
+        layers.push(("photons", frame.gathered.to_vec()));
+    }
     let error = previous
         .as_ref()
         .and_then(|p| pixel_error_estimate(p.photons, &p.radiance, frame.photons, &frame.radiance));
     if let Some(error) = error {
         layers.push(("error", error));
     }
-    let mut metadata = image_metadata(scene, "ppm", None);
-    metadata.extend([
-        (provenance::PASSES.into(), s.passes.to_string()),
-        ("caustic:photons".into(), s.photons.to_string()),
-        ("caustic:alpha".into(), scene.params.alpha.to_string()),
-        ("caustic:mean_radius".into(), format!("{:.6}", s.mean_radius)),
-        ("caustic:elapsed_secs".into(), format!("{:.3}", s.elapsed_secs)),
-    ]);
+    let mut metadata = image_metadata(scene, kind.name(), None);
+    metadata.extend(frame.stats.metadata.iter().cloned());
     Ok(Rendered {
         image: frame_image(&frame),
         layers,
         metadata,
-        summary: RendererSummary::PhotonMapping(s),
+        stats: frame.stats,
     })
 }
 
@@ -399,9 +367,13 @@ fn frame_image(f: &Frame) -> Image {
     }
 }
 
-/// The per-pixel layers a frame carries (what tev shows beside RGB).
-fn frame_layers(f: &Frame) -> [Layer<'_>; 2] {
-    [
+/// The per-pixel layers a frame carries (what tev shows beside RGB): a photon-mapped frame's
+/// search radius and photon count.
+fn frame_layers(f: &Frame) -> Vec<Layer<'_>> {
+    if f.stats.photon_mapping().is_none() {
+        return Vec::new();
+    }
+    vec![
         Layer {
             name: "radius",
             values: &f.radius,

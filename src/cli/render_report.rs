@@ -7,19 +7,9 @@ use std::path::Path;
 use serde::Serialize;
 
 use caustic::render::compare::{Reference, ReferenceErrors};
-use caustic::render::ppm::PpmStats;
-use caustic::render::{Image, WhittedStats};
+use caustic::render::session::FrameStats;
+use caustic::render::Image;
 use caustic::scene::Scene;
-
-/// What the renderer measured.
-#[derive(Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum RendererSummary {
-    /// Photon mapping's statistics.
-    PhotonMapping(PpmStats),
-    /// The ray tracer's statistics.
-    Whitted(WhittedStats),
-}
 
 /// The error against the reference after one pass.
 #[derive(Clone, Copy, Serialize)]
@@ -51,8 +41,9 @@ struct Summary<'a> {
     height: u32,
     seed: u64,
     mean: f64,
+    /// The renderer's statistics under its key (`photon_mapping`, `whitted`, …).
     #[serde(flatten)]
-    renderer: &'a RendererSummary,
+    renderer: &'a serde_json::Value,
     reference: Option<ReferenceSummary<'a>>,
     warnings: &'a [String],
 }
@@ -129,7 +120,7 @@ impl Report {
         &self,
         out: &Path,
         scene: &Scene,
-        renderer: RendererSummary,
+        stats: &FrameStats,
         reference: Option<&Reference>,
         image: &Image,
     ) {
@@ -147,7 +138,7 @@ impl Report {
                 height: image.height,
                 seed: scene.params.seed,
                 mean: image.mean(),
-                renderer: &renderer,
+                renderer: &stats.json,
                 reference: reference_summary,
                 warnings: &self.warnings,
             };
@@ -157,7 +148,7 @@ impl Report {
             }
             return;
         }
-        print_text(out, image, &renderer, scene.params.guided_emission);
+        print_text(out, image, stats);
         if let Some(r) = reference_summary {
             if let Some(e) = r.last {
                 println!(
@@ -169,52 +160,15 @@ impl Report {
     }
 }
 
-fn print_text(out: &Path, image: &Image, renderer: &RendererSummary, guided: bool) {
+fn print_text(out: &Path, image: &Image, stats: &FrameStats) {
     let (w, h) = (image.width, image.height);
-    match renderer {
-        RendererSummary::Whitted(stats) => println!(
-            "{}: {w}x{h} ray traced in {:.2} s ({} camera rays, {} edge pixels re-sampled, {:.0} rays/s)",
-            out.display(),
-            stats.elapsed_secs,
-            stats.camera_rays,
-            stats.edge_pixels,
-            stats.camera_rays as f64 / stats.elapsed_secs.max(1e-9)
-        ),
-        RendererSummary::PhotonMapping(s) => {
-            println!(
-                "{}: {w}x{h}, {} passes, {} photons in {:.2} s ({:.0} photons/s while tracing photons), mean radius {:.4}, {} visible points",
-                out.display(),
-                s.passes,
-                s.photons,
-                s.elapsed_secs,
-                s.photons as f64 / s.photon_secs.max(1e-9),
-                s.mean_radius,
-                s.visible_points
-            );
-            println!(
-                "  photons that reached a visible point: {:.1} %{}",
-                100.0 * s.useful_paths as f64 / s.photons.max(1) as f64,
-                if guided { " (guided emission on)" } else { "" }
-            );
-            if s.indirect_radius_scale > 1.0 {
-                println!(
-                    "  indirect light gathered over {:.2}x the radius of direct light and caustics",
-                    s.indirect_radius_scale
-                );
-            }
-            if s.narrowed_share > 0.0 {
-                println!(
-                    "  adaptive radius: {:.1} % of the points narrowed after the first pass, where photons were dense",
-                    100.0 * s.narrowed_share
-                );
-            }
-            println!(
-                "  time: eye passes {:.3} s ({} of them), area-light sampling {:.3} s, index builds {:.3} s, photons {:.3} s",
-                s.eye_secs, s.eye_passes, s.direct_secs, s.index_secs, s.photon_secs
-            );
-            for skipped in &s.skipped {
-                println!("  skipped: {skipped}");
-            }
-        }
+    let mut lines = stats.summary.iter();
+    println!(
+        "{}: {w}x{h}{}",
+        out.display(),
+        lines.next().map_or("", String::as_str)
+    );
+    for line in lines {
+        println!("{line}");
     }
 }

@@ -6,6 +6,8 @@
 pub mod compare;
 pub mod error;
 pub mod film;
+pub mod frame;
+pub mod integrator;
 pub mod ppm;
 pub mod provenance;
 pub mod rng;

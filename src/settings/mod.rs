@@ -7,6 +7,8 @@
 mod index;
 pub mod limits;
 mod params;
+mod renderer;
 
 pub use index::IndexKind;
-pub use params::{RenderParams, RendererKind};
+pub use params::RenderParams;
+pub use renderer::RendererKind;

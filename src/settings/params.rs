@@ -12,30 +12,7 @@ use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
 use super::limits;
-use super::IndexKind;
-
-/// Which renderer makes the image (`--renderer whitted|ppm` on the command line,
-/// `renderer = "whitted"|"ppm"` in a scene file).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
-#[serde(rename_all = "lowercase")]
-pub enum RendererKind {
-    /// The Whitted ray tracer (preview, and the seed report's first renderer).
-    Whitted,
-    /// Progressive photon mapping.
-    Ppm,
-}
-
-impl<'de> Deserialize<'de> for RendererKind {
-    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        match String::deserialize(d)?.as_str() {
-            "whitted" => Ok(RendererKind::Whitted),
-            "ppm" => Ok(RendererKind::Ppm),
-            other => Err(serde::de::Error::custom(format!(
-                "'renderer' must be \"whitted\" or \"ppm\", got \"{other}\""
-            ))),
-        }
-    }
-}
+use super::{IndexKind, RendererKind};
 
 /// Every render setting, with the defaults a scene file's `[render]` table starts from.
 /// Camera settings (pose, lens, image size) belong to [`crate::scene::Camera`].

@@ -18,17 +18,16 @@
 
 //!
 //! Files: [`command`] (the protocol: what may be asked, what restarts, what is valid),
-//! [`state`] (the rules), [`frame`] (what comes back), `integrator` (the renderer of an epoch:
-//! a photon-mapping pass, the preview, the ray-traced frame) and `thread` (the thread that
+//! [`state`] (the rules), `integrator` (the epoch's renderer as the session drives it: the plan
+//! of a pass, the preview) and `thread` (the thread that
 //! carries the rules out, and the handle to it).
 
 pub mod command;
-pub mod frame;
 mod integrator;
 pub mod state;
 mod thread;
 
+pub use crate::render::frame::{Frame, FrameStats};
 pub use command::Command;
-pub use frame::{Frame, FrameStats};
 pub use state::{Effect, Next, SessionOptions, SessionState};
 pub use thread::{RenderSession, Waker};

@@ -5,7 +5,7 @@ use std::time::Duration;
 
 use super::command::{apply_to_scene, valid, Command};
 use crate::render::ppm::PpmOptions;
-use crate::scene::{RendererKind, Scene};
+use crate::scene::Scene;
 use crate::settings::RenderParams;
 
 /// How a session renders, beyond the scene's own settings.
@@ -141,7 +141,7 @@ impl SessionState {
     /// Whether the session's limits are reached.
     fn finished(&self, epoch_secs: Duration) -> bool {
         self.options.max_passes.is_some_and(|n| self.passes >= n)
-            || (self.params.renderer == RendererKind::Ppm
+            || (self.params.renderer.progressive()
                 && self.options.time_limit.is_some_and(|t| epoch_secs >= t))
     }
 
@@ -153,7 +153,7 @@ impl SessionState {
             Next::Restart
         } else if self.waiting() {
             Next::Wait
-        } else if self.params.renderer == RendererKind::Whitted {
+        } else if !self.params.renderer.progressive() {
             Next::Trace
         } else if self.preview_due {
             Next::Preview
@@ -170,7 +170,7 @@ impl SessionState {
 
     /// Paused, or the ray-traced frame of this epoch is done.
     fn waiting(&self) -> bool {
-        self.paused || (self.params.renderer == RendererKind::Whitted && self.passes > 0)
+        self.paused || (!self.params.renderer.progressive() && self.passes > 0)
     }
 
     /// Opens a new epoch: the gathered commands are applied to `scene`.
@@ -187,16 +187,18 @@ impl SessionState {
     /// photons ([`RenderParams::pass_photons`]): the ramp from
     /// [`SessionOptions::first_pass_photons`] doubling up to `full`.
     pub fn pass_photons(&self, completed: u32, full: u64) -> u64 {
-        match self.options.first_pass_photons {
-            Some(first) => full.min(first.saturating_mul(1 << completed.min(40))),
-            None => full,
+        crate::render::integrator::PassPlan {
+            params: self.params.clone(),
+            first_pass_photons: self.options.first_pass_photons,
         }
+        .pass_photons(completed, full)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::settings::RendererKind;
     use glam::DVec3;
 
     fn state() -> SessionState {

@@ -11,9 +11,10 @@ use std::time::Instant;
 use crossbeam_channel::{bounded, unbounded, Receiver, Sender, TryRecvError};
 
 use super::command::Command;
-use super::frame::Frame;
-use super::integrator::{preview, Integrator, Step};
+use super::integrator::{pass, plan, preview, Step};
 use super::state::{Next, SessionOptions, SessionState};
+use crate::render::frame::Frame;
+use crate::render::integrator::{make, Setup};
 use crate::render::ppm::{Control, Interrupt, PpmOptions};
 use crate::scene::Scene;
 use crate::settings::RenderParams;
@@ -191,7 +192,7 @@ fn drain(state: &mut SessionState, commands: &Receiver<Command>) -> bool {
 }
 
 /// The render thread: a loop over [`SessionState::next`], carried out by the epoch's
-/// [`Integrator`].
+/// integrator.
 fn run(
     mut scene: Scene,
     options: SessionOptions,
@@ -203,8 +204,12 @@ fn run(
         let flag = interrupt.clone();
         Arc::new(move || flag.load(Ordering::Acquire))
     };
+    let setup = Setup {
+        ppm: options.ppm,
+        interrupt: Some(interrupted),
+    };
     let mut state = SessionState::new(&scene, options);
-    let mut integrator = Integrator::new(&scene, options.ppm, &interrupted);
+    let mut integrator = make(scene.params.renderer, &scene, &setup);
     let mut epoch_start = Instant::now();
     loop {
         // Whatever interrupted a pass is among the commands drained here.
@@ -215,34 +220,40 @@ fn run(
         let step = Step {
             epoch: state.epoch,
             epoch_start,
-            interrupted: &interrupted,
         };
+        let plan = plan(&state, &options);
         let frame = match state.next(epoch_start.elapsed()) {
             Next::Stop => return,
             Next::Wait => None,
             Next::Restart => {
                 state.restart(&mut scene);
-                integrator = Integrator::new(&scene, options.ppm, &interrupted);
+                integrator = make(scene.params.renderer, &scene, &setup);
                 epoch_start = Instant::now();
                 None
             }
             Next::Preview => {
                 state.preview_due = false;
                 let divisor = options.preview_divisor.unwrap_or(4);
-                preview(&mut scene, &options, divisor, step)
+                preview(&mut scene, &setup, &plan, divisor, step)
             }
             Next::Pass | Next::Trace => {
-                // Between batches: commands apply; a restart or the end drops the pass.
-                let mut control = |state: &mut SessionState| {
+                // Between batches: commands apply (α among them); a restart or the end
+                // drops the pass.
+                let mut control = |alpha: &mut f64| {
                     interrupt.store(false, Ordering::Release);
-                    drain(state, &commands);
+                    drain(&mut state, &commands);
+                    *alpha = state.params.alpha;
                     if state.must_abort() {
                         Control::Abort
                     } else {
                         Control::Continue
                     }
                 };
-                integrator.render(&scene, &mut state, step, &mut control)
+                let frame = pass(integrator.as_mut(), &scene, &plan, step, &mut control);
+                if frame.is_some() {
+                    state.passes = integrator.passes();
+                }
+                frame
             }
         };
         if let Some(frame) = frame {

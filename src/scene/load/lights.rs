@@ -112,7 +112,7 @@ pub(super) fn add_lights(
     let mut light_objects = Vec::new();
     let mut emitter_material: Option<usize> = None;
     for (k, desc) in descs.iter().enumerate() {
-        let light = light(&ctx, k, desc)?;
+        let light = light(ctx, k, desc)?;
         // Area lights are visible: their surface joins the geometry as an emitter.
         let id = objects.len() as u32;
         let emission = match &light {

@@ -1,0 +1,150 @@
+//! What a render hands on after each pass: a [`Frame`] (radiance and per-pixel statistics) and
+//! what its integrator measured ([`FrameStats`]: the rows the viewer shows, the lines and JSON
+//! the command line prints, the metadata an image records). The integrator fills them in; the
+//! session, the viewer and the command line only pass them on.
+
+use std::sync::Arc;
+
+use crate::render::ppm::PpmStats;
+use crate::settings::RendererKind;
+
+/// One statistic as the viewer shows it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StatRow {
+    /// Its name.
+    pub label: String,
+    /// Its value, formatted.
+    pub value: String,
+    /// What it means.
+    pub tip: String,
+}
+
+impl StatRow {
+    /// A row.
+    pub fn new(label: &str, value: String, tip: &str) -> Self {
+        Self {
+            label: label.to_owned(),
+            value,
+            tip: tip.to_owned(),
+        }
+    }
+}
+
+/// What a frame's integrator measured.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrameStats {
+    /// Which renderer made the frame.
+    pub kind: RendererKind,
+    /// Seconds the renderer spent (all passes of the epoch for a progressive one).
+    pub seconds: f64,
+    /// The viewer's statistics rows for this renderer.
+    pub rows: Vec<StatRow>,
+    /// The command line's closing summary: the first line follows `FILE: WxH`, the others are
+    /// printed as they are.
+    pub summary: Vec<String>,
+    /// Work the scene let the renderer skip, in words.
+    pub skipped: Vec<String>,
+    /// The statistics as JSON, under the renderer's key (`caustic render --json`).
+    pub json: serde_json::Value,
+    /// `caustic:*` metadata the saved image records.
+    pub metadata: Vec<(String, String)>,
+    /// Photon mapping's own statistics, where the frame was photon mapped.
+    pub ppm: Option<PpmStats>,
+}
+
+impl FrameStats {
+    /// Seconds the renderer spent on the frame (all passes of the epoch for photon mapping).
+    pub fn elapsed_secs(&self) -> f64 {
+        self.seconds
+    }
+
+    /// Photon mapping's statistics, if the frame was photon mapped.
+    pub fn photon_mapping(&self) -> Option<&PpmStats> {
+        self.ppm.as_ref()
+    }
+
+    /// Which renderer made the frame.
+    pub fn renderer(&self) -> RendererKind {
+        self.kind
+    }
+}
+
+/// One finished pass, as the viewer needs it.
+#[derive(Clone, Debug)]
+pub struct Frame {
+    /// Increases whenever accumulated statistics are discarded.
+    pub epoch: u64,
+    /// Passes completed in this epoch (1 for a ray-traced frame).
+    pub pass: u32,
+    /// Photons emitted in this epoch (0 for renderers without photons).
+    pub photons: u64,
+    /// Seconds since this epoch started.
+    pub elapsed_secs: f64,
+    /// What the renderer measured (and so which renderer made it).
+    pub stats: FrameStats,
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// Linear RGB radiance, `width × height` pixels, rows from the top.
+    pub radiance: Arc<[[f32; 3]]>,
+    /// Search radius per pixel (largest of the pixel's slots), for the viewer's probe; zeros
+    /// for renderers without one.
+    pub radius: Arc<[f32]>,
+    /// Accumulated photon count `N` per pixel (summed over the pixel's slots), or samples.
+    pub gathered: Arc<[f32]>,
+    /// A quick low-resolution preview of a new epoch (pass 0), enlarged to full size.
+    pub preview: bool,
+}
+
+impl Frame {
+    /// A frame of `radiance` with no per-pixel search statistics.
+    pub fn of_radiance(
+        (width, height): (u32, u32),
+        radiance: Vec<[f32; 3]>,
+        pass: u32,
+        (epoch, elapsed_secs): (u64, f64),
+        stats: FrameStats,
+    ) -> Frame {
+        let pixels = radiance.len();
+        Frame {
+            epoch,
+            pass,
+            photons: 0,
+            elapsed_secs,
+            stats,
+            width,
+            height,
+            radiance: radiance.into(),
+            radius: vec![0.0; pixels].into(),
+            gathered: vec![0.0; pixels].into(),
+            preview: false,
+        }
+    }
+
+    /// This frame at a larger size `(w, h)` (nearest neighbour), marked as a preview.
+    pub fn enlarged_preview(self, (w, h): (u32, u32)) -> Frame {
+        let small = (self.width, self.height);
+        Frame {
+            pass: 0,
+            photons: 0,
+            width: w,
+            height: h,
+            radiance: enlarge(&self.radiance, small, (w, h)),
+            radius: enlarge(&self.radius, small, (w, h)),
+            gathered: enlarge(&self.gathered, small, (w, h)),
+            preview: true,
+            ..self
+        }
+    }
+}
+
+/// Nearest-neighbour enlargement of a `(sw, sh)` image to `(w, h)`.
+fn enlarge<T: Copy>(src: &[T], (sw, sh): (u32, u32), (w, h): (u32, u32)) -> Arc<[T]> {
+    (0..h)
+        .flat_map(|y| {
+            let sy = (y as u64 * sh as u64 / h as u64) as usize;
+            (0..w).map(move |x| src[sy * sw as usize + (x as u64 * sw as u64 / w as u64) as usize])
+        })
+        .collect()
+}

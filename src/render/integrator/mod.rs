@@ -1,0 +1,85 @@
+//! The seam between a render and its renderer: every renderer is an [`Integrator`] that
+//! renders a pass at a time and describes its own image and statistics ([`Frame`],
+//! [`FrameStats`]). The session, the command line and the viewer talk to it through this
+//! interface only; which renderers exist, and whether each renders pass after pass or one
+//! frame per epoch, comes from the one list in `src/render/integrator/renderers.rs` ([`RendererKind`]).
+//!
+//! A new renderer is a file here with a type that implements [`Integrator`] and has
+//! `fn new(scene: &Scene, setup: &Setup) -> Self`, plus its line in `src/render/integrator/renderers.rs`.
+
+use crate::render::frame::Frame;
+use crate::render::ppm::{Control, Interrupt, PpmOptions};
+use crate::scene::Scene;
+use crate::settings::{RenderParams, RendererKind};
+
+/// How an integrator is set up, beyond the scene's own settings.
+#[derive(Clone, Default)]
+pub struct Setup {
+    /// Photon-mapping options (batch size, forced stochastic eye passes).
+    pub ppm: PpmOptions,
+    /// Asked often during a pass; returning true abandons it.
+    pub interrupt: Option<Interrupt>,
+}
+
+impl Setup {
+    /// Whether the pass in progress is to be abandoned.
+    pub fn interrupted(&self) -> bool {
+        self.interrupt.as_ref().is_some_and(|i| i())
+    }
+}
+
+/// What the coming pass is to do: the current parameters (α and the photon counts may change
+/// between passes without a restart) and the photon ramp of a new epoch.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PassPlan {
+    /// The render parameters now.
+    pub params: RenderParams,
+    /// Photons in an epoch's first pass, doubling pass by pass up to the full count (`None`:
+    /// full passes from the start).
+    pub first_pass_photons: Option<u64>,
+}
+
+impl PassPlan {
+    /// Photons of the pass after `completed` passes of a render whose full pass is `full`.
+    pub fn pass_photons(&self, completed: u32, full: u64) -> u64 {
+        match self.first_pass_photons {
+            Some(first) => full.min(first.saturating_mul(1 << completed.min(40))),
+            None => full,
+        }
+    }
+}
+
+/// A renderer: one pass at a time, its image and statistics on request.
+pub trait Integrator: Send {
+    /// Renders the next pass of `scene` as `plan` says. `control` is asked between batches of
+    /// work, with the α the pass uses (which it may change); [`Control::Abort`] abandons the
+    /// pass. Returns whether the pass completed (an abandoned pass leaves no trace).
+    fn render_pass(
+        &mut self,
+        scene: &Scene,
+        plan: &PassPlan,
+        control: &mut dyn FnMut(&mut f64) -> Control,
+    ) -> bool;
+
+    /// Completed passes.
+    fn passes(&self) -> u32;
+
+    /// The image so far as a frame of `epoch`, `elapsed_secs` into it.
+    fn frame(&self, epoch: u64, elapsed_secs: f64) -> Frame;
+}
+
+/// Declares each renderer's module and makes the integrator of a kind, from the list.
+macro_rules! renderers {
+    ($($variant:ident, $name:literal, $label:literal, $about:literal, $mode:ident, $module:ident :: $integrator:ident;)*) => {
+        $(pub mod $module;)*
+
+        /// The integrator of `kind` for `scene`.
+        pub fn make(kind: RendererKind, scene: &Scene, setup: &Setup) -> Box<dyn Integrator> {
+            match kind {
+                $(RendererKind::$variant => Box::new($module::$integrator::new(scene, setup)),)*
+            }
+        }
+    };
+}
+
+include!("renderers.rs");

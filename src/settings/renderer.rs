@@ -1,0 +1,105 @@
+//! Which renderer makes the image ([`RendererKind`]): made from the one list of renderers in
+//! `src/render/integrator/renderers.rs`, so the scene format, the command line (`--renderer`) and the viewer's
+//! buttons all come from it.
+
+use serde::{Deserialize, Serialize};
+
+/// Makes [`RendererKind`] from the list (the integrator column is the render layer's).
+macro_rules! renderers {
+    ($($variant:ident, $name:literal, $label:literal, $about:literal, $mode:ident, $module:ident :: $integrator:ident;)*) => {
+        /// Which renderer makes the image: `renderer = "NAME"` in a scene's `[render]` table,
+        /// `--renderer NAME` on the command line, a button in the viewer.
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, clap::ValueEnum)]
+        pub enum RendererKind {
+            $(
+                #[doc = $label]
+                #[value(name = $name)]
+                $variant,
+            )*
+        }
+
+        impl RendererKind {
+            /// Every renderer, in the list's order.
+            pub const ALL: &'static [RendererKind] = &[$(RendererKind::$variant),*];
+
+            /// The name in scene files and on the command line.
+            pub fn name(self) -> &'static str {
+                match self {
+                    $(RendererKind::$variant => $name,)*
+                }
+            }
+
+            /// The label the viewer shows.
+            pub fn label(self) -> &'static str {
+                match self {
+                    $(RendererKind::$variant => $label,)*
+                }
+            }
+
+            /// What it does, in a sentence (the viewer's tooltip).
+            pub fn description(self) -> &'static str {
+                match self {
+                    $(RendererKind::$variant => $about,)*
+                }
+            }
+
+            /// Whether it renders pass after pass until stopped (else one frame per epoch).
+            pub fn progressive(self) -> bool {
+                match self {
+                    $(RendererKind::$variant => renderers!(@progressive $mode),)*
+                }
+            }
+        }
+    };
+    (@progressive progressive) => { true };
+    (@progressive single) => { false };
+}
+
+include!("../render/integrator/renderers.rs");
+
+impl RendererKind {
+    /// The kind named `name`.
+    pub fn from_name(name: &str) -> Option<RendererKind> {
+        Self::ALL.iter().copied().find(|k| k.name() == name)
+    }
+}
+
+impl Serialize for RendererKind {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
+
+impl<'de> Deserialize<'de> for RendererKind {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let name = String::deserialize(d)?;
+        RendererKind::from_name(&name).ok_or_else(|| {
+            let names: Vec<String> = Self::ALL.iter().map(|k| format!("\"{}\"", k.name())).collect();
+            serde::de::Error::custom(format!(
+                "'renderer' must be {}, got \"{name}\"",
+                names.join(" or ")
+            ))
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_round_trip_and_unknown_ones_list_the_known() {
+        for &k in RendererKind::ALL {
+            assert_eq!(RendererKind::from_name(k.name()), Some(k));
+            let text = toml::to_string(&std::collections::BTreeMap::from([("r", k)])).expect("serializes");
+            assert_eq!(text.trim(), format!("r = \"{}\"", k.name()));
+        }
+        let err = toml::from_str::<std::collections::BTreeMap<String, RendererKind>>("r = \"x\"")
+            .expect_err("unknown");
+        assert!(
+            err.to_string()
+                .contains("'renderer' must be \"whitted\" or \"ppm\""),
+            "{err}"
+        );
+    }
+}
