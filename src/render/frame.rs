@@ -76,7 +76,8 @@ pub struct Frame {
     pub epoch: u64,
     /// Passes completed in this epoch (1 for a ray-traced frame).
     pub pass: u32,
-    /// Photons emitted in this epoch (0 for renderers without photons).
+    /// Photons emitted in this epoch, or paths traced by a renderer without photons: the
+    /// sample count that error estimates between two frames scale by (0 for a single frame).
     pub photons: u64,
     /// Seconds since this epoch started.
     pub elapsed_secs: f64,
