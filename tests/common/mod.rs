@@ -106,3 +106,4 @@ pub fn shared_edges(patches: &[BezierPatch]) -> Vec<SharedEdge> {
 
 #[cfg(feature = "viewer")]
 pub mod gpu;
+pub mod lighting;
