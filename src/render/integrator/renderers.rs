@@ -9,4 +9,5 @@
 renderers! {
     Whitted, "whitted", "Ray tracer", "Whitted ray tracer: one fast frame, direct light, mirrors and glass only", single, ray_tracer::RayTracer;
     Ppm, "ppm", "Photon mapping", "Progressive photon mapping: converges to caustics and indirect light", progressive, photon_mapping::PhotonMapping;
+    Path, "path", "Path tracer", "Unidirectional path tracer with light sampling and MIS: an unbiased cross-check of photon mapping", progressive, path::PathTracer;
 }
