@@ -12,7 +12,7 @@
 //!   and camera moves (drawn by [`crate::gpu::wireframe`]).
 //! - [`image_view`]: texture, fit / 1:1 / zoom / pan, probe.
 //! - [`params`]: parameters and the session commands their changes send.
-//! - [`convergence`]: the error estimate (and the true error against a reference) plotted
+//! - [`error_plot`]: the error estimate (and the true error against a reference) plotted
 //!   against time; [`reference`], [`difference`]: the reference image, the difference views
 //!   and the A/B toggle.
 //! - [`save`], [`job`], [`file_dialog`]: dialogs (native, or inside the window where no native
@@ -23,10 +23,10 @@
 pub mod action;
 pub mod automation;
 pub mod controls;
-pub mod convergence;
 pub mod difference;
 pub mod edit_panel;
 pub mod editor;
+pub mod error_plot;
 pub mod file_dialog;
 pub mod image_view;
 pub mod job;

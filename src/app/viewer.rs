@@ -8,8 +8,8 @@ use std::time::Instant;
 
 use super::action::{Action, AfterDiscard};
 use super::controls;
-use super::convergence::Convergence;
 use super::editor::Editor;
+use super::error_plot::Convergence;
 use super::file_dialog::{self, FileDialog, FileRequest, NativeDialog};
 use super::image_view::{frame_image, Comparison, ImageView, Probe};
 use super::job::{Job, Poll};

@@ -1,9 +1,9 @@
 //! Measurement harnesses behind `caustic bench`: deterministic inputs, figures printed, never
 //! asserted (tests assert correctness; benches report speed). Error against time lives in
-//! [`convergence`] (curves, CSV), [`plot`] (log-log PNG) and [`reference`] (the cached
+//! [`error_curves`] (curves, CSV), [`plot`] (log-log PNG) and [`reference`] (the cached
 //! reference render).
 
-pub mod convergence;
+pub mod error_curves;
 pub mod plot;
 pub mod reference;
 

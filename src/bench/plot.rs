@@ -6,7 +6,7 @@ use std::sync::Once;
 
 use plotters::prelude::*;
 
-use super::convergence::Curve;
+use super::error_curves::Curve;
 use crate::files::{write_atomically, WriteError};
 
 /// Plot size in pixels.

@@ -63,7 +63,7 @@ pub enum BenchCommand {
     /// Photon mapping: error against wall time for several configurations (old and new
     /// defaults, α, initial radius, index) against a long reference render, cached on disk.
     /// Prints a table; writes a CSV and a log-log plot on request.
-    Convergence(super::convergence::ConvergenceArgs),
+    Convergence(super::bench_convergence::ConvergenceArgs),
     /// Photon mapping: resident memory (current and peak) of a long stochastic render (open
     /// aperture), sampled every --every passes.
     Memory(super::memory::MemoryArgs),
@@ -96,9 +96,9 @@ impl BenchCommand {
     /// thread counts take a list of their own).
     pub fn threads(&self) -> Option<usize> {
         match self {
-            BenchCommand::Convergence(args) => args.threads,
-            BenchCommand::Memory(args) => args.threads,
-            BenchCommand::Tessellation(args) => args.threads,
+            BenchCommand::Convergence(args) => args.threads.threads,
+            BenchCommand::Memory(args) => args.threads.threads,
+            BenchCommand::Tessellation(args) => args.threads.threads,
             _ => None,
         }
     }
@@ -153,7 +153,7 @@ pub fn bench(what: BenchCommand, json: bool) -> Result<()> {
             };
             bench_ppm(scene.as_deref(), run, &threads, &mut out)
         }
-        BenchCommand::Convergence(args) => super::convergence::bench_convergence(args, &mut out),
+        BenchCommand::Convergence(args) => super::bench_convergence::bench_convergence(args, &mut out),
     }?;
     out.finish();
     Ok(())

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 
 use super::load_scene;
+use super::shared_args::Overwrite;
 use caustic::files::write_atomically;
 use caustic::geometry::freeform::{write_freeform_obj, DomainPatch};
 use caustic::geometry::tessellate::{tessellate, write_obj};
@@ -25,9 +26,8 @@ pub struct ExportArgs {
     /// (u,v) window), instead of triangles: reading the file back gives the same control points.
     #[arg(long, conflicts_with = "resolution")]
     freeform: bool,
-    /// Replace the output file if it exists.
-    #[arg(long)]
-    force: bool,
+    #[command(flatten)]
+    overwrite: Overwrite,
 }
 
 /// Writes the scene's patches, tessellated, as an OBJ file.
@@ -37,18 +37,14 @@ pub fn export_obj(args: ExportArgs) -> Result<()> {
         out,
         resolution,
         freeform,
-        force,
+        overwrite,
     } = args;
+    let force = overwrite.force;
     let out = out.as_path();
     if !(1..=256).contains(&resolution) {
         bail!("--resolution must be between 1 and 256, got {resolution}");
     }
-    if out.exists() && !force {
-        bail!(
-            "{}: the file exists; choose another name or pass --force to overwrite it",
-            out.display()
-        );
-    }
+    overwrite.check([out])?;
     let scene = load_scene(scene_path.as_deref())?;
     if freeform {
         return export_freeform(&scene, out, force);

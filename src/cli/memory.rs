@@ -7,6 +7,7 @@ use std::path::PathBuf;
 use anyhow::{bail, Result};
 
 use super::bench_output::BenchOutput;
+use super::shared_args::Threads;
 use super::{load_scene, render_session};
 use caustic::render::session::SessionOptions;
 use caustic::scene::RendererKind;
@@ -31,9 +32,8 @@ pub struct MemoryArgs {
     /// Photons per pass (small: the eye pass and its visible points are what grows).
     #[arg(long, default_value_t = 20_000)]
     photons: u64,
-    /// Render with this many threads (default: one per core).
-    #[arg(long, value_name = "N")]
-    pub threads: Option<usize>,
+    #[command(flatten)]
+    pub threads: Threads,
 }
 
 /// Resident set size and its peak, in MiB, from `/proc/self/status` (Linux).

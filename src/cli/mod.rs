@@ -1,13 +1,14 @@
 //! The `caustic` command line: argument parsing and dispatch; each command lives in a file of
-//! its own ([`view`], [`render`], [`export`], [`bench`], [`convergence`], [`memory`]).
+//! its own ([`view`], [`render`], [`export`], [`bench`], [`bench_convergence`], [`memory`]).
 
 mod bench;
+mod bench_convergence;
 mod bench_output;
-mod convergence;
 mod export;
 mod memory;
 mod render;
 mod render_report;
+mod shared_args;
 mod tessellation;
 mod view;
 
@@ -58,8 +59,8 @@ pub fn run() -> Result<()> {
         .command
         .unwrap_or_else(|| Command::View(view::ViewArgs::parse_from(["caustic view"])));
     use_threads(match &command {
-        Command::View(a) => a.threads,
-        Command::Render(a) => a.threads,
+        Command::View(a) => a.threads.threads,
+        Command::Render(a) => a.threads.threads,
         Command::ExportObj(_) => None,
         Command::Bench { what, .. } => what.threads(),
     })?;

@@ -9,6 +9,7 @@ use std::time::Duration;
 use anyhow::{bail, Result};
 
 use super::render_report::Report;
+use super::shared_args::{Overwrite, Threads};
 use super::{load_scene, render_session};
 use caustic::render::compare::Reference;
 use caustic::render::error::pixel_error_estimate;
@@ -52,12 +53,10 @@ pub struct RenderArgs {
     /// PNG exposure in stops (EXR is always linear); default 0, or what --from records.
     #[arg(long, allow_negative_numbers = true)]
     exposure: Option<f32>,
-    /// Replace the output file if it exists.
-    #[arg(long)]
-    force: bool,
-    /// Render with this many threads (default: one per core); the image does not depend on it.
-    #[arg(long, value_name = "N")]
-    pub threads: Option<usize>,
+    #[command(flatten)]
+    overwrite: Overwrite,
+    #[command(flatten)]
+    pub threads: Threads,
     /// Compare with a reference image (.exr or .pfm of the same size): RMSE and relative MSE
     /// after every pass and at the end.
     #[arg(long, value_name = "FILE")]
@@ -184,12 +183,7 @@ pub fn render(args: RenderArgs) -> Result<()> {
     if caustic::render::film::Format::from_path(out).is_none() {
         bail!("{}: unknown image format (use .png or .exr)", out.display());
     }
-    if out.exists() && !args.force {
-        bail!(
-            "{}: the file exists; choose another name or pass --force to overwrite it",
-            out.display()
-        );
-    }
+    args.overwrite.check([out])?;
     let mut report = Report::new(args.json);
     let (mut scene, recorded) = match &args.from {
         Some(image) => {
@@ -262,7 +256,7 @@ pub fn render(args: RenderArgs) -> Result<()> {
         .collect();
     rendered
         .image
-        .save_with_layers(out, exposure, &rendered.metadata, &layers, args.force)?;
+        .save_with_layers(out, exposure, &rendered.metadata, &layers, args.overwrite.force)?;
     report.finish(out, &scene, &rendered.stats, reference.as_ref(), &rendered.image);
     Ok(())
 }

@@ -13,6 +13,7 @@ use anyhow::{bail, Context, Result};
 
 use super::bench_output::BenchOutput;
 use super::load_scene;
+use super::shared_args::{CurveFiles, Threads};
 use caustic::bench::plot::{draw_series, write_png, Frame, Series};
 use caustic::files::write_atomically;
 use caustic::geometry::{PatchMethod, SubdivisionParams};
@@ -34,18 +35,11 @@ pub struct TessellationArgs {
     /// Subdivision depth of the per-ray (seed report) intersector.
     #[arg(long, default_value_t = 5)]
     per_ray_depth: u32,
-    /// Write every row (method, segments, triangles, seconds, RMSE) to this CSV file.
-    #[arg(long)]
-    csv: Option<PathBuf>,
-    /// Write the log-log plot of RMSE against render seconds to this PNG file.
-    #[arg(long)]
-    plot: Option<PathBuf>,
-    /// Replace existing CSV and plot files.
-    #[arg(long)]
-    force: bool,
-    /// Render with this many threads (default: one per core).
-    #[arg(long, value_name = "N")]
-    pub threads: Option<usize>,
+    /// Rows (method, segments, triangles, seconds, RMSE) and the plot of RMSE against seconds.
+    #[command(flatten)]
+    files: CurveFiles,
+    #[command(flatten)]
+    pub threads: Threads,
 }
 
 /// One render of the comparison.
@@ -76,14 +70,7 @@ pub fn bench_tessellation(args: TessellationArgs, out: &mut BenchOutput) -> Resu
             args.per_ray_depth
         );
     }
-    for path in [&args.csv, &args.plot].into_iter().flatten() {
-        if path.exists() && !args.force {
-            bail!(
-                "{}: the file exists; choose another name or pass --force",
-                path.display()
-            );
-        }
-    }
+    args.files.check()?;
     caustic::settings::limits::image_side(args.width).map_err(|e| anyhow::anyhow!("--width {e}"))?;
     scene.camera.resize(Some(args.width), None);
     let (w, h) = (scene.camera.width, scene.camera.height);
@@ -157,7 +144,7 @@ pub fn bench_tessellation(args: TessellationArgs, out: &mut BenchOutput) -> Resu
         );
         rows.push(row);
     }
-    if let Some(path) = &args.csv {
+    if let Some(path) = &args.files.csv {
         let mut text = String::from("geometry,segments,triangles,prepare_seconds,render_seconds,rmse\n");
         for r in &rows {
             let segments = r.segments.map_or(String::new(), |n| n.to_string());
@@ -171,12 +158,12 @@ pub fn bench_tessellation(args: TessellationArgs, out: &mut BenchOutput) -> Resu
                 r.rmse
             );
         }
-        write_atomically(path, args.force, |t| {
+        write_atomically(path, args.files.overwrite.force, |t| {
             std::fs::write(t, &text).map_err(|e| e.to_string())
         })?;
         out.say(format!("rows written to {}", path.display()));
     }
-    if let Some(path) = &args.plot {
+    if let Some(path) = &args.files.plot {
         let name = scene
             .source
             .file_name()
@@ -198,7 +185,7 @@ pub fn bench_tessellation(args: TessellationArgs, out: &mut BenchOutput) -> Resu
             },
         )
         .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-        write_png(&pixels, path, args.force).context("cannot write the plot")?;
+        write_png(&pixels, path, args.files.overwrite.force).context("cannot write the plot")?;
         out.say(format!("plot written to {}", path.display()));
     }
     Ok(())

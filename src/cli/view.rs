@@ -7,6 +7,8 @@ use anyhow::bail;
 use anyhow::Result;
 use clap::Parser;
 
+use super::shared_args::{Overwrite, Threads};
+
 /// `caustic view` (also what `caustic` alone runs, with these defaults).
 #[derive(Parser)]
 pub struct ViewArgs {
@@ -19,16 +21,14 @@ pub struct ViewArgs {
     /// Passes to wait for before --screenshot.
     #[arg(long, default_value_t = 4, value_name = "N")]
     pub after_passes: u32,
-    /// Replace an existing --screenshot file.
-    #[arg(long)]
-    pub force: bool,
+    #[command(flatten)]
+    pub overwrite: Overwrite,
     /// Measure launch-to-first-image, UI frame rate while rendering and the latency from
     /// an aperture change to the new image; print them and close.
     #[arg(long)]
     pub bench: bool,
-    /// Render with this many threads (default: one per core).
-    #[arg(long, value_name = "N")]
-    pub threads: Option<usize>,
+    #[command(flatten)]
+    pub threads: Threads,
     /// Compare with this reference image (.exr or .pfm of the scene's size): the true error
     /// in the convergence plot, the difference views and the A/B toggle (B).
     #[arg(long, value_name = "FILE")]
@@ -42,7 +42,7 @@ pub fn view(args: ViewArgs, launched: std::time::Instant) -> Result<()> {
         scene,
         screenshot,
         after_passes,
-        force,
+        overwrite,
         bench,
         threads: _,
         reference,
@@ -61,7 +61,7 @@ pub fn view(args: ViewArgs, launched: std::time::Instant) -> Result<()> {
     let launch = caustic::app::LaunchOptions {
         screenshot,
         screenshot_after_passes: after_passes.max(1),
-        force,
+        force: overwrite.force,
         bench,
         launched,
         reference,

@@ -10,7 +10,8 @@ use clap::ValueEnum;
 
 use super::bench_output::BenchOutput;
 use super::render_session;
-use caustic::bench::convergence::{errors, write_csv, Checkpoint, Curve};
+use super::shared_args::{CurveFiles, Threads};
+use caustic::bench::error_curves::{errors, write_csv, Checkpoint, Curve};
 use caustic::bench::plot::write_plot;
 use caustic::bench::reference::{default_cache_dir, ReferenceRecord};
 use caustic::render::ppm::Ppm;
@@ -140,18 +141,11 @@ pub struct ConvergenceArgs {
         default_value = "photons-only,default,unguided,unstratified,one-estimate,fixed-radius,alpha-0.5,alpha-0.667,alpha-0.9,radius-x4"
     )]
     configs: Vec<Config>,
-    /// Write every (configuration, pass, seconds, RMSE, relMSE) row to this CSV file.
-    #[arg(long)]
-    csv: Option<PathBuf>,
-    /// Write the log-log plot of RMSE against seconds to this PNG file.
-    #[arg(long)]
-    plot: Option<PathBuf>,
-    /// Replace existing CSV and plot files.
-    #[arg(long)]
-    force: bool,
-    /// Render with this many threads (default: one per core).
-    #[arg(long, value_name = "N")]
-    pub threads: Option<usize>,
+    /// Rows (configuration, pass, seconds, RMSE, relMSE) and the plot of RMSE against seconds.
+    #[command(flatten)]
+    files: CurveFiles,
+    #[command(flatten)]
+    pub threads: Threads,
 }
 
 /// Runs the measurement and prints the table.
@@ -163,14 +157,7 @@ pub fn bench_convergence(args: ConvergenceArgs, out: &mut BenchOutput) -> Result
         args.baseline_seconds,
         args.reference_passes,
     )?;
-    for out in [&args.csv, &args.plot].into_iter().flatten() {
-        if out.exists() && !args.force {
-            bail!(
-                "{}: the file exists; choose another name or pass --force",
-                out.display()
-            );
-        }
-    }
+    args.files.check()?;
     scene.camera.resize(Some(args.width), None);
     scene.params.renderer = RendererKind::Ppm;
     // The reference keeps the scene's own photons per pass, so runs with other --photons
@@ -207,11 +194,11 @@ pub fn bench_convergence(args: ConvergenceArgs, out: &mut BenchOutput) -> Result
         curves.push(measure(configured, config.label(), seconds, &reference)?);
     }
     print_table(&curves, out);
-    if let Some(path) = &args.csv {
-        write_csv(&curves, path, args.force)?;
+    if let Some(path) = &args.files.csv {
+        write_csv(&curves, path, args.files.overwrite.force)?;
         out.say(format!("rows written to {}", path.display()));
     }
-    if let Some(path) = &args.plot {
+    if let Some(path) = &args.files.plot {
         let title = format!(
             "{}: RMSE against time ({}x{})",
             scene
@@ -221,7 +208,7 @@ pub fn bench_convergence(args: ConvergenceArgs, out: &mut BenchOutput) -> Result
             scene.camera.width,
             scene.camera.height
         );
-        write_plot(&curves, &title, path, args.force)?;
+        write_plot(&curves, &title, path, args.files.overwrite.force)?;
         out.say(format!("plot written to {}", path.display()));
     }
     Ok(())
