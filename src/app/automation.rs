@@ -216,72 +216,8 @@ impl Automation {
                     };
                 }
             }
-            Stage::FrameRate {
-                start,
-                frames,
-                worst,
-                last,
-                ui_secs: total_ui,
-                paused,
-            } => {
-                *frames += 1;
-                *total_ui += ui_secs;
-                *worst = (*worst).max(now - *last);
-                *last = now;
-                if now - *start >= FPS_WINDOW {
-                    let secs = (now - *start).as_secs_f64();
-                    let figures = (
-                        *frames as f64 / secs,
-                        worst.as_secs_f64(),
-                        *total_ui / *frames as f64,
-                    );
-                    // Then the same with the renderer paused: what the UI costs by itself here.
-                    let mut p = viewer.params.clone();
-                    if *paused {
-                        self.fps_paused = Some(figures);
-                        p.paused = false;
-                        self.stage = Stage::Latency { round: 0, sent: None };
-                    } else {
-                        self.fps = Some(figures);
-                        p.paused = true;
-                        self.stage = Stage::frame_rate(now, true);
-                    }
-                    viewer.set_params(p);
-                }
-            }
-            Stage::Latency { round, sent } => match sent {
-                None => {
-                    // Move the aperture slider's value, exactly as a drag would.
-                    let mut p = viewer.params.clone();
-                    let open = viewer.ranges.aperture_max * 0.02;
-                    p.aperture = if *round % 2 == 0 { open } else { 0.0 };
-                    viewer.set_params(p);
-                    *sent = Some(now);
-                }
-                Some(at) => {
-                    let shown = viewer.restart_latency_secs().is_some() && !viewer.restart_pending();
-                    if shown {
-                        self.latencies.push(viewer.restart_latency_secs().unwrap_or(0.0));
-                        *round += 1;
-                        *sent = None;
-                        if *round == LATENCY_ROUNDS {
-                            self.stage = if viewer.patches().is_empty() {
-                                Stage::Screenshot { requested: false }
-                            } else {
-                                Stage::Drag(DragStage {
-                                    round: 0,
-                                    sent: None,
-                                    press: None,
-                                    start: now,
-                                    frames: 0,
-                                })
-                            };
-                        }
-                    } else if now - *at > Duration::from_secs(60) {
-                        self.finish(viewer, Some("no image 60 s after a restart".into()));
-                    }
-                }
-            },
+            Stage::FrameRate { .. } => self.frame_rate_step(viewer, now, ui_secs),
+            Stage::Latency { .. } => self.latency_step(viewer, now),
             Stage::Drag(drag) => match drag.step(viewer, now, &mut self.drag_latencies) {
                 Some(Ok(fps)) => {
                     self.drag_fps = Some(fps);
@@ -292,6 +228,86 @@ impl Automation {
             },
             Stage::Screenshot { .. } => self.screenshot_step(viewer, ctx),
             Stage::Done => {}
+        }
+    }
+
+    /// Counts a UI frame of the frame-rate measurement; after the window, records the rate and
+    /// moves on (rendering, then paused, then the latency rounds).
+    fn frame_rate_step(&mut self, viewer: &mut Viewer, now: Instant, ui_secs: f64) {
+        let Stage::FrameRate {
+            start,
+            frames,
+            worst,
+            last,
+            ui_secs: total_ui,
+            paused,
+        } = &mut self.stage
+        else {
+            return;
+        };
+        *frames += 1;
+        *total_ui += ui_secs;
+        *worst = (*worst).max(now - *last);
+        *last = now;
+        if now - *start >= FPS_WINDOW {
+            let secs = (now - *start).as_secs_f64();
+            let figures = (
+                *frames as f64 / secs,
+                worst.as_secs_f64(),
+                *total_ui / *frames as f64,
+            );
+            // Then the same with the renderer paused: what the UI costs by itself here.
+            let mut p = viewer.params.clone();
+            if *paused {
+                self.fps_paused = Some(figures);
+                p.paused = false;
+                self.stage = Stage::Latency { round: 0, sent: None };
+            } else {
+                self.fps = Some(figures);
+                p.paused = true;
+                self.stage = Stage::frame_rate(now, true);
+            }
+            viewer.set_params(p);
+        }
+    }
+
+    /// One round of the aperture-change latency: change it, then wait for the new image.
+    fn latency_step(&mut self, viewer: &mut Viewer, now: Instant) {
+        let Stage::Latency { round, sent } = &mut self.stage else {
+            return;
+        };
+        match sent {
+            None => {
+                // Move the aperture slider's value, exactly as a drag would.
+                let mut p = viewer.params.clone();
+                let open = viewer.ranges.aperture_max * 0.02;
+                p.aperture = if *round % 2 == 0 { open } else { 0.0 };
+                viewer.set_params(p);
+                *sent = Some(now);
+            }
+            Some(at) => {
+                let shown = viewer.restart_latency_secs().is_some() && !viewer.restart_pending();
+                if shown {
+                    self.latencies.push(viewer.restart_latency_secs().unwrap_or(0.0));
+                    *round += 1;
+                    *sent = None;
+                    if *round == LATENCY_ROUNDS {
+                        self.stage = if viewer.patches().is_empty() {
+                            Stage::Screenshot { requested: false }
+                        } else {
+                            Stage::Drag(DragStage {
+                                round: 0,
+                                sent: None,
+                                press: None,
+                                start: now,
+                                frames: 0,
+                            })
+                        };
+                    }
+                } else if now - *at > Duration::from_secs(60) {
+                    self.finish(viewer, Some("no image 60 s after a restart".into()));
+                }
+            }
         }
     }
 

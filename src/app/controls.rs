@@ -6,7 +6,7 @@ use egui_plot::{Line, Plot, PlotPoints};
 
 use super::action::Action;
 use super::keys::HELP;
-use super::params::{ALPHA_RANGE, DEPTH_RANGE, PHOTONS_RANGE};
+use super::params::{PanelParams, Ranges, ALPHA_RANGE, DEPTH_RANGE, PHOTONS_RANGE};
 use super::settings::{DisplayMode, Zoom};
 use super::viewer::{Status, Viewer};
 use crate::scene::RendererKind;
@@ -37,139 +37,9 @@ fn percent(fraction: f64) -> String {
 /// File, View and Help menus.
 pub fn menu_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) {
     egui::MenuBar::new().ui(ui, |ui| {
-        ui.menu_button("File", |ui| {
-            if ui
-                .button("Open scene...  (Ctrl+O)")
-                .on_hover_text("Open a scene file (.toml); you can also drop one on the window")
-                .clicked()
-            {
-                out.push(Action::PickScene);
-            }
-            if ui
-                .button("Save frame...  (Ctrl+S)")
-                .on_hover_text("Save the current frame: PNG as displayed, or EXR with linear radiance")
-                .clicked()
-            {
-                out.push(Action::SaveFrame);
-            }
-            if ui
-                .button("Send frame to tev")
-                .on_hover_text(format!(
-                    "Show the current frame (radiance, radius, photon count) in a running tev at {}",
-                    crate::tev::DEFAULT_ADDRESS
-                ))
-                .clicked()
-            {
-                out.push(Action::SendToTev(crate::tev::DEFAULT_ADDRESS.into()));
-            }
-            ui.separator();
-            if ui
-                .button("Open reference...")
-                .on_hover_text("Compare with a reference image (.exr or .pfm of the render's size): the true error in the plot, difference views and A/B; you can also drop one on the window")
-                .clicked()
-            {
-                out.push(Action::PickReference);
-            }
-            if ui
-                .add_enabled(viewer.reference().is_some(), egui::Button::new("Close reference"))
-                .on_hover_text("Stop comparing with the reference")
-                .clicked()
-            {
-                out.push(Action::CloseReference);
-            }
-            ui.separator();
-            if ui
-                .button("Save scene  (Ctrl+Shift+S)")
-                .on_hover_text("Write the scene as edited (camera, parameters, control points) to its file, after you confirm; the built-in scene asks where")
-                .clicked()
-            {
-                out.push(Action::SaveScene);
-            }
-            if ui
-                .button("Save scene as...")
-                .on_hover_text("Write the scene as edited to a new .toml file that loads back to the same patches")
-                .clicked()
-            {
-                out.push(Action::SaveSceneAs);
-            }
-            ui.separator();
-            if ui
-                .button("Quit")
-                .on_hover_text("Close the viewer (settings are kept; unsaved edits are asked about)")
-                .clicked()
-            {
-                out.push(Action::Close);
-            }
-        });
+        ui.menu_button("File", |ui| file_menu_ui(viewer, ui, out));
         super::edit_panel::edit_menu_ui(viewer, ui, out);
-        ui.menu_button("View", |ui| {
-            if ui
-                .button("Fit  (F)")
-                .on_hover_text("Scale the image to fit the view")
-                .clicked()
-            {
-                out.push(Action::SetZoom {
-                    zoom: Zoom::Fit,
-                    recentre: true,
-                });
-            }
-            if ui
-                .button("1:1  (1)")
-                .on_hover_text("One image pixel per screen pixel")
-                .clicked()
-            {
-                out.push(Action::SetZoom {
-                    zoom: Zoom::Scale(1.0),
-                    recentre: true,
-                });
-            }
-            ui.separator();
-            let mut display = viewer.settings.display;
-            for mode in DisplayMode::ALL {
-                let enabled = viewer.reference().is_some() || !mode.needs_reference();
-                let hover = if enabled {
-                    "What the image shows; the probe always reports radiance, radius and photons (D cycles)"
-                } else {
-                    "Open a reference image first (File > Open reference...)"
-                };
-                ui.add_enabled_ui(enabled, |ui| {
-                    ui.radio_value(&mut display, mode, mode.label())
-                        .on_hover_text(hover)
-                        .on_disabled_hover_text(hover);
-                });
-            }
-            let mut ab = viewer.showing_reference();
-            if ui
-                .add_enabled(
-                    viewer.reference().is_some(),
-                    egui::Checkbox::new(&mut ab, "Show the reference (A/B)  (B)"),
-                )
-                .on_hover_text("Show the reference image instead of the render, with the same exposure")
-                .changed()
-            {
-                out.push(Action::ShowReference(ab));
-            }
-            if display != viewer.settings.display {
-                out.push(Action::SetDisplay(display));
-            }
-            ui.separator();
-            let mut nets = viewer.settings.show_wireframe;
-            if ui
-                .checkbox(&mut nets, "Control nets  (W)")
-                .on_hover_text("Draw the patches' control nets and boundary curves over the image, to pick and drag")
-                .changed()
-            {
-                out.push(Action::ShowWireframe(nets));
-            }
-            let mut side = viewer.settings.show_side_panel;
-            if ui
-                .checkbox(&mut side, "Side panel  (P)")
-                .on_hover_text("Show or hide the parameters and statistics")
-                .changed()
-            {
-                out.push(Action::ShowSidePanel(side));
-            }
-        });
+        ui.menu_button("View", |ui| view_menu_ui(viewer, ui, out));
         ui.menu_button("Help", |ui| {
             if ui
                 .button("Keys and mouse  (F1)")
@@ -183,6 +53,142 @@ pub fn menu_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) {
         ui.label(RichText::new(viewer.scene.source.display().to_string()).weak())
             .on_hover_text("The scene file being rendered");
     });
+}
+
+/// Open, save, the reference, tev, quit.
+fn file_menu_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) {
+    if ui
+        .button("Open scene...  (Ctrl+O)")
+        .on_hover_text("Open a scene file (.toml); you can also drop one on the window")
+        .clicked()
+    {
+        out.push(Action::PickScene);
+    }
+    if ui
+        .button("Save frame...  (Ctrl+S)")
+        .on_hover_text("Save the current frame: PNG as displayed, or EXR with linear radiance")
+        .clicked()
+    {
+        out.push(Action::SaveFrame);
+    }
+    if ui
+        .button("Send frame to tev")
+        .on_hover_text(format!(
+            "Show the current frame (radiance, radius, photon count) in a running tev at {}",
+            crate::tev::DEFAULT_ADDRESS
+        ))
+        .clicked()
+    {
+        out.push(Action::SendToTev(crate::tev::DEFAULT_ADDRESS.into()));
+    }
+    ui.separator();
+    if ui
+        .button("Open reference...")
+        .on_hover_text("Compare with a reference image (.exr or .pfm of the render's size): the true error in the plot, difference views and A/B; you can also drop one on the window")
+        .clicked()
+    {
+        out.push(Action::PickReference);
+    }
+    if ui
+        .add_enabled(viewer.reference().is_some(), egui::Button::new("Close reference"))
+        .on_hover_text("Stop comparing with the reference")
+        .clicked()
+    {
+        out.push(Action::CloseReference);
+    }
+    ui.separator();
+    if ui
+        .button("Save scene  (Ctrl+Shift+S)")
+        .on_hover_text("Write the scene as edited (camera, parameters, control points) to its file, after you confirm; the built-in scene asks where")
+        .clicked()
+    {
+        out.push(Action::SaveScene);
+    }
+    if ui
+        .button("Save scene as...")
+        .on_hover_text("Write the scene as edited to a new .toml file that loads back to the same patches")
+        .clicked()
+    {
+        out.push(Action::SaveSceneAs);
+    }
+    ui.separator();
+    if ui
+        .button("Quit")
+        .on_hover_text("Close the viewer (settings are kept; unsaved edits are asked about)")
+        .clicked()
+    {
+        out.push(Action::Close);
+    }
+}
+
+/// Zoom, what the image shows, the overlay and the panel.
+fn view_menu_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) {
+    if ui
+        .button("Fit  (F)")
+        .on_hover_text("Scale the image to fit the view")
+        .clicked()
+    {
+        out.push(Action::SetZoom {
+            zoom: Zoom::Fit,
+            recentre: true,
+        });
+    }
+    if ui
+        .button("1:1  (1)")
+        .on_hover_text("One image pixel per screen pixel")
+        .clicked()
+    {
+        out.push(Action::SetZoom {
+            zoom: Zoom::Scale(1.0),
+            recentre: true,
+        });
+    }
+    ui.separator();
+    let mut display = viewer.settings.display;
+    for mode in DisplayMode::ALL {
+        let enabled = viewer.reference().is_some() || !mode.needs_reference();
+        let hover = if enabled {
+            "What the image shows; the probe always reports radiance, radius and photons (D cycles)"
+        } else {
+            "Open a reference image first (File > Open reference...)"
+        };
+        ui.add_enabled_ui(enabled, |ui| {
+            ui.radio_value(&mut display, mode, mode.label())
+                .on_hover_text(hover)
+                .on_disabled_hover_text(hover);
+        });
+    }
+    let mut ab = viewer.showing_reference();
+    if ui
+        .add_enabled(
+            viewer.reference().is_some(),
+            egui::Checkbox::new(&mut ab, "Show the reference (A/B)  (B)"),
+        )
+        .on_hover_text("Show the reference image instead of the render, with the same exposure")
+        .changed()
+    {
+        out.push(Action::ShowReference(ab));
+    }
+    if display != viewer.settings.display {
+        out.push(Action::SetDisplay(display));
+    }
+    ui.separator();
+    let mut nets = viewer.settings.show_wireframe;
+    if ui
+        .checkbox(&mut nets, "Control nets  (W)")
+        .on_hover_text("Draw the patches' control nets and boundary curves over the image, to pick and drag")
+        .changed()
+    {
+        out.push(Action::ShowWireframe(nets));
+    }
+    let mut side = viewer.settings.show_side_panel;
+    if ui
+        .checkbox(&mut side, "Side panel  (P)")
+        .on_hover_text("Show or hide the parameters and statistics")
+        .changed()
+    {
+        out.push(Action::ShowSidePanel(side));
+    }
 }
 
 /// Pixel probe and the last message.
@@ -220,9 +226,23 @@ pub fn status_ui(viewer: &Viewer, ui: &mut egui::Ui) {
 /// Parameters, actions, statistics and the convergence plot.
 pub fn side_panel_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) {
     let mut p = viewer.params.clone();
-    let ranges = viewer.ranges;
-    let photon_mapping = p.render.renderer == RendererKind::Ppm;
+    render_section_ui(viewer, &mut p, ui, out);
+    photon_mapping_section_ui(&mut p, viewer.ranges, ui);
+    camera_section_ui(&mut p, viewer.ranges, ui);
+    if p != viewer.params {
+        out.push(Action::SetParams(p));
+    }
 
+    if !viewer.patches().is_empty() {
+        ui.separator();
+        super::edit_panel::edit_panel_ui(viewer, ui, out);
+    }
+    ui.separator();
+    statistics_ui(viewer, ui);
+}
+
+/// The renderer, pause, restart, save and exposure.
+fn render_section_ui(viewer: &Viewer, p: &mut PanelParams, ui: &mut egui::Ui, out: &mut Vec<Action>) {
     ui.heading("Render");
     ui.horizontal(|ui| {
         ui.label("Renderer");
@@ -271,7 +291,11 @@ pub fn side_panel_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) 
     {
         out.push(Action::SetExposure(exposure));
     }
+}
 
+/// Photon mapping's parameters (enabled when it is the renderer).
+fn photon_mapping_section_ui(p: &mut PanelParams, ranges: Ranges, ui: &mut egui::Ui) {
+    let photon_mapping = p.render.renderer == RendererKind::Ppm;
     ui.separator();
     ui.heading("Photon mapping");
     ui.add_enabled_ui(photon_mapping, |ui| {
@@ -346,7 +370,10 @@ pub fn side_panel_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) 
                 .on_hover_text("The seed report's kd-tree");
         });
     });
+}
 
+/// The lens and the depth of paths.
+fn camera_section_ui(p: &mut PanelParams, ranges: Ranges, ui: &mut egui::Ui) {
     ui.separator();
     ui.heading("Camera");
     ui.add(
@@ -365,17 +392,6 @@ pub fn side_panel_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) 
     .on_hover_text("Distance from the lens to the plane in focus. Restarts.");
     ui.add(egui::Slider::new(&mut p.render.max_depth, DEPTH_RANGE.0..=DEPTH_RANGE.1).text("Max depth"))
         .on_hover_text("Most mirror/glass bounces followed by eye rays and photons. Restarts.");
-
-    if p != viewer.params {
-        out.push(Action::SetParams(p));
-    }
-
-    if !viewer.patches().is_empty() {
-        ui.separator();
-        super::edit_panel::edit_panel_ui(viewer, ui, out);
-    }
-    ui.separator();
-    statistics_ui(viewer, ui);
 }
 
 fn statistics_ui(viewer: &Viewer, ui: &mut egui::Ui) {
@@ -508,24 +524,7 @@ fn convergence_plot_ui(viewer: &Viewer, ui: &mut egui::Ui) {
 /// Help, scene error, renderer failure, overwrite and unsaved-edits windows.
 pub fn dialogs_ui(viewer: &Viewer, ctx: &egui::Context, out: &mut Vec<Action>) {
     if viewer.show_help {
-        let mut open = true;
-        egui::Window::new("Keys and mouse")
-            .open(&mut open)
-            .resizable(false)
-            .show(ctx, |ui| {
-                egui::Grid::new("caustic-help").num_columns(2).show(ui, |ui| {
-                    for (keys, what) in HELP {
-                        ui.monospace(*keys);
-                        ui.label(*what);
-                        ui.end_row();
-                    }
-                });
-                ui.separator();
-                ui.label("Hover over any control for what it does.");
-            });
-        if !open {
-            out.push(Action::ShowHelp(false));
-        }
+        help_window_ui(ctx, out);
     }
     if let Some(error) = &viewer.scene_error {
         let mut open = true;
@@ -582,33 +581,60 @@ pub fn dialogs_ui(viewer: &Viewer, ctx: &egui::Context, out: &mut Vec<Action>) {
         }
     }
     if viewer.unsaved_question.is_some() {
-        let modal = egui::Modal::new(egui::Id::unique("caustic-unsaved")).show(ctx, |ui| {
-            ui.heading("Unsaved edits");
-            ui.label("The scene has edits that are not saved. Save them first?");
-            ui.horizontal(|ui| {
-                if ui
-                    .button("Save")
-                    .on_hover_text("Save the scene, then go on")
-                    .clicked()
-                {
-                    Some(Some(false))
-                } else if ui
-                    .button("Discard")
-                    .on_hover_text("Go on without saving")
-                    .clicked()
-                {
-                    Some(Some(true))
-                } else if ui.button("Cancel").clicked() {
-                    Some(None)
-                } else {
-                    None
+        unsaved_question_ui(ctx, out);
+    }
+}
+
+/// The list of keys and mouse gestures (F1).
+fn help_window_ui(ctx: &egui::Context, out: &mut Vec<Action>) {
+    let mut open = true;
+    egui::Window::new("Keys and mouse")
+        .open(&mut open)
+        .resizable(false)
+        .show(ctx, |ui| {
+            egui::Grid::new("caustic-help").num_columns(2).show(ui, |ui| {
+                for (keys, what) in HELP {
+                    ui.monospace(*keys);
+                    ui.label(*what);
+                    ui.end_row();
                 }
-            })
-            .inner
+            });
+            ui.separator();
+            ui.label("Hover over any control for what it does.");
         });
-        if let Some(choice) = modal.inner.or(modal.should_close().then_some(None)) {
-            out.push(Action::ResolveUnsaved(choice));
-        }
+    if !open {
+        out.push(Action::ShowHelp(false));
+    }
+}
+
+/// Save, discard or cancel, before edits would be lost.
+fn unsaved_question_ui(ctx: &egui::Context, out: &mut Vec<Action>) {
+    let modal = egui::Modal::new(egui::Id::unique("caustic-unsaved")).show(ctx, |ui| {
+        ui.heading("Unsaved edits");
+        ui.label("The scene has edits that are not saved. Save them first?");
+        ui.horizontal(|ui| {
+            if ui
+                .button("Save")
+                .on_hover_text("Save the scene, then go on")
+                .clicked()
+            {
+                Some(Some(false))
+            } else if ui
+                .button("Discard")
+                .on_hover_text("Go on without saving")
+                .clicked()
+            {
+                Some(Some(true))
+            } else if ui.button("Cancel").clicked() {
+                Some(None)
+            } else {
+                None
+            }
+        })
+        .inner
+    });
+    if let Some(choice) = modal.inner.or(modal.should_close().then_some(None)) {
+        out.push(Action::ResolveUnsaved(choice));
     }
 }
 

@@ -101,6 +101,37 @@ pub fn handle(viewer: &Viewer, ctx: &egui::Context, out: &mut Vec<Action>) {
     } else if pressed(Key::E) {
         out.push(Action::SetExposure(settings.exposure_stops + 0.5));
     }
+    view_keys(viewer, ctx, out);
+    if pressed(Key::OpenBracket) {
+        out.push(Action::SetExposure(settings.exposure_stops - 0.5));
+    }
+    if pressed(Key::CloseBracket) {
+        out.push(Action::SetExposure(settings.exposure_stops + 0.5));
+    }
+    if pressed(Key::D) {
+        let modes: Vec<DisplayMode> = DisplayMode::ALL
+            .into_iter()
+            .filter(|m| viewer.reference().is_some() || !m.needs_reference())
+            .collect();
+        let at = modes.iter().position(|m| *m == settings.display).unwrap_or(0);
+        out.push(Action::SetDisplay(modes[(at + 1) % modes.len()]));
+    }
+    if pressed(Key::B) && viewer.reference().is_some() {
+        out.push(Action::ShowReference(!viewer.showing_reference()));
+    }
+    if pressed(Key::P) {
+        out.push(Action::ShowSidePanel(!settings.show_side_panel));
+    }
+    if pressed(Key::F1) {
+        out.push(Action::ShowHelp(!viewer.show_help));
+    }
+    editing_keys(viewer, ctx, out);
+}
+
+/// Zoom keys: fit, 1:1, in and out.
+fn view_keys(viewer: &Viewer, ctx: &egui::Context, out: &mut Vec<Action>) {
+    let pressed = |key: Key| ctx.input_mut(|i| i.consume_key(Modifiers::NONE, key));
+    let settings = &viewer.settings;
     if pressed(Key::F) {
         out.push(Action::SetZoom {
             zoom: Zoom::Fit,
@@ -128,30 +159,6 @@ pub fn handle(viewer: &Viewer, ctx: &egui::Context, out: &mut Vec<Action>) {
             recentre: false,
         });
     }
-    if pressed(Key::OpenBracket) {
-        out.push(Action::SetExposure(settings.exposure_stops - 0.5));
-    }
-    if pressed(Key::CloseBracket) {
-        out.push(Action::SetExposure(settings.exposure_stops + 0.5));
-    }
-    if pressed(Key::D) {
-        let modes: Vec<DisplayMode> = DisplayMode::ALL
-            .into_iter()
-            .filter(|m| viewer.reference().is_some() || !m.needs_reference())
-            .collect();
-        let at = modes.iter().position(|m| *m == settings.display).unwrap_or(0);
-        out.push(Action::SetDisplay(modes[(at + 1) % modes.len()]));
-    }
-    if pressed(Key::B) && viewer.reference().is_some() {
-        out.push(Action::ShowReference(!viewer.showing_reference()));
-    }
-    if pressed(Key::P) {
-        out.push(Action::ShowSidePanel(!settings.show_side_panel));
-    }
-    if pressed(Key::F1) {
-        out.push(Action::ShowHelp(!viewer.show_help));
-    }
-    editing_keys(viewer, ctx, out);
 }
 
 /// Keys of the control-net editor.

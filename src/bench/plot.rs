@@ -119,12 +119,13 @@ pub fn draw(curves: &[Curve], title: &str) -> Result<Vec<u8>, String> {
 }
 
 /// Draws lines on log-log axes (ticks 1, 2, 5 × 10ᵏ), with point labels and vertical markers;
-/// returns the RGB pixels, `SIZE` row by row.
-pub fn draw_series(series: &[Series], frame: &Frame) -> Result<Vec<u8>, String> {
-    register_font();
-    let (w, h) = SIZE;
-    let mut pixels = vec![255u8; (w * h * 3) as usize];
-    let positive = |&(x, y): &(f64, f64)| x > 0.0 && y > 0.0 && x.is_finite() && y.is_finite();
+/// Whether a point can be drawn on log-log axes.
+fn positive(&(x, y): &(f64, f64)) -> bool {
+    x > 0.0 && y > 0.0 && x.is_finite() && y.is_finite()
+}
+
+/// The x and y ranges of the log-log axes: every drawable point and marker, with a margin.
+fn log_ranges(series: &[Series], frame: &Frame) -> Result<[(f64, f64); 2], String> {
     let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, 0.0f64, f64::MAX, 0.0f64);
     for &(x, y) in series.iter().flat_map(|s| &s.points).filter(|p| positive(p)) {
         (x0, x1) = (x0.min(x), x1.max(x));
@@ -136,10 +137,18 @@ pub fn draw_series(series: &[Series], frame: &Frame) -> Result<Vec<u8>, String> 
     if x1 <= 0.0 || y1 <= 0.0 {
         return Err("no point with positive coordinates to plot".into());
     }
+    Ok([(x0 * 0.8, x1 * 1.25), (y0 * 0.8, y1 * 1.25)])
+}
+
+/// returns the RGB pixels, `SIZE` row by row.
+pub fn draw_series(series: &[Series], frame: &Frame) -> Result<Vec<u8>, String> {
+    register_font();
+    let (w, h) = SIZE;
+    let mut pixels = vec![255u8; (w * h * 3) as usize];
+    let [xr, yr] = log_ranges(series, frame)?;
     {
         let root = BitMapBackend::with_buffer(&mut pixels, SIZE).into_drawing_area();
         let err = |e: &dyn std::fmt::Display| e.to_string();
-        let (xr, yr) = ((x0 * 0.8, x1 * 1.25), (y0 * 0.8, y1 * 1.25));
         let mut chart = ChartBuilder::on(&root)
             .caption(frame.title, ("sans-serif", 22))
             .margin(16)

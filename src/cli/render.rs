@@ -185,40 +185,7 @@ pub fn render(args: RenderArgs) -> Result<()> {
     }
     args.overwrite.check([out])?;
     let mut report = Report::new(args.json);
-    let (mut scene, recorded) = match &args.from {
-        Some(image) => {
-            let recorded = Recorded::read(image)?;
-            if recorded.software != software() {
-                report.warn(format!(
-                    "{} was written by {}, this is {}: the pixels may differ",
-                    image.display(),
-                    recorded.software,
-                    software()
-                ));
-            }
-            (recorded.scene.clone(), Some(recorded))
-        }
-        None => (load_scene(args.scene.as_deref())?, None),
-    };
-    let exposure = args
-        .exposure
-        .or(recorded.as_ref().and_then(|r| r.exposure))
-        .unwrap_or(0.0);
-    if !exposure.is_finite() || exposure.abs() > 64.0 {
-        bail!("--exposure must be a finite number of stops between -64 and 64, got {exposure}");
-    }
-    for (flag, v) in [("--width", args.width), ("--height", args.height)] {
-        if let Some(v) = v {
-            flag_check(flag, limits::image_side(v))?;
-        }
-    }
-    scene.camera.resize(args.width, args.height);
-    if let Some(s) = args.seed {
-        scene.params.seed = s;
-    }
-    if let Some(kind) = args.renderer {
-        scene.params.renderer = kind;
-    }
+    let (mut scene, recorded, exposure) = scene_to_render(&args, &mut report)?;
     let reference = match &args.reference {
         Some(path) => {
             let reference = Reference::open(path)?;
@@ -259,6 +226,46 @@ pub fn render(args: RenderArgs) -> Result<()> {
         .save_with_layers(out, exposure, &rendered.metadata, &layers, args.overwrite.force)?;
     report.finish(out, &scene, &rendered.stats, reference.as_ref(), &rendered.image);
     Ok(())
+}
+
+/// The scene to render (from its file, or as an image recorded it with `--from`) with the
+/// command line's size, seed and renderer laid in; what `--from` recorded; the exposure.
+fn scene_to_render(args: &RenderArgs, report: &mut Report) -> Result<(Scene, Option<Recorded>, f32)> {
+    let (mut scene, recorded) = match &args.from {
+        Some(image) => {
+            let recorded = Recorded::read(image)?;
+            if recorded.software != software() {
+                report.warn(format!(
+                    "{} was written by {}, this is {}: the pixels may differ",
+                    image.display(),
+                    recorded.software,
+                    software()
+                ));
+            }
+            (recorded.scene.clone(), Some(recorded))
+        }
+        None => (load_scene(args.scene.as_deref())?, None),
+    };
+    let exposure = args
+        .exposure
+        .or(recorded.as_ref().and_then(|r| r.exposure))
+        .unwrap_or(0.0);
+    if !exposure.is_finite() || exposure.abs() > 64.0 {
+        bail!("--exposure must be a finite number of stops between -64 and 64, got {exposure}");
+    }
+    for (flag, v) in [("--width", args.width), ("--height", args.height)] {
+        if let Some(v) = v {
+            flag_check(flag, limits::image_side(v))?;
+        }
+    }
+    scene.camera.resize(args.width, args.height);
+    if let Some(s) = args.seed {
+        scene.params.seed = s;
+    }
+    if let Some(kind) = args.renderer {
+        scene.params.renderer = kind;
+    }
+    Ok((scene, recorded, exposure))
 }
 
 /// Where each finished pass goes besides the file: the reference comparison, tev, the report.

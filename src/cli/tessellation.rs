@@ -83,6 +83,20 @@ pub fn bench_tessellation(args: TessellationArgs, out: &mut BenchOutput) -> Resu
     out.set("size", [w, h]);
     out.set("patches", patches);
 
+    let rows = measure(&scene, &args, out);
+    if let Some(path) = &args.files.csv {
+        write_rows(&rows, path, args.files.overwrite.force, out)?;
+    }
+    if let Some(path) = &args.files.plot {
+        write_rows_plot(&scene, &rows, path, args.files.overwrite.force, out)?;
+    }
+    Ok(())
+}
+
+/// Renders the scene with each geometry (exact, per-ray, tessellated) and measures it
+/// against the first.
+fn measure(scene: &Scene, args: &TessellationArgs, out: &mut BenchOutput) -> Vec<Row> {
+    let patches = scene.geometry.patches().len();
     let exact_method = PatchMethod::Prepared(SubdivisionParams::default());
     let mut methods = vec![
         ("exact (prepared)".to_owned(), exact_method, None),
@@ -144,50 +158,63 @@ pub fn bench_tessellation(args: TessellationArgs, out: &mut BenchOutput) -> Resu
         );
         rows.push(row);
     }
-    if let Some(path) = &args.files.csv {
-        let mut text = String::from("geometry,segments,triangles,prepare_seconds,render_seconds,rmse\n");
-        for r in &rows {
-            let segments = r.segments.map_or(String::new(), |n| n.to_string());
-            let _ = writeln!(
-                text,
-                "{},{segments},{},{:.6},{:.6},{:.6e}",
-                caustic::bench::csv_field(&r.method),
-                r.triangles,
-                r.prepare_secs,
-                r.render_secs,
-                r.rmse
-            );
-        }
-        write_atomically(path, args.files.overwrite.force, |t| {
-            std::fs::write(t, &text).map_err(|e| e.to_string())
-        })?;
-        out.say(format!("rows written to {}", path.display()));
+    rows
+}
+
+/// Writes the rows as CSV.
+fn write_rows(rows: &[Row], path: &std::path::Path, force: bool, out: &mut BenchOutput) -> Result<()> {
+    let mut text = String::from("geometry,segments,triangles,prepare_seconds,render_seconds,rmse\n");
+    for r in rows {
+        let segments = r.segments.map_or(String::new(), |n| n.to_string());
+        let _ = writeln!(
+            text,
+            "{},{segments},{},{:.6},{:.6},{:.6e}",
+            caustic::bench::csv_field(&r.method),
+            r.triangles,
+            r.prepare_secs,
+            r.render_secs,
+            r.rmse
+        );
     }
-    if let Some(path) = &args.files.plot {
-        let name = scene
-            .source
-            .file_name()
-            .map_or("scene".into(), |n| n.to_string_lossy())
-            .replace("<built-in>", "built-in teapot scene");
-        let title = format!("{name}: tessellation error against render time ({w}x{h}, ray traced)");
-        let pixels = draw_series(
-            &[tessellated_series(&rows)],
-            &Frame {
-                title: &title,
-                x: "render seconds",
-                y: "RMSE against the exact render",
-                markers: rows
-                    .iter()
-                    .filter(|r| r.segments.is_none())
-                    .map(|r| (marker_label(r), r.render_secs))
-                    .collect(),
-                legend_lower_left: false,
-            },
-        )
-        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-        write_png(&pixels, path, args.files.overwrite.force).context("cannot write the plot")?;
-        out.say(format!("plot written to {}", path.display()));
-    }
+    write_atomically(path, force, |t| {
+        std::fs::write(t, &text).map_err(|e| e.to_string())
+    })?;
+    out.say(format!("rows written to {}", path.display()));
+    Ok(())
+}
+
+/// Draws the tessellated renders' error against their time, the exact ones as markers.
+fn write_rows_plot(
+    scene: &Scene,
+    rows: &[Row],
+    path: &std::path::Path,
+    force: bool,
+    out: &mut BenchOutput,
+) -> Result<()> {
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    let name = scene
+        .source
+        .file_name()
+        .map_or("scene".into(), |n| n.to_string_lossy())
+        .replace("<built-in>", "built-in teapot scene");
+    let title = format!("{name}: tessellation error against render time ({w}x{h}, ray traced)");
+    let pixels = draw_series(
+        &[tessellated_series(rows)],
+        &Frame {
+            title: &title,
+            x: "render seconds",
+            y: "RMSE against the exact render",
+            markers: rows
+                .iter()
+                .filter(|r| r.segments.is_none())
+                .map(|r| (marker_label(r), r.render_secs))
+                .collect(),
+            legend_lower_left: false,
+        },
+    )
+    .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    write_png(&pixels, path, force).context("cannot write the plot")?;
+    out.say(format!("plot written to {}", path.display()));
     Ok(())
 }
 

@@ -99,45 +99,14 @@ pub fn install(
         bind_group_layouts: &[Some(&layout)],
         immediate_size: 0,
     });
+    let target = Target {
+        format: render_state.target_format,
+        depth_format,
+        msaa_samples,
+    };
     let pipeline = |label: &str, entry: &str, stride: usize, attributes: &[wgpu::VertexAttribute]| {
-        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some(label),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                buffers: &[Some(wgpu::VertexBufferLayout {
-                    array_stride: stride as u64,
-                    step_mode: wgpu::VertexStepMode::Instance,
-                    attributes,
-                })],
-            },
-            primitive: wgpu::PrimitiveState::default(),
-            depth_stencil: depth_format.map(|format| wgpu::DepthStencilState {
-                format,
-                depth_write_enabled: Some(false),
-                depth_compare: Some(wgpu::CompareFunction::Always),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: wgpu::MultisampleState {
-                count: msaa_samples.max(1),
-                ..Default::default()
-            },
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: render_state.target_format,
-                    blend: Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING),
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        })
+        let shaders = (&module, &pipeline_layout);
+        instanced_pipeline(device, shaders, &target, (label, entry), (stride, attributes))
     };
     let segment_pipeline = pipeline(
         "caustic wireframe segments",
@@ -166,6 +135,62 @@ pub fn install(
             marker_count: 0,
             generation: None,
         });
+}
+
+/// What the overlay's pipelines draw into: egui's render pass.
+struct Target {
+    format: wgpu::TextureFormat,
+    depth_format: Option<wgpu::TextureFormat>,
+    msaa_samples: u32,
+}
+
+/// A pipeline drawing one screen-space quad per instance (a segment or a marker) with the
+/// vertex entry point `entry`, premultiplied-alpha blended, never depth tested.
+fn instanced_pipeline(
+    device: &wgpu::Device,
+    (module, layout): (&wgpu::ShaderModule, &wgpu::PipelineLayout),
+    target: &Target,
+    (label, entry): (&str, &str),
+    (stride, attributes): (usize, &[wgpu::VertexAttribute]),
+) -> wgpu::RenderPipeline {
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: Some(layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            buffers: &[Some(wgpu::VertexBufferLayout {
+                array_stride: stride as u64,
+                step_mode: wgpu::VertexStepMode::Instance,
+                attributes,
+            })],
+        },
+        primitive: wgpu::PrimitiveState::default(),
+        depth_stencil: target.depth_format.map(|format| wgpu::DepthStencilState {
+            format,
+            depth_write_enabled: Some(false),
+            depth_compare: Some(wgpu::CompareFunction::Always),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: wgpu::MultisampleState {
+            count: target.msaa_samples.max(1),
+            ..Default::default()
+        },
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some("fs_main"),
+            compilation_options: Default::default(),
+            targets: &[Some(wgpu::ColorTargetState {
+                format: target.format,
+                blend: Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING),
+                write_mask: wgpu::ColorWrites::ALL,
+            })],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
 }
 
 /// The uniform buffer, its bind group layout and its bind group.

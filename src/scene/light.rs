@@ -179,54 +179,71 @@ impl Light {
                 edge_u,
                 edge_v,
                 radiance,
-            } => {
-                let p = *corner + u.x * *edge_u + u.y * *edge_v;
-                let n = edge_u.cross(*edge_v);
-                let area = n.length();
-                let d = p - point;
-                let r2 = d.length_squared();
-                let distance = r2.sqrt();
-                let wi = d / distance;
-                let cos_light = -wi.dot(n / area);
-                (cos_light > 0.0).then(|| LightSample {
-                    wi,
-                    distance,
-                    incident: *radiance * (cos_light * area / r2),
-                })
-            }
+            } => sample_quad((*corner, *edge_u, *edge_v), *radiance, point, u),
             Light::Sphere {
                 center,
                 radius,
                 radiance,
-            } => {
-                // Uniform sampling of the cone of directions the sphere subtends (pbrt-v4).
-                let to_center = *center - point;
-                let dc2 = to_center.length_squared();
-                if dc2 <= radius * radius {
-                    return None;
-                }
-                let dc = dc2.sqrt();
-                let axis = to_center / dc;
-                let sin_max2 = radius * radius / dc2;
-                let cos_max = (1.0 - sin_max2).max(0.0).sqrt();
-                let cos_theta = 1.0 - u.x * (1.0 - cos_max);
-                let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
-                let phi = std::f64::consts::TAU * u.y;
-                let (t1, t2) = axis.any_orthonormal_pair();
-                let wi = cos_theta * axis + sin_theta * (phi.cos() * t1 + phi.sin() * t2);
-                // Distance to the sphere along wi (nearest root).
-                let b = wi.dot(to_center);
-                let disc = (radius * radius - (to_center - b * wi).length_squared()).max(0.0);
-                let distance = b - disc.sqrt();
-                let solid_angle = std::f64::consts::TAU * (1.0 - cos_max);
-                Some(LightSample {
-                    wi,
-                    distance,
-                    incident: *radiance * solid_angle,
-                })
-            }
+            } => sample_sphere((*center, *radius), *radiance, point, u),
         }
     }
+}
+
+/// A uniform sample of the quad `(corner, edge_u, edge_v)` of radiance `radiance` seen from
+/// `point` (by area: `incident` is `L cos θ_l A / r²`); `None` from behind it.
+fn sample_quad(
+    (corner, edge_u, edge_v): (DVec3, DVec3, DVec3),
+    radiance: DVec3,
+    point: DVec3,
+    u: DVec2,
+) -> Option<LightSample> {
+    let p = corner + u.x * edge_u + u.y * edge_v;
+    let n = edge_u.cross(edge_v);
+    let area = n.length();
+    let d = p - point;
+    let r2 = d.length_squared();
+    let distance = r2.sqrt();
+    let wi = d / distance;
+    let cos_light = -wi.dot(n / area);
+    (cos_light > 0.0).then(|| LightSample {
+        wi,
+        distance,
+        incident: radiance * (cos_light * area / r2),
+    })
+}
+
+/// A uniform sample of the cone of directions the sphere `(center, radius)` subtends from
+/// `point` (pbrt-v4); `None` from inside it.
+fn sample_sphere(
+    (center, radius): (DVec3, f64),
+    radiance: DVec3,
+    point: DVec3,
+    u: DVec2,
+) -> Option<LightSample> {
+    let to_center = center - point;
+    let dc2 = to_center.length_squared();
+    if dc2 <= radius * radius {
+        return None;
+    }
+    let dc = dc2.sqrt();
+    let axis = to_center / dc;
+    let sin_max2 = radius * radius / dc2;
+    let cos_max = (1.0 - sin_max2).max(0.0).sqrt();
+    let cos_theta = 1.0 - u.x * (1.0 - cos_max);
+    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    let phi = std::f64::consts::TAU * u.y;
+    let (t1, t2) = axis.any_orthonormal_pair();
+    let wi = cos_theta * axis + sin_theta * (phi.cos() * t1 + phi.sin() * t2);
+    // Distance to the sphere along wi (nearest root).
+    let b = wi.dot(to_center);
+    let disc = (radius * radius - (to_center - b * wi).length_squared()).max(0.0);
+    let distance = b - disc.sqrt();
+    let solid_angle = std::f64::consts::TAU * (1.0 - cos_max);
+    Some(LightSample {
+        wi,
+        distance,
+        incident: radiance * solid_angle,
+    })
 }
 
 impl LightSample {
