@@ -8,12 +8,11 @@ use clap::{Subcommand, ValueEnum};
 
 use super::bench_output::BenchOutput;
 use super::{load_scene, ppm_stats, render_session};
-use caustic::assets::SMALLPPM_SCENE;
 use caustic::bench::{teapot_geometry, teapot_view, time_intersect};
 use caustic::geometry::{PatchMethod, SubdivisionParams};
 use caustic::render::render_whitted;
 use caustic::render::session::SessionOptions;
-use caustic::scene::{RendererKind, Scene};
+use caustic::scene::RendererKind;
 
 #[derive(Subcommand)]
 pub enum BenchCommand {
@@ -159,14 +158,6 @@ pub fn bench(what: BenchCommand, json: bool) -> Result<()> {
     Ok(())
 }
 
-/// The scene a photon-mapping bench measures: the file, or smallppm's built-in scene.
-pub(super) fn photon_scene(path: Option<&Path>) -> Result<Scene> {
-    Ok(match path {
-        Some(p) => Scene::load(p)?,
-        None => Scene::from_str(SMALLPPM_SCENE, Path::new("<built-in smallppm>"), None)?,
-    })
-}
-
 /// What one `bench ppm` measurement renders.
 struct PpmRun {
     photons: u64,
@@ -179,7 +170,7 @@ fn bench_ppm(scene_path: Option<&Path>, run: PpmRun, threads: &[usize], out: &mu
     if photons == 0 || passes == 0 {
         bail!("--photons and --passes must be at least 1");
     }
-    let mut scene = photon_scene(scene_path)?;
+    let mut scene = super::photon_scene(scene_path)?;
     scene.params.photons_per_pass = photons;
     if let Some(k) = run.indirect_radius_scale {
         scene.params.indirect_radius_scale = Some(k);

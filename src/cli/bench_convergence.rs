@@ -150,7 +150,7 @@ pub struct ConvergenceArgs {
 
 /// Runs the measurement and prints the table.
 pub fn bench_convergence(args: ConvergenceArgs, out: &mut BenchOutput) -> Result<()> {
-    let mut scene = super::bench::photon_scene(args.scene.as_deref())?;
+    let mut scene = super::photon_scene(args.scene.as_deref())?;
     check(
         &args.width,
         args.seconds,

@@ -98,6 +98,18 @@ fn progress_bar(len: u64, template: &str, message: String) -> Result<indicatif::
     Ok(bar)
 }
 
+/// The scene a photon-mapping bench measures: the file, or smallppm's built-in scene.
+fn photon_scene(path: Option<&Path>) -> Result<Scene> {
+    Ok(match path {
+        Some(p) => Scene::load(p)?,
+        None => Scene::from_str(
+            caustic::assets::SMALLPPM_SCENE,
+            Path::new("<built-in smallppm>"),
+            None,
+        )?,
+    })
+}
+
 fn load_scene(path: Option<&Path>) -> Result<Scene> {
     match path {
         Some(p) => Ok(Scene::load(p)?),

@@ -1,6 +1,6 @@
 //! The one set of render parameters. The scene file's `[render]` table, the command line's
 //! flags and the viewer's controls overlay their values onto a [`RenderParams`]; the render
-//! session receives the whole set ([`crate::render::session::Command::SetParams`]), checks it
+//! session receives the whole set (the session's `Command::SetParams`), checks it
 //! with [`RenderParams::validate`] (over the ranges in [`super::limits`]) and asks
 //! [`RenderParams::restarts_from`] whether the change discards the accumulation; the
 //! integrators read it each pass.
@@ -15,7 +15,7 @@ use super::limits;
 use super::{IndexKind, RendererKind};
 
 /// Every render setting, with the defaults a scene file's `[render]` table starts from.
-/// Camera settings (pose, lens, image size) belong to [`crate::scene::Camera`].
+/// Camera settings (pose, lens, image size) belong to the scene's camera.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct RenderParams {
