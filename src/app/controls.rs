@@ -8,7 +8,7 @@ use super::action::Action;
 use super::keys::HELP;
 use super::params::{PanelParams, Ranges, ALPHA_RANGE, DEPTH_RANGE, PHOTONS_RANGE};
 use super::settings::{DisplayMode, Zoom};
-use super::viewer::{Status, Viewer};
+use super::state::{Status, ViewerState};
 use crate::scene::RendererKind;
 use crate::settings::IndexKind;
 
@@ -35,7 +35,7 @@ fn percent(fraction: f64) -> String {
 }
 
 /// File, View and Help menus.
-pub fn menu_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) {
+pub fn menu_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Action>) {
     egui::MenuBar::new().ui(ui, |ui| {
         ui.menu_button("File", |ui| file_menu_ui(viewer, ui, out));
         super::edit_panel::edit_menu_ui(viewer, ui, out);
@@ -56,7 +56,7 @@ pub fn menu_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) {
 }
 
 /// Open, save, the reference, tev, quit.
-fn file_menu_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) {
+fn file_menu_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Action>) {
     if ui
         .button("Open scene...  (Ctrl+O)")
         .on_hover_text("Open a scene file (.toml); you can also drop one on the window")
@@ -122,7 +122,7 @@ fn file_menu_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) {
 }
 
 /// Zoom, what the image shows, the overlay and the panel.
-fn view_menu_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) {
+fn view_menu_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Action>) {
     if ui
         .button("Fit  (F)")
         .on_hover_text("Scale the image to fit the view")
@@ -192,7 +192,7 @@ fn view_menu_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) {
 }
 
 /// Pixel probe and the last message.
-pub fn status_ui(viewer: &Viewer, ui: &mut egui::Ui) {
+pub fn status_ui(viewer: &ViewerState, ui: &mut egui::Ui) {
     ui.horizontal(|ui| {
         match (&viewer.probe, &viewer.frame) {
             (Some(p), Some(f)) => {
@@ -224,7 +224,7 @@ pub fn status_ui(viewer: &Viewer, ui: &mut egui::Ui) {
 }
 
 /// Parameters, actions, statistics and the convergence plot.
-pub fn side_panel_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) {
+pub fn side_panel_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Action>) {
     let mut p = viewer.params.clone();
     render_section_ui(viewer, &mut p, ui, out);
     photon_mapping_section_ui(&mut p, viewer.ranges, ui);
@@ -242,7 +242,7 @@ pub fn side_panel_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) 
 }
 
 /// The renderer, pause, restart, save and exposure.
-fn render_section_ui(viewer: &Viewer, p: &mut PanelParams, ui: &mut egui::Ui, out: &mut Vec<Action>) {
+fn render_section_ui(viewer: &ViewerState, p: &mut PanelParams, ui: &mut egui::Ui, out: &mut Vec<Action>) {
     ui.heading("Render");
     ui.horizontal(|ui| {
         ui.label("Renderer");
@@ -394,7 +394,7 @@ fn camera_section_ui(p: &mut PanelParams, ranges: Ranges, ui: &mut egui::Ui) {
         .on_hover_text("Most mirror/glass bounces followed by eye rays and photons. Restarts.");
 }
 
-fn statistics_ui(viewer: &Viewer, ui: &mut egui::Ui) {
+fn statistics_ui(viewer: &ViewerState, ui: &mut egui::Ui) {
     ui.heading("Statistics");
     if viewer.restart_pending() {
         let what = if viewer.params.render.renderer.progressive() {
@@ -463,7 +463,7 @@ fn statistics_ui(viewer: &Viewer, ui: &mut egui::Ui) {
 
 /// The error against time (log scale): the estimate from successive frames and, with a
 /// reference open, the true RMSE and relative MSE against it.
-fn convergence_plot_ui(viewer: &Viewer, ui: &mut egui::Ui) {
+fn convergence_plot_ui(viewer: &ViewerState, ui: &mut egui::Ui) {
     let with_reference = viewer.reference().is_some();
     let title = if with_reference {
         "Error against time"
@@ -522,7 +522,7 @@ fn convergence_plot_ui(viewer: &Viewer, ui: &mut egui::Ui) {
 }
 
 /// Help, scene error, renderer failure, overwrite and unsaved-edits windows.
-pub fn dialogs_ui(viewer: &Viewer, ctx: &egui::Context, out: &mut Vec<Action>) {
+pub fn dialogs_ui(viewer: &ViewerState, ctx: &egui::Context, out: &mut Vec<Action>) {
     if viewer.show_help {
         help_window_ui(ctx, out);
     }

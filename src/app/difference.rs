@@ -6,7 +6,7 @@
 
 use egui::{Color32, Rect, RichText, Vec2};
 
-use super::image_view::false_colour;
+use super::false_colour::false_colour;
 
 /// Which difference.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

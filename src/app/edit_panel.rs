@@ -5,7 +5,7 @@ use egui::RichText;
 
 use super::action::Action;
 use super::overlay::PointRef;
-use super::viewer::Viewer;
+use super::state::ViewerState;
 
 /// An editing command offered by both the Edit menu and the side panel.
 struct EditCommand {
@@ -16,7 +16,7 @@ struct EditCommand {
 }
 
 /// Undo, redo, whole patch, select none, frame: `action` is `None` where it does not apply.
-fn edit_commands(viewer: &Viewer) -> [EditCommand; 5] {
+fn edit_commands(viewer: &ViewerState) -> [EditCommand; 5] {
     let (can_undo, can_redo) = viewer.editor.history.can_undo_redo();
     let selected = viewer.editor.selection.first().copied();
     [
@@ -54,7 +54,7 @@ fn edit_commands(viewer: &Viewer) -> [EditCommand; 5] {
 }
 
 /// The Edit menu.
-pub fn edit_menu_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) {
+pub fn edit_menu_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Action>) {
     ui.menu_button("Edit", |ui| {
         for c in edit_commands(viewer) {
             let button = egui::Button::new(format!("{}  ({})", c.label, c.keys));
@@ -85,7 +85,7 @@ fn coordinates_ui(ui: &mut egui::Ui, position: glam::DVec3, speed: f64) -> Optio
 }
 
 /// The side panel's editing section.
-pub fn edit_panel_ui(viewer: &Viewer, ui: &mut egui::Ui, out: &mut Vec<Action>) {
+pub fn edit_panel_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Action>) {
     let editor = &viewer.editor;
     ui.heading("Edit");
     let mut nets = viewer.settings.show_wireframe;

@@ -5,7 +5,7 @@ use egui::{Key, KeyboardShortcut, Modifiers, Vec2};
 use super::action::Action;
 use super::image_view::{MAX_SCALE, MIN_SCALE};
 use super::settings::{DisplayMode, Zoom};
-use super::viewer::Viewer;
+use super::state::ViewerState;
 
 /// Shortcuts and mouse gestures as shown in the help window: (keys, what they do).
 pub const HELP: &[(&str, &str)] = &[
@@ -65,7 +65,7 @@ const REDO_Y: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::
 
 /// The actions of the shortcuts pressed this frame (plain keys only when no widget has
 /// focus).
-pub fn handle(viewer: &Viewer, ctx: &egui::Context, out: &mut Vec<Action>) {
+pub fn handle(viewer: &ViewerState, ctx: &egui::Context, out: &mut Vec<Action>) {
     let shortcut = |s: &KeyboardShortcut| ctx.input_mut(|i| i.consume_shortcut(s));
     // With Shift before without: egui matches Ctrl+Z also when Shift is held.
     if shortcut(&SAVE_SCENE) {
@@ -129,7 +129,7 @@ pub fn handle(viewer: &Viewer, ctx: &egui::Context, out: &mut Vec<Action>) {
 }
 
 /// Zoom keys: fit, 1:1, in and out.
-fn view_keys(viewer: &Viewer, ctx: &egui::Context, out: &mut Vec<Action>) {
+fn view_keys(viewer: &ViewerState, ctx: &egui::Context, out: &mut Vec<Action>) {
     let pressed = |key: Key| ctx.input_mut(|i| i.consume_key(Modifiers::NONE, key));
     let settings = &viewer.settings;
     if pressed(Key::F) {
@@ -162,7 +162,7 @@ fn view_keys(viewer: &Viewer, ctx: &egui::Context, out: &mut Vec<Action>) {
 }
 
 /// Keys of the control-net editor.
-fn editing_keys(viewer: &Viewer, ctx: &egui::Context, out: &mut Vec<Action>) {
+fn editing_keys(viewer: &ViewerState, ctx: &egui::Context, out: &mut Vec<Action>) {
     let pressed = |key: Key| ctx.input_mut(|i| i.consume_key(Modifiers::NONE, key));
     if pressed(Key::W) {
         out.push(Action::ShowWireframe(!viewer.settings.show_wireframe));

@@ -21,12 +21,14 @@
 //! - [`keys`], [`settings`], [`automation`]: shortcuts, stored preferences, scripted runs.
 
 pub mod action;
+mod apply;
 pub mod automation;
 pub mod controls;
 pub mod difference;
 pub mod edit_panel;
 pub mod editor;
 pub mod error_plot;
+pub mod false_colour;
 pub mod file_dialog;
 pub mod image_view;
 pub mod job;
@@ -35,9 +37,11 @@ pub mod navigate;
 pub mod overlay;
 pub mod params;
 pub mod reference;
+mod reference_files;
 pub mod save;
 mod scene_file;
 pub mod settings;
+pub mod state;
 pub mod tev_send;
 pub mod view_input;
 pub mod viewer;

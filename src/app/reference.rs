@@ -2,14 +2,15 @@
 //! converged render, or a long run of this one), opened from the File menu, by dropping the
 //! file on the window or with `caustic view --reference FILE`. While one is open, the
 //! convergence plot adds the true error against it, the View menu offers the difference views
-//! ([`super::difference`]) and `B` flips between the render and the reference (A/B).
+//! ([`super::difference`]) and `B` flips between the render and the reference (A/B). This
+//! file holds the reference and its loading; opening, closing and showing it are the viewer's
+//! (`reference_files.rs`).
 
 use std::path::PathBuf;
 
-use super::file_dialog::{FileDialog, FileRequest};
-use super::job::{Job, Poll};
-use super::viewer::{Status, Viewer};
-use crate::render::compare::{Reference, ReferenceErrors};
+use super::file_dialog::FileDialog;
+use super::job::Job;
+use crate::render::compare::Reference;
 
 /// The reference and its loading.
 #[derive(Default)]
@@ -19,7 +20,7 @@ pub struct ReferenceState {
     /// Shows the reference instead of the render (the A/B toggle).
     pub(super) show_reference: bool,
     pub(super) picking: Option<FileDialog>,
-    loading: Option<(Job<Result<Reference, String>>, PathBuf)>,
+    pub(super) loading: Option<(Job<Result<Reference, String>>, PathBuf)>,
 }
 
 /// Whether a file is one the viewer opens as a reference (by its extension).
@@ -33,123 +34,5 @@ impl ReferenceState {
     /// Whether a dialog or a load is under way.
     pub fn busy(&self) -> bool {
         self.picking.is_some() || self.loading.is_some()
-    }
-}
-
-impl Viewer {
-    /// The open reference.
-    pub fn reference(&self) -> Option<&Reference> {
-        self.reference.open.as_ref()
-    }
-
-    /// Whether the reference is shown instead of the render (A/B).
-    pub fn showing_reference(&self) -> bool {
-        self.reference.show_reference && self.reference.open.is_some()
-    }
-
-    /// The current frame's error against the reference, when both are there and match.
-    pub fn reference_errors(&self) -> Option<ReferenceErrors> {
-        let frame = self.frame.as_ref()?;
-        self.reference.open.as_ref()?.errors(&frame.radiance)
-    }
-
-    /// Reads `path` as the reference (on a thread); the result shows in the status bar.
-    pub fn open_reference(&mut self, path: PathBuf) {
-        let p = path.clone();
-        let job = Job::spawn("caustic-reference", &self.ctx, move || {
-            Reference::open(&p).map_err(|e| e.to_string())
-        });
-        self.reference.loading = Some((job, path));
-    }
-
-    /// Shows the open dialog for a reference (on a thread).
-    pub fn pick_reference(&mut self) {
-        if self.reference.picking.is_some() {
-            return;
-        }
-        let request = FileRequest {
-            title: "Open reference image".into(),
-            filters: vec![("OpenEXR or PFM".into(), vec!["exr".into(), "pfm".into()])],
-            directory: self.settings.last_directory.clone(),
-            file_name: None,
-            save: false,
-        };
-        let native = self.native_dialog();
-        self.reference.picking = Some(FileDialog::open(
-            "caustic-reference-dialog",
-            &self.ctx,
-            native,
-            request,
-        ));
-    }
-
-    /// Closes the reference (the difference views fall back to the radiance).
-    pub fn close_reference(&mut self) {
-        if let Some(r) = self.reference.open.take() {
-            self.status = Some(Status::Info(format!("Closed the reference {}", r.path.display())));
-        }
-        self.reference.show_reference = false;
-        self.convergence.clear_reference();
-        self.image_view.invalidate();
-    }
-
-    /// Shows the reference instead of the render, or the render again.
-    pub fn show_reference(&mut self, on: bool) {
-        self.reference.show_reference = on && self.reference.open.is_some();
-        self.image_view.invalidate();
-    }
-
-    /// Takes a finished dialog or load; call once per UI frame.
-    pub(super) fn poll_reference(&mut self) {
-        if let Some(job) = &self.reference.picking {
-            match job.poll() {
-                Poll::Pending => {}
-                Poll::Ready(choice) => {
-                    self.reference.picking = None;
-                    if let Some(path) = choice {
-                        self.open_reference(path);
-                    }
-                }
-                Poll::Lost => {
-                    self.reference.picking = None;
-                    self.status = Some(Status::Error("the file dialog failed".into()));
-                }
-            }
-        }
-        let Some((job, path)) = &self.reference.loading else {
-            return;
-        };
-        let result = match job.poll() {
-            Poll::Pending => return,
-            Poll::Ready(r) => r,
-            Poll::Lost => Err(format!("{}: reading failed unexpectedly", path.display())),
-        };
-        self.reference.loading = None;
-        match result {
-            Ok(reference) => self.set_reference(reference),
-            Err(e) => self.status = Some(Status::Error(format!("Reference not opened: {e}"))),
-        }
-    }
-
-    /// Compares with `reference` from now on, if it has the scene's image size (else the
-    /// status bar says why not and any open reference stays).
-    pub fn set_reference(&mut self, reference: Reference) {
-        let (w, h) = (self.scene.camera.width, self.scene.camera.height);
-        if let Err(e) = reference.check_size(w, h) {
-            self.status = Some(Status::Error(format!("Reference not opened: {e}")));
-            return;
-        }
-        self.remember_folder_of(&reference.path);
-        self.status = Some(Status::Info(format!(
-            "Comparing with the reference {} (B: A/B, D: difference views)",
-            reference.path.display()
-        )));
-        self.reference.open = Some(reference);
-        self.convergence.clear_reference();
-        if let Some(errors) = self.reference_errors() {
-            let secs = self.frame.as_ref().map_or(0.0, |f| f.elapsed_secs);
-            self.convergence.add_reference(secs, errors);
-        }
-        self.image_view.invalidate();
     }
 }

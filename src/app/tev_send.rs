@@ -3,7 +3,8 @@
 //! streaming `caustic render --tev` does ([`crate::tev`]).
 
 use super::job::{Job, Poll};
-use super::viewer::{Status, Viewer};
+use super::state::Status;
+use crate::render::session::Frame;
 use crate::render::Layer;
 use crate::tev::TevStream;
 
@@ -20,26 +21,15 @@ impl TevSend {
     }
 }
 
-impl Viewer {
-    /// Sends the current frame to tev at `address` (`HOST:PORT`) as the image
-    /// `caustic: <scene file>`.
-    pub fn send_to_tev(&mut self, address: &str) {
-        let Some(frame) = self.frame.clone() else {
-            self.status = Some(Status::Error("nothing to send yet: no frame has arrived".into()));
-            return;
-        };
-        if self.tev.job.is_some() {
-            return;
+impl TevSend {
+    /// Sends `frame` to tev at `address` (`HOST:PORT`) as the image `name`, on a thread;
+    /// `None` when a send is already under way.
+    pub fn send(&mut self, ctx: &egui::Context, frame: Frame, name: String, address: &str) -> Option<()> {
+        if self.job.is_some() {
+            return None;
         }
-        let name = format!(
-            "caustic: {}",
-            self.scene
-                .source
-                .file_name()
-                .map_or("scene".into(), |n| n.to_string_lossy())
-        );
         let address = address.to_owned();
-        self.tev.job = Some(Job::spawn("caustic-tev", &self.ctx, move || {
+        self.job = Some(Job::spawn("caustic-tev", ctx, move || {
             let mut stream = TevStream::connect(&address, &name).map_err(|e| e.to_string())?;
             let layers = [
                 Layer {
@@ -56,22 +46,21 @@ impl Viewer {
                 .map_err(|e| e.to_string())?;
             Ok(address)
         }));
+        Some(())
     }
 
-    /// Takes a finished send; call once per UI frame.
-    pub(super) fn poll_tev(&mut self) {
-        let Some(job) = &self.tev.job else {
-            return;
-        };
+    /// The status line of a finished send, if one finished; call once per UI frame.
+    pub fn poll(&mut self) -> Option<Status> {
+        let job = self.job.as_ref()?;
         let result = match job.poll() {
-            Poll::Pending => return,
+            Poll::Pending => return None,
             Poll::Ready(r) => r,
             Poll::Lost => Err("sending to tev failed unexpectedly".into()),
         };
-        self.tev.job = None;
-        self.status = Some(match result {
+        self.job = None;
+        Some(match result {
             Ok(address) => Status::Info(format!("Sent the frame to tev at {address}")),
             Err(e) => Status::Error(format!("Not sent: {e}")),
-        });
+        })
     }
 }

@@ -6,22 +6,22 @@ use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use super::action::{Action, AfterDiscard};
+use super::action::Action;
 use super::controls;
 use super::editor::Editor;
-use super::error_plot::Convergence;
 use super::file_dialog::{self, FileDialog, FileRequest, NativeDialog};
-use super::image_view::{frame_image, Comparison, ImageView, Probe};
+use super::image_view::{frame_image, Comparison, ImageView};
 use super::job::{Job, Poll};
 use super::keys;
 use super::overlay::OverlayProjection;
 use super::params::{PanelParams, Ranges};
-use super::reference::{is_reference_file, ReferenceState};
-use super::save::{default_file_name, SaveEvent, SaveFlow, Snapshot};
+use super::reference::is_reference_file;
+use super::save::{default_file_name, SaveEvent, Snapshot};
 use super::settings::{ViewerSettings, Zoom};
+pub use super::state::Status;
+use super::state::ViewerState;
 use super::tev_send::TevSend;
 use super::view_input;
-use crate::geometry::BezierPatch;
 use crate::render::image_metadata;
 use crate::render::ppm::PpmOptions;
 use crate::render::session::{Command, Frame, RenderSession, SessionOptions};
@@ -38,73 +38,43 @@ pub const VIEWER_PREVIEW_DIVISOR: u32 = 4;
 /// Commands kept in [`Viewer::recent_commands`].
 const COMMAND_LOG: usize = 256;
 
-/// A line in the status bar.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Status {
-    /// Something worked.
-    Info(String),
-    /// Something did not.
-    Error(String),
-}
-
-/// The viewer.
+/// The viewer: its state ([`ViewerState`], what the widgets read) and what runs it (the render
+/// session, dialogs and loads under way, the image's texture and the overlay). It derefs to its
+/// state, so the code that carries out actions reads and writes the state's fields directly;
+/// widgets get only `&ViewerState` and answer with actions.
 pub struct Viewer {
+    /// What the widgets read.
+    pub state: ViewerState,
     pub(super) ctx: egui::Context,
-    /// Persisted preferences.
-    pub settings: ViewerSettings,
-    /// The scene as loaded (parameters as in its file).
-    pub(super) scene: Scene,
-    /// Slider ranges for the scene.
-    pub(super) ranges: Ranges,
-    /// Current parameter values.
-    pub params: PanelParams,
     session: RenderSession,
-    /// Newest frame of the newest epoch seen.
-    pub(super) frame: Option<Frame>,
     pub(super) image_view: ImageView,
-    pub(super) probe: Option<Probe>,
-    pub(super) convergence: Convergence,
-    /// A restart sent at this time, from this epoch, not shown yet.
-    pending_restart: Option<(Instant, u64)>,
-    /// Seconds from the last restart-type change to its first image.
-    pub(super) restart_latency_secs: Option<f64>,
-    pub(super) save: SaveFlow,
     picking: Option<FileDialog>,
     /// How native file dialogs are shown.
     native_dialog: NativeDialog,
     loading: Option<(Job<Result<Scene, String>>, PathBuf)>,
-    /// A scene that failed to open, with its error (shown in a window).
-    pub(super) scene_error: Option<String>,
-    /// The render thread's panic message.
-    pub(super) render_failure: Option<String>,
-    pub(super) status: Option<Status>,
-    pub(super) show_help: bool,
     recent_commands: VecDeque<Command>,
-    /// Seconds from [`Viewer::new`] to the first image shown.
-    pub(super) first_image_secs: Option<f64>,
     created: Instant,
-    /// Control points as edited, selection, gesture and undo history.
-    pub(super) editor: Editor,
     /// Where the image and its overlay were placed in the last UI frame.
     pub(super) projection: Option<OverlayProjection>,
     /// Whether the wgpu overlay was installed in the renderer (else it is not drawn).
     pub(super) overlay_installed: bool,
     /// The "save scene as" dialog.
     pub(super) scene_dialog: Option<FileDialog>,
-    /// A scene file waiting for the user to confirm replacing it.
-    pub(super) confirm_scene_overwrite: Option<PathBuf>,
-    /// What waits on the unsaved-edits question.
-    pub(super) unsaved_question: Option<AfterDiscard>,
-    /// What to do once the scene is saved (from "Save" in the unsaved-edits question).
-    pub(super) after_save: Option<AfterDiscard>,
-    /// The window may close even with unsaved edits (the user said so).
-    pub(super) allow_close: bool,
-    /// The `R` key asked to restart: "discard the passes?" is shown.
-    pub(super) confirm_restart: bool,
-    /// The reference image compared with, and its loading.
-    pub(super) reference: ReferenceState,
     /// A frame being sent to tev.
     pub(super) tev: TevSend,
+}
+
+impl std::ops::Deref for Viewer {
+    type Target = ViewerState;
+    fn deref(&self) -> &ViewerState {
+        &self.state
+    }
+}
+
+impl std::ops::DerefMut for Viewer {
+    fn deref_mut(&mut self) -> &mut ViewerState {
+        &mut self.state
+    }
 }
 
 fn session_options(start_paused: bool) -> SessionOptions {
@@ -145,46 +115,20 @@ impl Viewer {
     /// A viewer whose renderer starts paused when `paused` (Resume, or Space, starts it).
     pub fn with_pause(ctx: &egui::Context, scene: Scene, settings: ViewerSettings, paused: bool) -> Self {
         let scene = photon_mapped(scene);
-        let settings = settings.sanitized();
-        let mut params = PanelParams::from_scene(&scene);
-        params.paused = paused;
-        let ranges = Ranges::for_scene(&scene);
         let session = start_session(ctx, scene.clone(), paused);
-        let editor = Editor::new(&scene);
         Self {
+            state: ViewerState::new(scene, settings.sanitized(), paused),
             ctx: ctx.clone(),
-            settings,
-            scene,
-            ranges,
-            params,
             session,
-            frame: None,
             image_view: ImageView::default(),
-            probe: None,
-            convergence: Convergence::default(),
-            pending_restart: None,
-            restart_latency_secs: None,
-            save: SaveFlow::default(),
             picking: None,
             native_dialog: file_dialog::rfd_dialog,
             loading: None,
-            scene_error: None,
-            render_failure: None,
-            status: None,
-            show_help: false,
             recent_commands: VecDeque::new(),
-            first_image_secs: None,
             created: Instant::now(),
-            editor,
             projection: None,
             overlay_installed: false,
             scene_dialog: None,
-            confirm_scene_overwrite: None,
-            unsaved_question: None,
-            after_save: None,
-            allow_close: false,
-            confirm_restart: false,
-            reference: ReferenceState::default(),
             tev: TevSend::default(),
         }
     }
@@ -200,39 +144,9 @@ impl Viewer {
         self.overlay_installed = true;
     }
 
-    /// The scene being rendered (as loaded).
-    pub fn scene(&self) -> &Scene {
-        &self.scene
-    }
-
-    /// The newest frame shown.
-    pub fn frame(&self) -> Option<&Frame> {
-        self.frame.as_ref()
-    }
-
-    /// The error curves of the epoch shown (estimate, and the true error against a reference).
-    pub fn convergence(&self) -> &Convergence {
-        &self.convergence
-    }
-
     /// Commands sent to the render session, oldest first (the last 256).
     pub fn recent_commands(&self) -> impl Iterator<Item = &Command> {
         self.recent_commands.iter()
-    }
-
-    /// The error of the last scene that failed to open, if it is still shown.
-    pub fn scene_error(&self) -> Option<&str> {
-        self.scene_error.as_deref()
-    }
-
-    /// The render thread's failure, if it failed.
-    pub fn render_failure(&self) -> Option<&str> {
-        self.render_failure.as_deref()
-    }
-
-    /// The status line.
-    pub fn status(&self) -> Option<&Status> {
-        self.status.as_ref()
     }
 
     /// Whether a scene is being opened or a frame or scene saved.
@@ -243,21 +157,6 @@ impl Viewer {
             || self.scene_dialog.is_some()
             || self.reference.busy()
             || self.tev.busy()
-    }
-
-    /// Seconds from creation to the first image shown, once there is one.
-    pub fn first_image_secs(&self) -> Option<f64> {
-        self.first_image_secs
-    }
-
-    /// Seconds from the last restarting change to the first image of its epoch.
-    pub fn restart_latency_secs(&self) -> Option<f64> {
-        self.restart_latency_secs
-    }
-
-    /// Whether a restarting change waits for its first image.
-    pub fn restart_pending(&self) -> bool {
-        self.pending_restart.is_some()
     }
 
     /// Sends a command to the render session, remembering it (and when a restart was asked).
@@ -301,40 +200,6 @@ impl Viewer {
         self.frame = None;
         self.convergence.reset();
         self.image_view.invalidate();
-    }
-
-    /// The scene as edited: the panel's parameters, the camera and the control points.
-    pub fn edited_scene(&self) -> Scene {
-        let mut scene = self.scene.clone();
-        self.params.apply_to(&mut scene);
-        let edits: Vec<(usize, BezierPatch)> = self
-            .editor
-            .patches
-            .iter()
-            .zip(scene.geometry.patches())
-            .enumerate()
-            .filter(|(_, (edited, (current, _)))| *edited != current)
-            .map(|(k, (edited, _))| (k, *edited))
-            .collect();
-        if !edits.is_empty() {
-            scene.geometry.update_patches(&edits);
-        }
-        scene
-    }
-
-    /// The control points as edited (geometry order).
-    pub fn patches(&self) -> &[BezierPatch] {
-        &self.editor.patches
-    }
-
-    /// The selected control points.
-    pub fn selection(&self) -> impl Iterator<Item = super::overlay::PointRef> + '_ {
-        self.editor.selection.iter().copied()
-    }
-
-    /// Whether the scene has edits not saved yet.
-    pub fn unsaved_edits(&self) -> bool {
-        self.editor.history.unsaved()
     }
 
     /// Where the image and overlay were placed in the last UI frame.
@@ -422,7 +287,8 @@ impl Viewer {
         };
         let name = default_file_name(&self.scene.source, snapshot.pass);
         let dir = self.settings.last_directory.clone();
-        self.save
+        self.state
+            .save
             .open_dialog(&self.ctx, self.native_dialog, snapshot, dir, name);
     }
 
@@ -433,19 +299,14 @@ impl Viewer {
             self.status = Some(Status::Error("nothing to save yet: no frame has arrived".into()));
             return;
         };
-        if let Some(event) = self.save.save_to(&self.ctx, path, snapshot) {
+        if let Some(event) = self.state.save.save_to(&self.ctx, path, snapshot) {
             self.on_save_event(event);
         }
     }
 
-    /// Whether an overwrite question is open.
-    pub fn confirming_overwrite(&self) -> Option<&Path> {
-        self.save.confirm.as_ref().map(|(p, _)| p.as_path())
-    }
-
     /// Answers the overwrite question.
     pub fn confirm_overwrite(&mut self, replace: bool) {
-        if let Some(event) = self.save.confirm_overwrite(&self.ctx, replace) {
+        if let Some(event) = self.state.save.confirm_overwrite(&self.ctx, replace) {
             self.on_save_event(event);
         }
     }
@@ -515,12 +376,14 @@ impl Viewer {
                 }
             }
         }
-        if let Some(event) = self.save.poll(&self.ctx) {
+        if let Some(event) = self.state.save.poll(&self.ctx) {
             self.on_save_event(event);
         }
         self.poll_scene_dialog();
         self.poll_reference();
-        self.poll_tev();
+        if let Some(status) = self.tev.poll() {
+            self.status = Some(status);
+        }
     }
 
     /// Shows `frame` as the newest image if it is newer (a later epoch, or a later pass of
@@ -554,8 +417,8 @@ impl Viewer {
                 self.convergence.add_reference(frame.elapsed_secs, errors);
             }
         }
-        self.first_image_secs
-            .get_or_insert_with(|| self.created.elapsed().as_secs_f64());
+        let since_start = self.created.elapsed().as_secs_f64();
+        self.first_image_secs.get_or_insert(since_start);
         self.frame = Some(frame);
         self.image_view.invalidate();
     }
@@ -588,16 +451,17 @@ impl Viewer {
             ui.ctx().send_viewport_cmd(egui::ViewportCommand::CancelClose);
             actions.push(Action::Close);
         }
-        if let Some(frame) = &self.frame {
+        let state = &self.state;
+        if let Some(frame) = &state.frame {
             let comparison = Comparison {
-                reference: self.reference.open.as_ref().map(|r| &r.image.pixels[..]),
-                show_reference: self.reference.show_reference,
+                reference: state.reference.open.as_ref().map(|r| &r.image.pixels[..]),
+                show_reference: state.reference.show_reference,
             };
             self.image_view.update_texture(
                 ui.ctx(),
                 frame,
-                self.settings.display,
-                self.settings.exposure_stops,
+                state.settings.display,
+                state.settings.exposure_stops,
                 comparison,
             );
         }
@@ -621,6 +485,23 @@ impl Viewer {
         for action in actions {
             self.apply(action);
         }
+    }
+
+    /// Sends the current frame to tev at `address` (`HOST:PORT`) as the image
+    /// `caustic: <scene file>`; the status bar says how it went.
+    pub fn send_to_tev(&mut self, address: &str) {
+        let Some(frame) = self.frame.clone() else {
+            self.status = Some(Status::Error("nothing to send yet: no frame has arrived".into()));
+            return;
+        };
+        let name = format!(
+            "caustic: {}",
+            self.scene
+                .source
+                .file_name()
+                .map_or("scene".into(), |n| n.to_string_lossy())
+        );
+        self.tev.send(&self.ctx, frame, name, address);
     }
 
     /// The file dialogs under way (at most one of each kind).
@@ -649,11 +530,6 @@ impl Viewer {
     /// nothing at once counts as one that could not be shown, and the window's own opens.
     pub fn set_native_dialog(&mut self, native: NativeDialog) {
         self.native_dialog = native;
-    }
-
-    /// Whether the overlay is shown and can be edited.
-    pub(super) fn editing(&self) -> bool {
-        self.settings.show_wireframe && !self.editor.patches.is_empty()
     }
 
     /// The image, the control-net overlay over it, and the mouse.

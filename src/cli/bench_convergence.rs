@@ -53,6 +53,10 @@ pub enum Config {
     RadiusX4,
     /// The seed report's kd-tree instead of the hash grid.
     KdTree,
+    /// The path tracer (one sample per pixel a pass), against the same photon-mapped
+    /// reference.
+    #[value(name = "path")]
+    PathTracer,
 }
 
 impl Config {
@@ -70,6 +74,7 @@ impl Config {
             Config::Alpha09 => "alpha 0.9",
             Config::RadiusX4 => "initial radius x4",
             Config::KdTree => "kd-tree",
+            Config::PathTracer => "path tracer",
         }
     }
 
@@ -103,6 +108,7 @@ impl Config {
             Config::Alpha09 => p.alpha = 0.9,
             Config::RadiusX4 => p.initial_radius = Some(4.0 * auto_radius),
             Config::KdTree => p.index = IndexKind::KdTree,
+            Config::PathTracer => p.renderer = RendererKind::Path,
         }
         p
     }

@@ -1,0 +1,277 @@
+//! [`Viewer::apply`]: the one place that carries out the [`Action`]s the widgets emit —
+//! changing the viewer's state, telling the render session, recording undo steps; undo and
+//! redo replay inverse edits through the same code.
+
+use glam::DVec3;
+
+use super::action::{Action, AfterDiscard};
+use super::editor::{Edit, Gesture};
+use super::overlay::PointRef;
+use super::settings::EXPOSURE_LIMIT;
+use super::state::Status;
+use super::viewer::Viewer;
+use crate::render::session::Command;
+use crate::scene::Camera;
+
+impl Viewer {
+    /// Carries out an action.
+    pub fn apply(&mut self, action: Action) {
+        match action {
+            Action::PickScene => self.unless_unsaved(AfterDiscard::Pick),
+            Action::OpenScene(path) => self.unless_unsaved(AfterDiscard::Open(path)),
+            Action::PickReference => self.pick_reference(),
+            Action::OpenReference(path) => self.open_reference(path),
+            Action::CloseReference => self.close_reference(),
+            Action::ShowReference(on) => self.show_reference(on),
+            Action::SendToTev(address) => self.send_to_tev(&address),
+            Action::SaveFrame => self.save_with_dialog(),
+            Action::ConfirmFrameOverwrite(replace) => self.confirm_overwrite(replace),
+            Action::SaveScene => self.save_scene(),
+            Action::SaveSceneAs => self.pick_scene_file(),
+            Action::SaveSceneTo(path) => self.save_scene_to(path),
+            Action::ConfirmSceneOverwrite(replace) => self.confirm_scene_overwrite(replace),
+            Action::ResolveUnsaved(choice) => self.resolve_unsaved(choice),
+            Action::Close => self.unless_unsaved(AfterDiscard::Close),
+            Action::SetParams(p) => self.set_params(p),
+            Action::Restart => self.send(Command::Restart),
+            Action::AskRestart => {
+                // One pass (or a preview) is no work to lose; more is worth a question.
+                if self.frame.as_ref().is_some_and(|f| f.pass >= 2) {
+                    self.confirm_restart = true;
+                } else {
+                    self.send(Command::Restart);
+                }
+            }
+            Action::ConfirmRestart(restart) => {
+                self.confirm_restart = false;
+                if restart {
+                    self.send(Command::Restart);
+                }
+            }
+            Action::RestartRenderer => self.restart_renderer(),
+            Action::DismissSceneError => self.scene_error = None,
+            Action::SetExposure(stops) => {
+                self.settings.exposure_stops = stops.clamp(-EXPOSURE_LIMIT, EXPOSURE_LIMIT);
+                self.image_view.invalidate();
+            }
+            Action::SetZoom { zoom, recentre } => {
+                self.settings.zoom = zoom;
+                if recentre {
+                    self.image_view.recentre();
+                }
+            }
+            Action::SetDisplay(mode) => {
+                self.settings.display = mode;
+                self.image_view.invalidate();
+            }
+            Action::ShowSidePanel(on) => self.settings.show_side_panel = on,
+            Action::ShowHelp(on) => self.show_help = on,
+            Action::ShowWireframe(on) => self.settings.show_wireframe = on,
+            a @ (Action::Hover(_)
+            | Action::Select { .. }
+            | Action::SelectPatch(_)
+            | Action::ClearSelection) => self.apply_selection(a),
+            a @ (Action::BeginPointDrag { .. }
+            | Action::DragPoints { .. }
+            | Action::BeginCameraDrag(_)
+            | Action::DragCamera(_)
+            | Action::EndGesture) => self.apply_gesture(a),
+            edit => self.apply_edit(edit),
+        }
+    }
+
+    /// Hover and selection.
+    fn apply_selection(&mut self, action: Action) {
+        match action {
+            Action::Hover(point) => {
+                if self.editor.hovered != point {
+                    self.editor.hovered = point;
+                    self.editor.touch();
+                }
+            }
+            Action::Select { point, add } => {
+                if !self.editor.exists(point) {
+                    return;
+                }
+                // A point shared by patches (a seam) is selected with its twins, so the
+                // patches stay joined when it moves.
+                let welded = self.editor.welded(point);
+                if !add {
+                    self.editor.selection = welded.into_iter().collect();
+                } else if self.editor.selection.contains(&point) {
+                    for r in welded {
+                        self.editor.selection.remove(&r);
+                    }
+                } else {
+                    self.editor.selection.extend(welded);
+                }
+                self.editor.touch();
+            }
+            Action::SelectPatch(patch) => {
+                if patch < self.editor.patches.len() {
+                    let points = (0..16).map(|index| PointRef { patch, index });
+                    self.editor.selection = points.flat_map(|r| self.editor.welded(r)).collect();
+                    self.editor.touch();
+                }
+            }
+            Action::ClearSelection => {
+                self.editor.selection.clear();
+                self.editor.touch();
+            }
+            other => unreachable!("not a selection action: {other:?}"),
+        }
+    }
+
+    /// Mouse drags of points and of the camera.
+    fn apply_gesture(&mut self, action: Action) {
+        match action {
+            Action::BeginPointDrag { grab, press } => {
+                let on_screen = self.editor.exists(grab).then(|| self.editor.point(grab));
+                let on_screen = on_screen.and_then(|q| self.projection.as_ref()?.to_screen(q));
+                if let Some(grab_screen) = on_screen {
+                    // Dragging an unselected point selects it (with its twins at seams).
+                    if !self.editor.selection.contains(&grab) {
+                        self.editor.selection = self.editor.welded(grab).into_iter().collect();
+                        self.editor.touch();
+                    }
+                    let start = self.editor.selected_points();
+                    self.editor.gesture = Some(Gesture::Points {
+                        grab,
+                        grab_screen,
+                        press,
+                        start,
+                    });
+                }
+            }
+            Action::DragPoints { pointer, along_view } => {
+                if let Some(proj) = &self.projection {
+                    let moves = self.editor.dragged_points(proj, pointer, along_view);
+                    self.move_points(&moves);
+                }
+            }
+            Action::BeginCameraDrag(how) => {
+                self.editor.gesture = Some(Gesture::Camera {
+                    how,
+                    start: (self.scene.camera.clone(), self.editor.pivot),
+                });
+            }
+            Action::DragCamera(delta) => {
+                if let Some(proj) = &self.projection {
+                    if let Some((camera, pivot)) = self.editor.dragged_camera(proj, delta) {
+                        self.set_camera(camera, pivot);
+                    }
+                }
+            }
+            Action::EndGesture => self.end_gesture(),
+            other => unreachable!("not a gesture action: {other:?}"),
+        }
+    }
+
+    /// One-step edits and undo/redo.
+    fn apply_edit(&mut self, action: Action) {
+        match action {
+            Action::SetPoint(point, position) => {
+                let changed = self.move_points(&[(point, position)]);
+                self.record(Edit::Points(changed));
+            }
+            Action::Nudge(step) => {
+                if let Some(proj) = &self.projection {
+                    let moves = self.editor.nudge(proj, step);
+                    let changed = self.move_points(&moves);
+                    self.record(Edit::Points(changed));
+                }
+            }
+            Action::FrameSelection => {
+                let before = (self.scene.camera.clone(), self.editor.pivot);
+                let (centre, radius) = self.editor.selection_sphere();
+                let camera = super::navigate::frame(&self.scene.camera, centre, radius, self.editor.world_up);
+                self.set_camera(camera, centre);
+                let after = (self.scene.camera.clone(), self.editor.pivot);
+                self.record(Edit::Camera { before, after });
+            }
+            Action::Undo => {
+                if let Some(edit) = self.editor.history.undo() {
+                    self.replay(edit);
+                }
+            }
+            Action::Redo => {
+                if let Some(edit) = self.editor.history.redo() {
+                    self.replay(edit);
+                }
+            }
+            other => unreachable!("not an editing action: {other:?}"),
+        }
+    }
+
+    /// Records an edit unless it changed nothing.
+    fn record(&mut self, edit: Edit) {
+        let empty = match &edit {
+            Edit::Points(moves) => moves.is_empty(),
+            Edit::Camera { before, after } => before == after,
+        };
+        if !empty {
+            self.editor.history.record(edit);
+        }
+    }
+
+    /// The gesture in progress becomes one undo step.
+    fn end_gesture(&mut self) {
+        match self.editor.gesture.take() {
+            Some(Gesture::Points { start, .. }) => {
+                let moves = start
+                    .into_iter()
+                    .map(|(r, before)| (r, before, self.editor.point(r)))
+                    .filter(|(_, a, b)| a != b)
+                    .collect();
+                self.record(Edit::Points(moves));
+            }
+            Some(Gesture::Camera { start, .. }) => {
+                let after = (self.scene.camera.clone(), self.editor.pivot);
+                self.record(Edit::Camera { before: start, after });
+            }
+            None => {}
+        }
+    }
+
+    /// Applies an edit (undo or redo) without recording it.
+    fn replay(&mut self, edit: Edit) {
+        match edit {
+            Edit::Points(moves) => {
+                let targets: Vec<(PointRef, DVec3)> =
+                    moves.iter().map(|(r, _, after)| (*r, *after)).collect();
+                self.move_points(&targets);
+            }
+            Edit::Camera { after, .. } => self.set_camera(after.0, after.1),
+        }
+    }
+
+    /// Moves control points and tells the render session; returns what changed.
+    fn move_points(&mut self, moves: &[(PointRef, DVec3)]) -> Vec<(PointRef, DVec3, DVec3)> {
+        let changed = self.editor.set_points(moves);
+        for (r, _, position) in &changed {
+            self.send(Command::MoveControlPoint {
+                patch: r.patch,
+                index: r.index,
+                position: *position,
+            });
+        }
+        changed
+    }
+
+    /// Places the camera (pose from `camera`, lens from the panel's parameters) and the
+    /// orbit pivot, and tells the render session.
+    fn set_camera(&mut self, camera: Camera, pivot: DVec3) {
+        let camera = self.params.lens_on(&camera);
+        if !(camera.position.is_finite() && camera.forward.is_finite() && pivot.is_finite()) {
+            self.status = Some(Status::Error(
+                "camera move ignored: it left the scene's numbers".into(),
+            ));
+            return;
+        }
+        self.editor.pivot = pivot;
+        if camera != self.scene.camera {
+            self.scene.camera = camera.clone();
+            self.send(Command::SetCamera(camera));
+        }
+    }
+}

@@ -1,0 +1,211 @@
+//! The viewer's state: everything its widgets read (the scene and its parameters, the newest
+//! frame, the edits, the open questions and flows, the messages), apart from what runs it
+//! (the render session, the dialogs and loads under way, the texture), which stays in
+//! [`super::viewer::Viewer`]. Widgets read a `&ViewerState` and answer with
+//! [`super::action::Action`]s; `Viewer::apply` carries them out.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use super::action::AfterDiscard;
+use super::editor::Editor;
+use super::error_plot::Convergence;
+use super::image_view::Probe;
+use super::params::{PanelParams, Ranges};
+use super::reference::ReferenceState;
+use super::save::SaveFlow;
+use super::settings::ViewerSettings;
+use crate::geometry::BezierPatch;
+use crate::render::compare::{Reference, ReferenceErrors};
+use crate::render::session::Frame;
+use crate::scene::Scene;
+
+/// A line in the status bar.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Status {
+    /// Something worked.
+    Info(String),
+    /// Something did not.
+    Error(String),
+}
+
+/// What the viewer's widgets read.
+pub struct ViewerState {
+    /// Persisted preferences.
+    pub settings: ViewerSettings,
+    /// The scene as loaded (parameters as in its file).
+    pub(super) scene: Scene,
+    /// Slider ranges for the scene.
+    pub(super) ranges: Ranges,
+    /// Current parameter values.
+    pub params: PanelParams,
+    /// Newest frame of the newest epoch seen.
+    pub(super) frame: Option<Frame>,
+    pub(super) probe: Option<Probe>,
+    pub(super) convergence: Convergence,
+    /// A restart sent at this time, from this epoch, not shown yet.
+    pub(super) pending_restart: Option<(Instant, u64)>,
+    /// Seconds from the last restart-type change to its first image.
+    pub(super) restart_latency_secs: Option<f64>,
+    pub(super) save: SaveFlow,
+    /// A scene that failed to open, with its error (shown in a window).
+    pub(super) scene_error: Option<String>,
+    /// The render thread's panic message.
+    pub(super) render_failure: Option<String>,
+    pub(super) status: Option<Status>,
+    pub(super) show_help: bool,
+    /// Seconds from the viewer's start to the first image shown.
+    pub(super) first_image_secs: Option<f64>,
+    /// Control points as edited, selection, gesture and undo history.
+    pub(super) editor: Editor,
+    /// A scene file waiting for the user to confirm replacing it.
+    pub(super) confirm_scene_overwrite: Option<PathBuf>,
+    /// What waits on the unsaved-edits question.
+    pub(super) unsaved_question: Option<AfterDiscard>,
+    /// What to do once the scene is saved (from "Save" in the unsaved-edits question).
+    pub(super) after_save: Option<AfterDiscard>,
+    /// The window may close even with unsaved edits (the user said so).
+    pub(super) allow_close: bool,
+    /// The `R` key asked to restart: "discard the passes?" is shown.
+    pub(super) confirm_restart: bool,
+    /// The reference image compared with, and its loading.
+    pub(super) reference: ReferenceState,
+}
+
+impl ViewerState {
+    /// The state of a viewer that has just opened `scene` (parameters as in its file, with
+    /// `paused`), with `settings` from storage.
+    pub(super) fn new(scene: Scene, settings: ViewerSettings, paused: bool) -> Self {
+        let mut params = PanelParams::from_scene(&scene);
+        params.paused = paused;
+        Self {
+            settings,
+            ranges: Ranges::for_scene(&scene),
+            params,
+            frame: None,
+            probe: None,
+            convergence: Convergence::default(),
+            pending_restart: None,
+            restart_latency_secs: None,
+            save: SaveFlow::default(),
+            scene_error: None,
+            render_failure: None,
+            status: None,
+            show_help: false,
+            first_image_secs: None,
+            editor: Editor::new(&scene),
+            confirm_scene_overwrite: None,
+            unsaved_question: None,
+            after_save: None,
+            allow_close: false,
+            confirm_restart: false,
+            reference: ReferenceState::default(),
+            scene,
+        }
+    }
+
+    /// The scene being rendered (as loaded).
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    /// The newest frame shown.
+    pub fn frame(&self) -> Option<&Frame> {
+        self.frame.as_ref()
+    }
+
+    /// The error curves of the epoch shown (estimate, and the true error against a reference).
+    pub fn convergence(&self) -> &Convergence {
+        &self.convergence
+    }
+
+    /// The error of the last scene that failed to open, if it is still shown.
+    pub fn scene_error(&self) -> Option<&str> {
+        self.scene_error.as_deref()
+    }
+
+    /// The render thread's failure, if it failed.
+    pub fn render_failure(&self) -> Option<&str> {
+        self.render_failure.as_deref()
+    }
+
+    /// The status line.
+    pub fn status(&self) -> Option<&Status> {
+        self.status.as_ref()
+    }
+
+    /// Seconds from creation to the first image shown, once there is one.
+    pub fn first_image_secs(&self) -> Option<f64> {
+        self.first_image_secs
+    }
+
+    /// Seconds from the last restarting change to the first image of its epoch.
+    pub fn restart_latency_secs(&self) -> Option<f64> {
+        self.restart_latency_secs
+    }
+
+    /// Whether a restarting change waits for its first image.
+    pub fn restart_pending(&self) -> bool {
+        self.pending_restart.is_some()
+    }
+
+    /// The scene as edited: the panel's parameters, the camera and the control points.
+    pub fn edited_scene(&self) -> Scene {
+        let mut scene = self.scene.clone();
+        self.params.apply_to(&mut scene);
+        let edits: Vec<(usize, BezierPatch)> = self
+            .editor
+            .patches
+            .iter()
+            .zip(scene.geometry.patches())
+            .enumerate()
+            .filter(|(_, (edited, (current, _)))| *edited != current)
+            .map(|(k, (edited, _))| (k, *edited))
+            .collect();
+        if !edits.is_empty() {
+            scene.geometry.update_patches(&edits);
+        }
+        scene
+    }
+
+    /// The control points as edited (geometry order).
+    pub fn patches(&self) -> &[BezierPatch] {
+        &self.editor.patches
+    }
+
+    /// The selected control points.
+    pub fn selection(&self) -> impl Iterator<Item = super::overlay::PointRef> + '_ {
+        self.editor.selection.iter().copied()
+    }
+
+    /// Whether the scene has edits not saved yet.
+    pub fn unsaved_edits(&self) -> bool {
+        self.editor.history.unsaved()
+    }
+
+    /// Whether an overwrite question is open.
+    pub fn confirming_overwrite(&self) -> Option<&Path> {
+        self.save.confirm.as_ref().map(|(p, _)| p.as_path())
+    }
+
+    /// Whether the overlay is shown and can be edited.
+    pub fn editing(&self) -> bool {
+        self.settings.show_wireframe && !self.editor.patches.is_empty()
+    }
+
+    /// The open reference.
+    pub fn reference(&self) -> Option<&Reference> {
+        self.reference.open.as_ref()
+    }
+
+    /// Whether the reference is shown instead of the render (A/B).
+    pub fn showing_reference(&self) -> bool {
+        self.reference.show_reference && self.reference.open.is_some()
+    }
+
+    /// The current frame's error against the reference, when both are there and match.
+    pub fn reference_errors(&self) -> Option<ReferenceErrors> {
+        let frame = self.frame.as_ref()?;
+        self.reference.open.as_ref()?.errors(&frame.radiance)
+    }
+}
