@@ -38,6 +38,17 @@ fn bspline_obj(nu: usize, nv: usize, u_knots: &[f64], v_knots: &[f64], range: [f
     text
 }
 
+/// The points of an OBJ text's `v` lines.
+fn vertices(text: &str) -> Vec<DVec3> {
+    text.lines()
+        .filter_map(|l| l.strip_prefix("v "))
+        .map(|l| {
+            let n: Vec<f64> = l.split_whitespace().map(|w| w.parse().expect("number")).collect();
+            DVec3::new(n[0], n[1], n[2])
+        })
+        .collect()
+}
+
 fn parse(text: &str) -> Result<Vec<(BezierPatch, Window)>, String> {
     parse_freeform_obj(text, Path::new("surface.obj")).map_err(|e| e.to_string())
 }
@@ -51,17 +62,10 @@ fn a_clamped_4x4_bspline_is_its_bezier_patch() {
     let (patch, window) = patches[0];
     assert_eq!(window, Window::FULL);
     // OBJ lists u fastest: vertex i + 4j is the patch's P_ij.
-    let vertices: Vec<DVec3> = text
-        .lines()
-        .filter_map(|l| l.strip_prefix("v "))
-        .map(|l| {
-            let n: Vec<f64> = l.split_whitespace().map(|w| w.parse().expect("number")).collect();
-            DVec3::new(n[0], n[1], n[2])
-        })
-        .collect();
+    let points = vertices(&text);
     for i in 0..4 {
         for j in 0..4 {
-            assert_eq!(patch.point(i, j), vertices[i + 4 * j], "P_{i}{j}");
+            assert_eq!(patch.point(i, j), points[i + 4 * j], "P_{i}{j}");
         }
     }
 }
@@ -72,14 +76,7 @@ fn a_uniform_5x5_bspline_becomes_four_patches_on_the_surface() {
     let text = bspline_obj(5, 5, &uniform, &uniform, [3.0, 5.0, 3.0, 5.0]);
     let patches = parse(&text).expect("reads");
     assert_eq!(patches.len(), 4);
-    let points: Vec<DVec3> = text
-        .lines()
-        .filter_map(|l| l.strip_prefix("v "))
-        .map(|l| {
-            let n: Vec<f64> = l.split_whitespace().map(|w| w.parse().expect("number")).collect();
-            DVec3::new(n[0], n[1], n[2])
-        })
-        .collect();
+    let points = vertices(&text);
     let surface = BsplineSurface {
         points,
         u_knots: Knots::new(uniform.clone(), 5, 'u').expect("knots"),
@@ -123,14 +120,7 @@ fn a_sub_range_and_repeated_knots_still_match_de_boor() {
     let patches = parse(&text).expect("reads");
     // u: spans [0.1,0.3], [0.3,0.7], [0.7,0.9]; v: [0.2,0.5], [0.5,1].
     assert_eq!(patches.len(), 6);
-    let points: Vec<DVec3> = text
-        .lines()
-        .filter_map(|l| l.strip_prefix("v "))
-        .map(|l| {
-            let n: Vec<f64> = l.split_whitespace().map(|w| w.parse().expect("number")).collect();
-            DVec3::new(n[0], n[1], n[2])
-        })
-        .collect();
+    let points = vertices(&text);
     let surface = BsplineSurface {
         points,
         u_knots: Knots::new(u.to_vec(), 7, 'u').expect("knots"),
