@@ -425,3 +425,78 @@ fn the_overlay_one_pixel_off_fails_the_snapshot() {
     );
     eprintln!("one-pixel overlay shift: {failing} pixels fail the snapshot");
 }
+
+/// Every question answers the keyboard: Escape cancels, Enter takes the default action — the
+/// unsaved-edits question (Enter saves: the built-in scene asks where) and "Replace file?" for a
+/// scene file (Enter replaces).
+#[test]
+fn the_unsaved_edits_and_scene_replace_questions_answer_enter_and_escape() {
+    fn no_native_dialog(_: &caustic::app::file_dialog::FileRequest) -> Option<std::path::PathBuf> {
+        None
+    }
+    let mut h = editing_app();
+    h.state_mut()
+        .as_mut()
+        .expect("viewer")
+        .set_native_dialog(no_native_dialog);
+    let (_, s) = isolated_point(viewer(&h));
+    drag(&mut h, s, Vec2::new(25.0, 0.0), PointerButton::Primary);
+    let other = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell.toml");
+    let open_other = |h: &mut App<'_>| {
+        let action = caustic::app::Action::OpenScene(other.clone());
+        h.state_mut().as_mut().expect("viewer").apply(action);
+        h.run_steps(3);
+        assert!(
+            h.query_by_label_contains("not saved").is_some(),
+            "no question asked"
+        );
+    };
+    open_other(&mut h);
+    h.key_press(egui::Key::Escape);
+    h.run_steps(2);
+    assert!(
+        h.query_by_label_contains("not saved").is_none(),
+        "Escape left the question open"
+    );
+    assert!(
+        viewer(&h).unsaved_edits() && !viewer(&h).busy(),
+        "Escape did more than cancel"
+    );
+    assert_eq!(viewer(&h).scene().source, Path::new("<built-in>"));
+    open_other(&mut h);
+    h.key_press(egui::Key::Enter);
+    let start = std::time::Instant::now();
+    while !viewer(&h).file_dialog_in_window() {
+        assert!(
+            start.elapsed().as_secs() < 30,
+            "Enter did not save (the built-in scene asks where to)"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(5));
+        h.step();
+    }
+
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("edited.toml");
+    std::fs::write(&path, "precious").expect("writes");
+    let mut h = editing_app();
+    drag(&mut h, s, Vec2::new(25.0, 0.0), PointerButton::Primary);
+    for (key, replaced) in [(egui::Key::Escape, false), (egui::Key::Enter, true)] {
+        h.state_mut()
+            .as_mut()
+            .expect("viewer")
+            .save_scene_to(path.clone());
+        h.run_steps(3);
+        assert!(
+            h.query_by_label("Replace file?").is_some(),
+            "no question before {key:?}"
+        );
+        h.key_press(key);
+        h.run_steps(2);
+        assert!(
+            h.query_by_label("Replace file?").is_none(),
+            "{key:?} left the question open"
+        );
+        let text = std::fs::read_to_string(&path).expect("file");
+        assert_eq!(text != "precious", replaced, "{key:?}: {text}");
+    }
+}

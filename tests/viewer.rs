@@ -651,3 +651,49 @@ fn the_viewer_sends_its_frame_to_tev() {
         viewer(&h).status()
     );
 }
+
+/// "Replace file?" and "discard the passes?" answer the keyboard: Escape cancels, Enter takes
+/// the default action (replace, restart).
+#[test]
+fn the_replace_and_restart_questions_answer_enter_and_escape() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let png = dir.path().join("frame.png");
+    std::fs::write(&png, b"precious").expect("write");
+    let mut h = harness(ball(), false);
+    step_until(&mut h, "two passes", |v| v.frame().is_some_and(|f| f.pass >= 2));
+    let paused = caustic::app::params::PanelParams {
+        paused: true,
+        ..viewer(&h).params.clone()
+    };
+    viewer_mut(&mut h).set_params(paused);
+    for (key, replaced) in [(egui::Key::Escape, false), (egui::Key::Enter, true)] {
+        viewer_mut(&mut h).save_to(png.clone());
+        h.run_steps(3);
+        assert!(
+            h.query_by_label("Replace file?").is_some(),
+            "no question before {key:?}"
+        );
+        h.key_press(key);
+        h.step();
+        wait_saved(&mut h);
+        let bytes = std::fs::read(&png).expect("read");
+        assert_eq!(bytes != b"precious", replaced, "{key:?}");
+    }
+    for (key, restarts) in [(egui::Key::Escape, false), (egui::Key::Enter, true)] {
+        let before = sent(&h).len();
+        h.key_press(egui::Key::R);
+        h.run_steps(2);
+        assert!(
+            h.query_by_label("Discard and restart").is_some(),
+            "no question before {key:?}"
+        );
+        h.key_press(key);
+        h.run_steps(2);
+        assert!(
+            h.query_by_label("Discard and restart").is_none(),
+            "{key:?} left it open"
+        );
+        let restarted = sent(&h)[before..].contains(&Command::Restart);
+        assert_eq!(restarted, restarts, "{key:?}");
+    }
+}

@@ -609,6 +609,11 @@ fn help_window_ui(ctx: &egui::Context, out: &mut Vec<Action>) {
 
 /// Save, discard or cancel, before edits would be lost.
 fn unsaved_question_ui(ctx: &egui::Context, out: &mut Vec<Action>) {
+    // Enter saves (the first button), Escape cancels.
+    let keys = answer_keys(ctx).map(|k| match k {
+        AnswerKey::Enter => Some(false),
+        AnswerKey::Escape => None,
+    });
     let modal = egui::Modal::new(egui::Id::unique("caustic-unsaved")).show(ctx, |ui| {
         ui.heading("Unsaved edits");
         ui.label("The scene has edits that are not saved. Save them first?");
@@ -633,7 +638,7 @@ fn unsaved_question_ui(ctx: &egui::Context, out: &mut Vec<Action>) {
         })
         .inner
     });
-    if let Some(choice) = modal.inner.or(modal.should_close().then_some(None)) {
+    if let Some(choice) = modal.inner.or(keys).or(modal.should_close().then_some(None)) {
         out.push(Action::ResolveUnsaved(choice));
     }
 }
@@ -648,15 +653,17 @@ struct Question<'a> {
 }
 
 impl Question<'_> {
-    /// Shows it: `Some(true)` yes, `Some(false)` no (or closed), `None` not answered yet.
+    /// Shows it: `Some(true)` yes (its button, or Enter), `Some(false)` no (its button,
+    /// Escape, or a click outside), `None` not answered yet.
     fn ask(&self, ctx: &egui::Context) -> Option<bool> {
+        let keys = answer_keys(ctx);
         let modal = egui::Modal::new(egui::Id::unique(self.id)).show(ctx, |ui| {
             ui.heading(self.heading);
             ui.label(self.text);
             ui.horizontal(|ui| {
-                if ui.button(self.yes).clicked() {
+                if ui.button(self.yes).on_hover_text("Enter").clicked() {
                     Some(true)
-                } else if ui.button(self.no).clicked() {
+                } else if ui.button(self.no).on_hover_text("Escape").clicked() {
                     Some(false)
                 } else {
                     None
@@ -664,8 +671,31 @@ impl Question<'_> {
             })
             .inner
         });
-        modal.inner.or(modal.should_close().then_some(false))
+        let answer = keys.map(|k| k == AnswerKey::Enter);
+        modal.inner.or(answer).or(modal.should_close().then_some(false))
     }
+}
+
+/// A key that answers an open question.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum AnswerKey {
+    /// Take the default action (the first button).
+    Enter,
+    /// Cancel.
+    Escape,
+}
+
+/// Enter or Escape pressed this frame (taken, so nothing else acts on it).
+fn answer_keys(ctx: &egui::Context) -> Option<AnswerKey> {
+    ctx.input_mut(|i| {
+        if i.consume_key(egui::Modifiers::NONE, egui::Key::Enter) {
+            Some(AnswerKey::Enter)
+        } else if i.consume_key(egui::Modifiers::NONE, egui::Key::Escape) {
+            Some(AnswerKey::Escape)
+        } else {
+            None
+        }
+    })
 }
 
 /// A "Replace file?" modal: `Some(true)` replace, `Some(false)` cancel, `None` not answered.

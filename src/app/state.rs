@@ -208,4 +208,12 @@ impl ViewerState {
         let frame = self.frame.as_ref()?;
         self.reference.open.as_ref()?.errors(&frame.radiance)
     }
+
+    /// Whether a question waits for an answer (replace a file, discard passes, unsaved edits).
+    pub fn question_open(&self) -> bool {
+        self.confirming_overwrite().is_some()
+            || self.confirm_scene_overwrite.is_some()
+            || self.confirm_restart
+            || self.unsaved_question.is_some()
+    }
 }

@@ -428,8 +428,8 @@ impl Viewer {
     pub fn ui(&mut self, ui: &mut egui::Ui) {
         self.poll();
         let mut actions = Vec::new();
-        // The window's own file dialog takes the keyboard (Enter, Escape) while it is open.
-        if !self.file_dialog_in_window() {
+        // An open question or the window's own file dialog takes the keyboard (Enter, Escape).
+        if !self.file_dialog_in_window() && !self.question_open() {
             keys::handle(self, ui.ctx(), &mut actions);
         }
         // Files dropped on the window open as scenes (the first one); images (.exr, .pfm)
