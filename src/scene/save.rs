@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use glam::DVec3;
 use toml_edit::{Array, DocumentMut, Item, Table, Value};
 
-use super::{RenderParams, Scene};
+use super::{Camera, RenderParams, Scene};
 use crate::files::{write_atomically, WriteError};
 use crate::geometry::{BezierPatch, Window};
 
@@ -34,11 +34,51 @@ fn vec3(v: DVec3) -> Value {
     Array::from_iter([v.x, v.y, v.z]).into()
 }
 
-/// One patch as a TOML array of its 16 points, on one line.
-fn patch_value(p: &BezierPatch) -> Value {
-    let mut points: Array = p.points.iter().map(|q| vec3(*q)).collect();
-    points.decor_mut().set_prefix("\n    ");
-    points.into()
+/// Patches as FORMAT.md writes them: each patch on lines of its own, one row of four points a
+/// line, numbers in their shortest round-trip form.
+fn patch_list(own: &[(usize, &BezierPatch)]) -> Value {
+    let point = |q: DVec3| format!("[{:?}, {:?}, {:?}]", q.x, q.y, q.z);
+    let mut text = String::from("[\n");
+    for (_, p) in own {
+        text.push_str("[\n");
+        for row in p.points.chunks_exact(4) {
+            let row: Vec<String> = row.iter().map(|q| point(*q)).collect();
+            text.push_str(&format!("    {},\n", row.join(", ")));
+        }
+        text.push_str("],\n");
+    }
+    text.push(']');
+    text.parse().expect("the patches' text is a TOML array")
+}
+
+/// Moves only the edited points of an object whose patches are written inline (and not
+/// transformed), each in its place: every other character of the file stays. `false` when the
+/// object is not of that kind.
+fn edit_inline_points(object: &mut Table, own: &[(usize, &BezierPatch)], loaded: &[BezierPatch]) -> bool {
+    if object.contains_key("transform") {
+        return false;
+    }
+    let Some(list) = object.get_mut("patches").and_then(Item::as_array_mut) else {
+        return false;
+    };
+    if list.len() != own.len() || list.iter().any(|p| p.as_array().is_none_or(|a| a.len() != 16)) {
+        return false;
+    }
+    for (slot, (i, patch)) in list.iter_mut().zip(own) {
+        let Some(points) = slot.as_array_mut() else {
+            return false;
+        };
+        for (j, q) in patch.points.iter().enumerate() {
+            if loaded.get(*i).is_some_and(|l| l.points[j] == *q) {
+                continue;
+            }
+            let decor = points.get(j).map(|v| v.decor().clone()).unwrap_or_default();
+            let mut value = vec3(*q);
+            *value.decor_mut() = decor;
+            points.replace(j, value);
+        }
+    }
+    true
 }
 
 /// `file` made absolute against `base` when relative (so it resolves from another folder).
@@ -75,8 +115,15 @@ pub fn scene_toml(
     out_dir: Option<&Path>,
 ) -> Result<String, SaveError> {
     let mut doc = parse_text(scene)?;
-    write_camera(&mut doc, scene);
-    write_render(&mut doc, scene);
+    // What the file itself says: what did not change stays as the user wrote it.
+    let original = Scene::from_str(&scene.text, &scene.source, scene.base_dir.as_deref()).ok();
+    match &original {
+        Some(o) => write_changed_camera(&mut doc, scene, &o.camera),
+        None => write_camera(&mut doc, scene),
+    }
+    if original.as_ref().is_none_or(|o| o.params != scene.params) {
+        write_render(&mut doc, scene);
+    }
     write_patches(&mut doc, scene, loaded);
     if let (Some(base), Some(out)) = (&scene.base_dir, out_dir) {
         let same = base
@@ -153,6 +200,65 @@ fn write_camera(doc: &mut DocumentMut, scene: &Scene) {
     t.insert("focal_distance", toml_edit::value(c.focal_distance));
 }
 
+/// A `[camera]` array of three numbers.
+fn table_vec3(t: &Table, key: &str) -> Option<DVec3> {
+    let a = t.get(key)?.as_array()?;
+    let v: Vec<f64> = a
+        .iter()
+        .map(|x| x.as_float().or_else(|| x.as_integer().map(|i| i as f64)))
+        .collect::<Option<_>>()?;
+    (v.len() == 3).then(|| DVec3::new(v[0], v[1], v[2]))
+}
+
+/// Whether two unit vectors agree to rounding.
+fn same_direction(a: DVec3, b: DVec3) -> bool {
+    (a - b).length() < 1e-12
+}
+
+/// Writes into `[camera]` only what differs from `original` (the camera the file gives), as a
+/// person would: `look_at` kept while the view still passes through it, no derived `up`,
+/// aperture or focal distance that the file's own values already give.
+fn write_changed_camera(doc: &mut DocumentMut, scene: &Scene, original: &Camera) {
+    let c = &scene.camera;
+    if c == original {
+        return;
+    }
+    let t = table(doc, "camera");
+    if c.position != original.position {
+        t.insert("position", toml_edit::value(vec3(c.position)));
+    }
+    let look_at = match table_vec3(t, "look_at") {
+        Some(l) if same_direction((l - c.position).normalize(), c.forward) => l,
+        _ => {
+            let l = c.position + c.forward * c.focal_distance;
+            t.insert("look_at", toml_edit::value(vec3(l)));
+            l
+        }
+    };
+    let up = table_vec3(t, "up").unwrap_or(DVec3::Y);
+    let fov = c.fov_y.to_degrees();
+    let implied = Camera::look_at(c.position, look_at, up, fov, c.width, c.height, 0.0, None);
+    if !same_direction(implied.up, c.up) {
+        t.insert("up", toml_edit::value(vec3(c.up)));
+    }
+    if c.fov_y != original.fov_y {
+        t.insert("fov", toml_edit::value(fov));
+    }
+    if (c.width, c.height) != (original.width, original.height) {
+        write_size(t, scene);
+    }
+    if c.aperture != original.aperture {
+        t.insert("aperture", toml_edit::value(c.aperture));
+    }
+    let focal = t
+        .get("focal_distance")
+        .and_then(|v| v.as_float())
+        .unwrap_or(implied.focal_distance);
+    if (focal - c.focal_distance).abs() > 1e-12 * c.focal_distance {
+        t.insert("focal_distance", toml_edit::value(c.focal_distance));
+    }
+}
+
 /// Writes the render parameters into `[render]`: every key the table already has, and every
 /// value that differs from the default (so a file that never named a setting stays lean).
 fn write_render(doc: &mut DocumentMut, scene: &Scene) {
@@ -200,13 +306,13 @@ fn write_patches(doc: &mut DocumentMut, scene: &Scene, loaded: &[BezierPatch]) {
         if own.is_empty() || !edited {
             continue;
         }
+        if edit_inline_points(object, &own, loaded) {
+            continue;
+        }
         for key in ["file", "builtin", "transform", "domains"] {
             object.remove(key);
         }
-        let mut list: Array = own.iter().map(|(_, p)| patch_value(p)).collect();
-        list.set_trailing("\n");
-        list.set_trailing_comma(true);
-        object.insert("patches", toml_edit::value(list));
+        object.insert("patches", toml_edit::value(patch_list(&own)));
         // Patches cut from a larger surface keep their (u,v) windows, so textures still follow it.
         let windows: Vec<Window> = own.iter().map(|(i, _)| domains[*i]).collect();
         if windows.iter().any(|w| *w != Window::FULL) {
@@ -237,6 +343,7 @@ pub fn save_scene(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::BUILTIN_SCENE;
 
     #[test]
     fn an_edited_teapot_saves_and_loads_back_bit_for_bit() {
@@ -264,6 +371,71 @@ mod tests {
         // Unedited, the teapot stays a reference to the built-in copy.
         let plain = scene_toml(&Scene::builtin(), &loaded, None).expect("saves");
         assert!(plain.contains("builtin = \"teapot\"") && !plain.contains("patches ="));
+    }
+
+    /// The inline-patch scene with one control point moved: the saved text differs from the
+    /// file in that point's line only (camera, render table, other points and comments kept).
+    #[test]
+    fn moving_one_point_changes_only_its_line() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/inline_patch.toml");
+        let original = std::fs::read_to_string(&path).expect("scene");
+        let mut scene = Scene::from_str(&original, &path, None).expect("loads");
+        let loaded: Vec<BezierPatch> = scene.geometry.patches().iter().map(|(p, _)| *p).collect();
+        assert!(scene
+            .geometry
+            .set_control_point(0, 6, DVec3::new(0.4, 2.75, -0.3)));
+        let text = scene_toml(&scene, &loaded, None).expect("saves");
+        let before: Vec<&str> = original.lines().collect();
+        let after: Vec<&str> = text.lines().collect();
+        assert_eq!(before.len(), after.len(), "{text}");
+        let changed: Vec<(&&str, &&str)> = before.iter().zip(&after).filter(|(a, b)| a != b).collect();
+        assert_eq!(changed.len(), 1, "{changed:#?}");
+        assert_eq!(
+            *changed[0].1,
+            "    [-1, 1.5, -0.333], [-0.333, 2.6, -0.333], [0.4, 2.75, -0.3], [1, 1.5, -0.333],"
+        );
+        let back = Scene::from_str(&text, &path, None).expect("loads back");
+        assert_eq!(back.geometry.patches(), scene.geometry.patches());
+    }
+
+    /// A scene with comments, several patches written inline as FORMAT.md does, and a camera
+    /// that moved: the camera is written as a person would (look_at kept where the view still
+    /// passes through it, no derived up), and everything loads back.
+    #[test]
+    fn a_moved_camera_and_several_patches_round_trip() {
+        let mut scene = Scene::builtin();
+        let loaded: Vec<BezierPatch> = scene.geometry.patches().iter().map(|(p, _)| *p).collect();
+        assert!(scene.geometry.set_control_point(0, 0, DVec3::new(1.5, 0.25, 2.4)));
+        assert!(scene.geometry.set_control_point(7, 3, DVec3::new(-0.5, 1.0, 2.0)));
+        // Slide the camera along its view: the point looked at stays on the view axis.
+        let c = &mut scene.camera;
+        c.position -= c.forward * 0.5;
+        c.focal_distance += 0.5;
+        let text = scene_toml(&scene, &loaded, None).expect("saves");
+        assert!(text.contains("# The Utah teapot"), "comments lost");
+        let camera = text.split("[camera]").nth(1).expect("camera table");
+        let camera = camera.split("\n[").next().expect("table");
+        let original_up = BUILTIN_SCENE.lines().find(|l| l.starts_with("up")).expect("up");
+        assert!(camera.contains(original_up), "up rewritten:{camera}");
+        assert!(
+            !camera.contains("focal_distance"),
+            "a derived focal distance was added:{camera}"
+        );
+        let original = Scene::builtin();
+        let original_look_at = BUILTIN_SCENE
+            .lines()
+            .find(|l| l.starts_with("look_at"))
+            .expect("look_at");
+        assert!(camera.contains(original_look_at), "look_at rewritten:{camera}");
+        // Each patch's rows on lines of their own.
+        assert!(text.contains("patches = [\n[\n    ["), "{text}");
+        let back = Scene::from_str(&text, Path::new("saved.toml"), None).expect("loads back");
+        assert_eq!(back.geometry.patches(), scene.geometry.patches());
+        let (a, b) = (&back.camera, &scene.camera);
+        assert!((a.position - b.position).length() < 1e-12);
+        assert!((a.forward - b.forward).length() < 1e-12 && (a.up - b.up).length() < 1e-12);
+        assert!((a.focal_distance - b.focal_distance).abs() < 1e-9);
+        assert_eq!(back.params, original.params);
     }
 
     #[test]
