@@ -500,3 +500,80 @@ fn the_unsaved_edits_and_scene_replace_questions_answer_enter_and_escape() {
         assert_eq!(text != "precious", replaced, "{key:?}: {text}");
     }
 }
+
+/// Shift + left drag on empty space draws a rectangle; on release every control point inside
+/// joins the selection (which it adds to), and neither the image nor any point moves.
+#[test]
+fn shift_drag_on_empty_space_selects_the_points_in_its_rectangle() {
+    let mut h = editing_app();
+    let (first, s) = isolated_point(viewer(&h));
+    pointer(&mut h, s, PointerButton::Primary, true, Modifiers::NONE);
+    pointer(&mut h, s, PointerButton::Primary, false, Modifiers::NONE);
+    h.run_steps(2);
+    assert!(
+        viewer(&h).selection().any(|r| r == first),
+        "the click did not select"
+    );
+    let proj = viewer(&h).projection().expect("placed").clone();
+    // From the image's corner farthest from the selected point (the walls: empty space) to
+    // the image's centre.
+    let image = proj.image;
+    let from = [
+        image.left_top(),
+        image.right_top(),
+        image.left_bottom(),
+        image.right_bottom(),
+    ]
+    .into_iter()
+    .map(|c| c + (image.center() - c) * 0.05)
+    .max_by(|a, b| a.distance(s).total_cmp(&b.distance(s)))
+    .expect("corners");
+    let to = image.center();
+    assert!(
+        proj.pick(viewer(&h).patches(), from).is_none(),
+        "the drag must start on empty space"
+    );
+    let rect = egui::Rect::from_two_pos(from, to);
+    let inside: Vec<PointRef> = control_points(viewer(&h).patches())
+        .filter(|(_, q)| proj.to_screen(*q).is_some_and(|p| rect.contains(p)))
+        .map(|(r, _)| r)
+        .collect();
+    assert!(
+        inside.len() >= 4 && !inside.contains(&first),
+        "{} points inside",
+        inside.len()
+    );
+    let before = sent(&h).len();
+
+    h.event(Event::ModifiersChanged(Modifiers::SHIFT));
+    h.event(Event::PointerMoved(from));
+    h.step();
+    pointer(&mut h, from, PointerButton::Primary, true, Modifiers::SHIFT);
+    for k in 1..=5 {
+        h.event(Event::PointerMoved(from + (to - from) * (k as f32 / 5.0)));
+        h.step();
+    }
+    pointer(&mut h, to, PointerButton::Primary, false, Modifiers::SHIFT);
+    h.event(Event::ModifiersChanged(Modifiers::NONE));
+    h.run_steps(2);
+
+    let selected: Vec<PointRef> = viewer(&h).selection().collect();
+    assert!(
+        selected.contains(&first),
+        "the box replaced the selection instead of adding"
+    );
+    for r in &inside {
+        assert!(selected.contains(r), "{r:?} inside the box is not selected");
+    }
+    assert_eq!(
+        sent(&h).len(),
+        before,
+        "the box moved something: {:?}",
+        &sent(&h)[before..]
+    );
+    assert_eq!(
+        viewer(&h).projection().expect("placed").image,
+        proj.image,
+        "the image panned"
+    );
+}

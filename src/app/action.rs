@@ -100,6 +100,16 @@ pub enum Action {
     SelectPatch(usize),
     /// Select nothing.
     ClearSelection,
+    /// A Shift + left drag on empty space: the rectangle from `from` to `to` (screen points);
+    /// when `done`, every control point inside joins the selection.
+    BoxSelect {
+        /// Where the drag began.
+        from: Pos2,
+        /// Where the pointer is.
+        to: Pos2,
+        /// The button was released.
+        done: bool,
+    },
     /// A drag begins on a control point.
     BeginPointDrag {
         /// The grabbed point.

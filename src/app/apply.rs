@@ -6,7 +6,7 @@ use glam::DVec3;
 
 use super::action::{Action, AfterDiscard};
 use super::editor::{Edit, Gesture};
-use super::overlay::PointRef;
+use super::overlay::{control_points, PointRef};
 use super::settings::EXPOSURE_LIMIT;
 use super::state::Status;
 use super::viewer::Viewer;
@@ -70,7 +70,8 @@ impl Viewer {
             a @ (Action::Hover(_)
             | Action::Select { .. }
             | Action::SelectPatch(_)
-            | Action::ClearSelection) => self.apply_selection(a),
+            | Action::ClearSelection
+            | Action::BoxSelect { .. }) => self.apply_selection(a),
             a @ (Action::BeginPointDrag { .. }
             | Action::DragPoints { .. }
             | Action::BeginCameraDrag(_)
@@ -103,6 +104,26 @@ impl Viewer {
                         self.editor.selection.remove(&r);
                     }
                 } else {
+                    self.editor.selection.extend(welded);
+                }
+                self.editor.touch();
+            }
+            Action::BoxSelect { from, to, done } => {
+                if !done {
+                    self.editor.rubber_band = Some((from, to));
+                    return;
+                }
+                self.editor.rubber_band = None;
+                let rect = egui::Rect::from_two_pos(from, to);
+                let Some(projection) = &self.projection else {
+                    return;
+                };
+                let inside: Vec<PointRef> = control_points(&self.editor.patches)
+                    .filter(|(_, q)| projection.to_screen(*q).is_some_and(|s| rect.contains(s)))
+                    .map(|(r, _)| r)
+                    .collect();
+                for r in inside {
+                    let welded = self.editor.welded(r);
                     self.editor.selection.extend(welded);
                 }
                 self.editor.touch();

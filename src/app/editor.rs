@@ -143,6 +143,8 @@ pub struct Editor {
     pub loaded: Vec<BezierPatch>,
     /// Selected control points.
     pub selection: BTreeSet<PointRef>,
+    /// The rectangle of a box selection under way (screen points, corner to corner).
+    pub rubber_band: Option<(Pos2, Pos2)>,
     /// The control point under the cursor.
     pub hovered: Option<PointRef>,
     /// The drag in progress.
@@ -168,6 +170,7 @@ impl Editor {
             loaded: patches.clone(),
             patches,
             selection: BTreeSet::new(),
+            rubber_band: None,
             hovered: None,
             gesture: None,
             pivot: cam.position + cam.forward * cam.focal_distance,

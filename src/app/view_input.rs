@@ -37,6 +37,9 @@ pub fn view_actions(
             out.push(Action::Hover(hovered));
         }
     }
+    if box_select_actions(editor, projection, response, editing, out) {
+        return;
+    }
     drag_actions(editor, projection, response, editing, out);
     // Clicks select.
     if response.clicked() && editing {
@@ -50,6 +53,39 @@ pub fn view_actions(
             None => {}
         }
     }
+}
+
+/// Shift + left drag on empty space: a box selection. Returns whether one is under way (it
+/// takes the pointer: no click or drag else this frame).
+fn box_select_actions(
+    editor: &Editor,
+    projection: &OverlayProjection,
+    response: &Response,
+    editing: bool,
+    out: &mut Vec<Action>,
+) -> bool {
+    let (shift, press) = response
+        .ctx
+        .input(|i| (i.modifiers.shift, i.pointer.press_origin()));
+    let starts = response.drag_started_by(PointerButton::Primary)
+        && editing
+        && shift
+        && grab_at(editor, Some(projection), press).is_none();
+    let Some(from) = editor
+        .rubber_band
+        .map(|(from, _)| from)
+        .or(press.filter(|_| starts))
+    else {
+        return false;
+    };
+    let to = response
+        .interact_pointer_pos()
+        .or(response.hover_pos())
+        .or(editor.rubber_band.map(|(_, to)| to))
+        .unwrap_or(from);
+    let done = response.drag_stopped() || !response.ctx.input(|i| i.pointer.primary_down());
+    out.push(Action::BoxSelect { from, to, done });
+    true
 }
 
 /// Drags: points with the left button, the camera with the right or middle one.

@@ -547,7 +547,10 @@ impl Viewer {
         let size = [frame.width, frame.height];
         // A left drag that starts on a control point moves it; elsewhere it pans the image.
         let press = ui.input(|i| i.pointer.press_origin());
-        let grabbing = matches!(self.editor.gesture, Some(super::editor::Gesture::Points { .. }))
+        let box_selecting =
+            self.editor.rubber_band.is_some() || (self.editing() && ui.input(|i| i.modifiers.shift));
+        let grabbing = box_selecting
+            || matches!(self.editor.gesture, Some(super::editor::Gesture::Points { .. }))
             || (self.editing()
                 && view_input::grab_at(&self.editor, self.projection.as_ref(), press).is_some());
         let shown = self.image_view.ui(ui, self.settings.zoom, size, !grabbing);
@@ -578,6 +581,13 @@ impl Viewer {
                 .add(eframe::egui_wgpu::Callback::new_paint_callback(
                     shown.view, callback,
                 ));
+        }
+        if let Some((from, to)) = self.editor.rubber_band {
+            let band = egui::Rect::from_two_pos(from, to);
+            let stroke = egui::Stroke::new(1.0, ui.visuals().selection.stroke.color);
+            let painter = ui.painter_at(shown.view);
+            painter.rect_filled(band, 0.0, ui.visuals().selection.bg_fill.gamma_multiply(0.25));
+            painter.rect_stroke(band, 0.0, stroke, egui::StrokeKind::Inside);
         }
         self.projection = Some(projection);
         if let Some(legend) = self.image_view.legend {
