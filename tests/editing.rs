@@ -577,3 +577,44 @@ fn shift_drag_on_empty_space_selects_the_points_in_its_rectangle() {
         "the image panned"
     );
 }
+
+/// A control point on screen but outside the image's rectangle (a narrow field of view: the
+/// teapot's net reaches past the frame into the view's margin) is hovered and picked like any
+/// other.
+#[test]
+fn a_point_outside_the_image_rectangle_can_be_picked() {
+    // The widest view whose net reaches past the image into the view around it.
+    let found = [30.0, 25.0, 20.0, 16.0, 12.0].into_iter().find_map(|fov: f64| {
+        let mut h = harness(Harness::builder());
+        let mut scene = teapot();
+        scene.camera.fov_y = fov.to_radians();
+        let mut v = Viewer::with_pause(&h.ctx, scene, ViewerSettings::default(), true);
+        v.show_frame(flat_frame());
+        *h.state_mut() = Some(v);
+        h.run_steps(2);
+        let proj = viewer(&h).projection().expect("placed").clone();
+        let screen: Vec<(PointRef, Pos2)> = control_points(viewer(&h).patches())
+            .filter_map(|(r, q)| Some((r, proj.to_screen(q)?)))
+            .collect();
+        // Outside the image, inside the view, and no other point within two pick radii.
+        let outside = screen.iter().copied().find(|(r, p)| {
+            !proj.image.expand(2.0).contains(*p)
+                && proj.view.shrink(10.0).contains(*p)
+                && screen
+                    .iter()
+                    .all(|(o, q)| o == r || q.distance(*p) > 2.0 * caustic::app::overlay::PICK_RADIUS)
+        })?;
+        Some((h, outside))
+    });
+    let (mut h, (r, p)) = found.expect("no field of view puts a control point outside the image");
+    h.event(Event::PointerMoved(p));
+    h.run_steps(2);
+    pointer(&mut h, p, PointerButton::Primary, true, Modifiers::NONE);
+    pointer(&mut h, p, PointerButton::Primary, false, Modifiers::NONE);
+    h.run_steps(2);
+    let selected: Vec<PointRef> = viewer(&h).selection().collect();
+    assert!(
+        selected.contains(&r),
+        "the click at {p:?}, outside the image, picked {selected:?}"
+    );
+}
