@@ -46,6 +46,12 @@ pub fn export_obj(args: ExportArgs) -> Result<()> {
     }
     overwrite.check([out])?;
     let scene = load_scene(scene_path.as_deref())?;
+    if !scene.geometry.has_patches() {
+        bail!(
+            "{}: the scene has no Bézier patches to export",
+            scene.source.display()
+        );
+    }
     if freeform {
         return export_freeform(&scene, out, force);
     }
@@ -59,18 +65,7 @@ pub fn export_obj(args: ExportArgs) -> Result<()> {
             (name, tessellate(p, resolution))
         })
         .collect();
-    if meshes.is_empty() {
-        bail!(
-            "{}: the scene has no Bézier patches to export",
-            scene.source.display()
-        );
-    }
-    let write = |tmp: &Path| -> Result<(), String> {
-        let mut file = std::io::BufWriter::new(std::fs::File::create(tmp).map_err(|e| e.to_string())?);
-        write_obj(&meshes, &mut file).map_err(|e| e.to_string())?;
-        std::io::Write::flush(&mut file).map_err(|e| e.to_string())
-    };
-    write_atomically(out, force, write).context("cannot write the OBJ file")?;
+    write_obj_file(out, force, |file| write_obj(&meshes, file))?;
     let triangles: usize = meshes.iter().map(|(_, m)| m.indices.len()).sum();
     println!(
         "{}: {} patches, {triangles} triangles",
@@ -78,6 +73,21 @@ pub fn export_obj(args: ExportArgs) -> Result<()> {
         meshes.len()
     );
     Ok(())
+}
+
+/// Writes `out` through a buffer filled by `fill` (temporary name, then rename; an existing
+/// file only replaced when `force`).
+fn write_obj_file(
+    out: &Path,
+    force: bool,
+    fill: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> std::io::Result<()>,
+) -> Result<()> {
+    let write = |tmp: &Path| -> Result<(), String> {
+        let mut file = std::io::BufWriter::new(std::fs::File::create(tmp).map_err(|e| e.to_string())?);
+        fill(&mut file).map_err(|e| e.to_string())?;
+        std::io::Write::flush(&mut file).map_err(|e| e.to_string())
+    };
+    write_atomically(out, force, write).context("cannot write the OBJ file")
 }
 
 /// The object name of each patch, as an OBJ group name (no spaces).
@@ -99,18 +109,7 @@ fn export_freeform(scene: &caustic::scene::Scene, out: &Path, force: bool) -> Re
             _ => groups.push((name, vec![(*p, *domain)])),
         }
     }
-    if groups.is_empty() {
-        bail!(
-            "{}: the scene has no Bézier patches to export",
-            scene.source.display()
-        );
-    }
-    let write = |tmp: &Path| -> Result<(), String> {
-        let mut file = std::io::BufWriter::new(std::fs::File::create(tmp).map_err(|e| e.to_string())?);
-        write_freeform_obj(&groups, &mut file).map_err(|e| e.to_string())?;
-        std::io::Write::flush(&mut file).map_err(|e| e.to_string())
-    };
-    write_atomically(out, force, write).context("cannot write the OBJ file")?;
+    write_obj_file(out, force, |file| write_freeform_obj(&groups, file))?;
     println!(
         "{}: {} patches as free-form Bézier surfaces",
         out.display(),

@@ -42,10 +42,16 @@ pub struct PassPlan {
 impl PassPlan {
     /// Photons of the pass after `completed` passes of a render whose full pass is `full`.
     pub fn pass_photons(&self, completed: u32, full: u64) -> u64 {
-        match self.first_pass_photons {
-            Some(first) => full.min(first.saturating_mul(1 << completed.min(40))),
-            None => full,
-        }
+        photon_ramp(self.first_pass_photons, completed, full)
+    }
+}
+
+/// Photons of the pass after `completed` passes when a full pass is `full`: from `first`,
+/// doubling pass by pass up to `full` (`None`: `full` from the start).
+pub fn photon_ramp(first: Option<u64>, completed: u32, full: u64) -> u64 {
+    match first {
+        Some(first) => full.min(first.saturating_mul(1 << completed.min(40))),
+        None => full,
     }
 }
 

@@ -327,7 +327,7 @@ impl Integrator for PathTracer {
 
 /// The path tracer's statistics as a frame's.
 fn frame_stats(s: &PathStats) -> FrameStats {
-    let pixels_rate = s.segments as f64 / s.elapsed_secs.max(1e-9);
+    let segment_rate = s.segments as f64 / s.elapsed_secs.max(1e-9);
     FrameStats {
         kind: RendererKind::Path,
         seconds: s.elapsed_secs,
@@ -335,12 +335,12 @@ fn frame_stats(s: &PathStats) -> FrameStats {
             StatRow::new("Samples", s.passes.to_string(), "Paths traced per pixel (one a pass)"),
             StatRow::new(
                 "Segments/s",
-                format!("{pixels_rate:.0}"),
+                format!("{segment_rate:.0}"),
                 "Path segments (eye and bounce rays) traced per second",
             ),
         ],
         summary: vec![format!(
-            ", {} samples per pixel in {:.2} s ({} path segments, {} shadow rays, {pixels_rate:.0} segments/s)",
+            ", {} samples per pixel in {:.2} s ({} path segments, {} shadow rays, {segment_rate:.0} segments/s)",
             s.passes, s.elapsed_secs, s.segments, s.shadow_rays
         )],
         skipped: Vec::new(),

@@ -187,11 +187,7 @@ impl SessionState {
     /// photons ([`RenderParams::pass_photons`]): the ramp from
     /// [`SessionOptions::first_pass_photons`] doubling up to `full`.
     pub fn pass_photons(&self, completed: u32, full: u64) -> u64 {
-        crate::render::integrator::PassPlan {
-            params: self.params.clone(),
-            first_pass_photons: self.options.first_pass_photons,
-        }
-        .pass_photons(completed, full)
+        crate::render::integrator::photon_ramp(self.options.first_pass_photons, completed, full)
     }
 }
 
