@@ -408,6 +408,10 @@ impl Automation {
                 DRAG_POINT.index,
                 21,
             );
+            match drag_preview_error(viewer) {
+                Ok(line) => println!("{line}"),
+                Err(e) => println!("  drag preview error: not measured ({e})"),
+            }
             if !secs.is_empty() {
                 println!(
                     "  re-prepare one edited patch (subdivision + BVH update): median {:.2} ms, max {:.2} ms over {} edits",
@@ -424,6 +428,61 @@ impl Automation {
             );
         }
     }
+}
+
+/// Passes of the converged render the drag preview is measured against.
+const PREVIEW_REFERENCE_PASSES: u32 = 100;
+
+/// The drag preview's figure: the RMSE of what is on screen [`ON_SCREEN_AFTER`] a move of the
+/// dragged point (from where it was to where the drag left it), against a converged render of
+/// the edited scene, with warm restarts (the viewer's) and with the cold restart and preview
+/// the viewer had before them; medians of 3 runs each, in the viewer's kind of render session
+/// without the window.
+fn drag_preview_error(viewer: &Viewer) -> Result<String, String> {
+    use crate::bench::edit::{measure_edit, median, EditPlan, ON_SCREEN_AFTER};
+    let edited = viewer.edited_scene();
+    let position = edited.geometry.patches()[DRAG_POINT.patch].0.points[DRAG_POINT.index];
+    let mut before = edited.clone();
+    let mut patch = before.geometry.patches()[DRAG_POINT.patch].0;
+    patch.points[DRAG_POINT.index] =
+        viewer.scene().geometry.patches()[DRAG_POINT.patch].0.points[DRAG_POINT.index];
+    before.geometry.update_patches(&[(DRAG_POINT.patch, patch)]);
+    let reference = {
+        let options = crate::render::session::SessionOptions {
+            max_passes: Some(PREVIEW_REFERENCE_PASSES),
+            every_frame: true,
+            ..Default::default()
+        };
+        let mut reference = edited.clone();
+        reference.params.seed ^= 0x5eed;
+        let session = crate::render::session::RenderSession::start_with(reference, options, None);
+        let last = session.frames().iter().last();
+        session.failure().map_or(Ok(()), Err)?;
+        last.ok_or("no reference frame")?.radiance.to_vec()
+    };
+    let mut figures = [Vec::new(), Vec::new()];
+    for _ in 0..3 {
+        for (k, warm) in [true, false].into_iter().enumerate() {
+            let plan = EditPlan {
+                edit: crate::render::session::Command::MoveControlPoint {
+                    patch: DRAG_POINT.patch,
+                    index: DRAG_POINT.index,
+                    position,
+                },
+                before_passes: 8,
+                warm,
+                target: 0.0,
+                limit: ON_SCREEN_AFTER * 3,
+            };
+            figures[k].push(measure_edit(before.clone(), &plan, &reference)?.on_screen);
+        }
+    }
+    let [warm, cold] = figures.map(median);
+    Ok(format!(
+        "  drag preview: RMSE on screen {} ms after a move, against a {PREVIEW_REFERENCE_PASSES}-pass render of the edited scene: {warm:.3e} with warm restarts, {cold:.3e} with the cold restart and ¼-resolution preview of before ({:.2}x)",
+        ON_SCREEN_AFTER.as_millis(),
+        warm / cold
+    ))
 }
 
 /// Writes a window screenshot as PNG (temp name + rename; refuses to replace unless `force`).

@@ -23,18 +23,9 @@ use super::state::ViewerState;
 use super::tev_send::TevSend;
 use super::view_input;
 use crate::render::image_metadata;
-use crate::render::ppm::PpmOptions;
 use crate::render::session::{Command, Frame, RenderSession, SessionOptions};
 use crate::scene::{RendererKind, Scene};
 
-/// Photons between two looks at the command channel: 4 chunks, about 30–60 ms on 2 cores,
-/// so a slider reacts well within the 250 ms target.
-pub const VIEWER_BATCH_PHOTONS: u64 = 16_384;
-/// Photons in the first pass of an epoch (doubling up to photons per pass): the first image of
-/// a new setting appears after one small pass.
-pub const VIEWER_FIRST_PASS_PHOTONS: u64 = 16_384;
-/// A new epoch first shows a preview at this fraction of the resolution.
-pub const VIEWER_PREVIEW_DIVISOR: u32 = 4;
 /// Commands kept in [`Viewer::recent_commands`].
 const COMMAND_LOG: usize = 256;
 
@@ -79,14 +70,8 @@ impl std::ops::DerefMut for Viewer {
 
 fn session_options(start_paused: bool) -> SessionOptions {
     SessionOptions {
-        ppm: PpmOptions {
-            batch_photons: VIEWER_BATCH_PHOTONS,
-            ..Default::default()
-        },
-        first_pass_photons: Some(VIEWER_FIRST_PASS_PHOTONS),
         start_paused,
-        preview_divisor: Some(VIEWER_PREVIEW_DIVISOR),
-        ..Default::default()
+        ..SessionOptions::interactive()
     }
 }
 

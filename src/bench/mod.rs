@@ -3,6 +3,7 @@
 //! [`error_curves`] (curves, CSV), [`plot`] (log-log PNG) and [`reference`] (the cached
 //! reference render).
 
+pub mod edit;
 pub mod error_curves;
 pub mod plot;
 pub mod reference;

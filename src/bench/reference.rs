@@ -27,6 +27,10 @@ pub struct ReferenceRecord {
     pub passes: u32,
     /// Every render parameter, seed included.
     pub params: RenderParams,
+    /// An edit made to the scene after it was read (`bench edit`'s moved control point), in
+    /// words; absent for the scene as written.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub edit: Option<String>,
 }
 
 impl ReferenceRecord {
@@ -41,6 +45,7 @@ impl ReferenceRecord {
             height: scene.camera.height,
             passes,
             params: scene.params.clone(),
+            edit: None,
         }
     }
 

@@ -63,6 +63,10 @@ pub enum BenchCommand {
     /// defaults, α, initial radius, index) against a long reference render, cached on disk.
     /// Prints a table; writes a CSV and a log-log plot on request.
     Convergence(super::bench_convergence::ConvergenceArgs),
+    /// Live editing: the time from moving one control point to relative MSE 1e-2 against a
+    /// reference of the edited scene (cached), with the new epoch started warm and cold; the
+    /// medians of several runs each.
+    Edit(super::bench_edit::EditArgs),
     /// Photon mapping: resident memory (current and peak) of a long stochastic render (open
     /// aperture), sampled every --every passes.
     Memory(super::memory::MemoryArgs),
@@ -96,6 +100,7 @@ impl BenchCommand {
     pub fn threads(&self) -> Option<usize> {
         match self {
             BenchCommand::Convergence(args) => args.threads.threads,
+            BenchCommand::Edit(args) => args.threads.threads,
             BenchCommand::Memory(args) => args.threads.threads,
             BenchCommand::Tessellation(args) => args.threads.threads,
             _ => None,
@@ -109,6 +114,7 @@ pub fn bench(what: BenchCommand, json: bool) -> Result<()> {
         BenchCommand::Intersect { .. } => "intersect",
         BenchCommand::Ppm { .. } => "ppm",
         BenchCommand::Convergence(_) => "convergence",
+        BenchCommand::Edit(_) => "edit",
         BenchCommand::Memory(_) => "memory",
         BenchCommand::Whitted { .. } => "whitted",
         BenchCommand::Tessellation(_) => "tessellation",
@@ -153,6 +159,7 @@ pub fn bench(what: BenchCommand, json: bool) -> Result<()> {
             bench_ppm(scene.as_deref(), run, &threads, &mut out)
         }
         BenchCommand::Convergence(args) => super::bench_convergence::bench_convergence(args, &mut out),
+        BenchCommand::Edit(args) => super::bench_edit::bench_edit(args, &mut out),
     }?;
     out.finish();
     Ok(())

@@ -168,7 +168,13 @@ pub fn bench_convergence(args: ConvergenceArgs, out: &mut BenchOutput) -> Result
     scene.params.renderer = RendererKind::Ppm;
     // The reference keeps the scene's own photons per pass, so runs with other --photons
     // share it.
-    let reference = reference(&scene, args.reference_passes, args.reference_dir.as_deref(), out)?;
+    let reference = reference(
+        &scene,
+        args.reference_passes,
+        args.reference_dir.as_deref(),
+        None,
+        out,
+    )?;
     if let Some(n) = args.photons {
         scene.params.photons_per_pass = n;
     }
@@ -242,13 +248,23 @@ fn check(width: &u32, seconds: f64, baseline: Option<f64>, passes: u32) -> Resul
 /// indirect estimate that the default configurations use; the adaptive radius narrows it
 /// further where photons are dense (a fixed-radius reference keeps the caustics blurred by the
 /// initial radius for hundreds of passes, and would count a sharper caustic as error).
-fn reference(scene: &Scene, passes: u32, dir: Option<&Path>, out: &mut BenchOutput) -> Result<Vec<[f32; 3]>> {
+/// `edit` describes a change made to the scene after it was read (part of the cache's key).
+pub(super) fn reference(
+    scene: &Scene,
+    passes: u32,
+    dir: Option<&Path>,
+    edit: Option<String>,
+    out: &mut BenchOutput,
+) -> Result<Vec<[f32; 3]>> {
     let dir = dir.map_or_else(default_cache_dir, Path::to_path_buf);
     let mut reference_scene = scene.clone();
     reference_scene.params.seed ^= 0x5eed;
     reference_scene.params.indirect_radius_scale = Some(1.0);
     reference_scene.params.adaptive_radius = true;
-    let record = ReferenceRecord::new(&reference_scene, passes);
+    let record = ReferenceRecord {
+        edit,
+        ..ReferenceRecord::new(&reference_scene, passes)
+    };
     if let Some(pixels) = record.load(&dir) {
         out.say(format!("reference: {} (cached)", record.path_in(&dir).display()));
         out.set("reference", record.path_in(&dir).display().to_string());

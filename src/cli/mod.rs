@@ -3,6 +3,7 @@
 
 mod bench;
 mod bench_convergence;
+mod bench_edit;
 mod bench_output;
 mod export;
 mod memory;

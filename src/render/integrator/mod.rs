@@ -8,7 +8,7 @@
 //! `fn new(scene: &Scene, setup: &Setup) -> Self`, plus its line in `src/render/integrator/renderers.rs`.
 
 use crate::render::frame::Frame;
-use crate::render::ppm::{Control, Interrupt, PpmOptions};
+use crate::render::ppm::{Control, Interrupt, PpmOptions, WarmStart};
 use crate::scene::Scene;
 use crate::settings::{RenderParams, RendererKind};
 
@@ -72,6 +72,16 @@ pub trait Integrator: Send {
 
     /// The image so far as a frame of `epoch`, `elapsed_secs` into it.
     fn frame(&self, epoch: u64, elapsed_secs: f64) -> Frame;
+
+    /// What the next epoch may keep after an edit of the scene (a warm restart, see
+    /// [`crate::render::ppm::warm`]); `None` (the default) when the renderer keeps nothing.
+    fn into_warm_start(self: Box<Self>) -> Option<WarmStart> {
+        None
+    }
+
+    /// Starts this new epoch of the edited `scene` from what the previous one kept (ignored
+    /// by default).
+    fn inherit(&mut self, _scene: &Scene, _warm: WarmStart) {}
 }
 
 /// Declares each renderer's module and makes the integrator of a kind, from the list.

@@ -42,6 +42,14 @@ impl Integrator for PhotonMapping {
         self.ppm.stats().passes
     }
 
+    fn into_warm_start(self: Box<Self>) -> Option<crate::render::ppm::WarmStart> {
+        self.ppm.into_warm_start()
+    }
+
+    fn inherit(&mut self, scene: &Scene, warm: crate::render::ppm::WarmStart) {
+        self.ppm.inherit(scene, warm);
+    }
+
     fn frame(&self, epoch: u64, elapsed_secs: f64) -> Frame {
         let mut frame = Frame::from_ppm(&self.ppm, epoch, elapsed_secs);
         frame.stats = frame_stats(self.ppm.stats().clone(), self.guided_emission);

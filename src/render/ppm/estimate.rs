@@ -78,6 +78,10 @@ pub struct Slot {
     /// Whether the primary estimate was restarted with a narrower radius after the first
     /// pass (adaptive radius).
     pub restart: Restart,
+    /// Photons emitted before this epoch that both estimates' flux already counts: a slot a
+    /// warm restart kept ([`super::warm`]) carries its previous estimate as a prior worth
+    /// this many photons, which fades as the epoch's own photons come (0: a cold slot).
+    pub prior: f64,
 }
 
 /// A primary estimate's restart with a narrower radius ([`Ppm::narrow_dense`]).
@@ -101,6 +105,7 @@ impl Slot {
             primary: Estimate::default(),
             indirect: Estimate::default(),
             restart: Restart::None,
+            prior: 0.0,
         }
     }
 
@@ -142,6 +147,9 @@ impl Ppm {
             self.first_pass_photons = self.pass_photons;
             self.narrow_dense(&m);
         }
+        if self.stochastic && self.options.warm_restarts {
+            self.last_points = self.point_records();
+        }
         if self.stochastic {
             for (d, p) in self.direct.iter_mut().zip(self.pass_direct.drain(..)) {
                 *d += p;
@@ -149,6 +157,7 @@ impl Ppm {
             self.stats.eye_passes += 1;
         }
         self.stats.passes += 1;
+        self.inherited = None;
         self.stats.indirect_radius_scale = match self.indirect_scale {
             IndirectScale::Fixed(k) => k,
             _ => 1.0,

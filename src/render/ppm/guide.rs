@@ -166,6 +166,34 @@ impl EmissionGuide {
         }
     }
 
+    /// This guide as the prior of a new epoch after an edit of the scene (a warm restart):
+    /// each light's counts scaled down to at most `photons` emitted, so that what the new
+    /// epoch learns soon outweighs them, and the densities rebuilt from the scaled counts.
+    /// Lights in `moved` forget what they learned (their photons now go elsewhere). `None`
+    /// when the scene's lights are not the guide's (another count).
+    pub fn as_prior(&self, scene: &Scene, photons: u64, moved: &[usize]) -> Option<Self> {
+        if scene.lights.len() != self.lights.len() {
+            return None;
+        }
+        let mut prior = self.clone();
+        for (l, g) in prior.lights.iter_mut().enumerate() {
+            let total: u64 = g.emitted.iter().sum();
+            let keep = if moved.contains(&l) {
+                0.0
+            } else if total > photons {
+                photons as f64 / total as f64
+            } else {
+                1.0
+            };
+            // Scaling both counts by one factor and rounding down keeps useful ≤ emitted.
+            for c in g.emitted.iter_mut().chain(g.useful.iter_mut()) {
+                *c = (*c as f64 * keep) as u64;
+            }
+            g.density = Density2D::learned(&g.emitted, &g.useful);
+        }
+        Some(prior)
+    }
+
     /// How many times more photons reach a visible point with the learned densities than with
     /// uniform emission (by the counts so far; 1 before anything is learned), at most
     /// [`MAX_GAIN`].

@@ -34,6 +34,7 @@ pub mod hash_grid;
 pub mod kd_tree;
 pub mod photon;
 pub mod visible;
+pub mod warm;
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -53,6 +54,7 @@ pub use index::SpatialIndex;
 pub use photon_pass::DEFAULT_BATCH_PHOTONS;
 use radius::IndirectScale;
 pub use stats::PpmStats;
+pub use warm::{StreamOffset, WarmStart};
 
 /// Random stream ids of photon mapping.
 mod streams {
@@ -72,6 +74,10 @@ pub struct PpmOptions {
     /// 4096-photon chunks). Smaller batches let a viewer react sooner; the image does not
     /// depend on it.
     pub batch_photons: u64,
+    /// Keep, after each stochastic pass, a copy of every pixel's visible point (36 bytes a
+    /// pixel), so that an epoch can hand a warm restart its statistics ([`warm`]); classic
+    /// PPM keeps its points anyway.
+    pub warm_restarts: bool,
 }
 
 impl Default for PpmOptions {
@@ -79,6 +85,7 @@ impl Default for PpmOptions {
         Self {
             force_stochastic: false,
             batch_photons: DEFAULT_BATCH_PHOTONS,
+            warm_restarts: false,
         }
     }
 }
@@ -145,6 +152,15 @@ pub struct Ppm {
     height: u32,
     seed: u64,
     interrupt: Option<Interrupt>,
+    /// Where this epoch's random streams start (after the previous epoch's, when warm).
+    offset: StreamOffset,
+    /// What a warm restart inherited, until the first pass completes ([`warm`]).
+    inherited: Option<WarmStart>,
+    /// Per pixel, its visible point in the last completed stochastic pass, with
+    /// [`PpmOptions::warm_restarts`] ([`warm::records`]).
+    last_points: Vec<warm::PointRecord>,
+    /// Per pixel, the light seen directly that a warm restart kept (empty when cold).
+    prior_light: Vec<warm::PriorLight>,
 }
 
 /// Asked often during a pass (from any thread); returning true abandons the pass. The render
@@ -219,6 +235,10 @@ impl Ppm {
             height: cam.height,
             seed: scene.params.seed,
             interrupt: None,
+            offset: StreamOffset::default(),
+            inherited: None,
+            last_points: Vec::new(),
+            prior_light: Vec::new(),
         }
     }
 
@@ -294,24 +314,32 @@ impl Ppm {
             let restarted = (self.stats.photons - self.first_pass_photons) as f64;
             for s in &self.slots {
                 let primary = match s.restart {
-                    Restart::Restarted => s.primary.radiance(restarted),
-                    _ => s.primary.radiance(emitted),
+                    Restart::Restarted => s.primary.radiance(restarted + s.prior),
+                    _ => s.primary.radiance(emitted + s.prior),
                 };
-                out[s.pixel as usize] += primary + s.indirect.radiance(emitted);
+                out[s.pixel as usize] += primary + s.indirect.radiance(emitted + s.prior);
             }
         }
-        let eye = self.stats.eye_passes.max(1) as f64;
-        let passes = self.stats.passes.max(1) as f64;
-        for (o, a) in out.iter_mut().zip(&self.area_direct) {
-            *o += *a / passes;
-        }
         out.iter()
-            .zip(&self.direct)
-            .map(|(l, d)| {
-                let c = *l + *d / eye;
+            .enumerate()
+            .map(|(i, l)| {
+                let c = *l + self.light_seen(i);
                 [c.x as f32, c.y as f32, c.z as f32]
             })
             .collect()
+    }
+
+    /// Pixel `i`'s mean light seen directly (emission, and lights sampled at its visible
+    /// points), with what a warm restart kept of it counted as earlier passes.
+    fn light_seen(&self, i: usize) -> DVec3 {
+        let prior = self.prior_light.get(i).copied().unwrap_or_default();
+        let eye = self.stats.eye_passes as f64 + prior.direct_passes;
+        let passes = self.stats.passes as f64 + prior.area_passes;
+        let mut light = (self.direct[i] + prior.direct) / eye.max(1.0);
+        if let Some(a) = self.area_direct.get(i) {
+            light += (*a + prior.area) / passes.max(1.0);
+        }
+        light
     }
 
     /// The statistics slots (for the viewer's probe).

@@ -117,7 +117,8 @@ impl Ppm {
         let mut narrowed = 0usize;
         for (k, s) in self.slots.iter_mut().enumerate() {
             let count = m[2 * k] as f64 + if merged { m[2 * k + 1] as f64 } else { 0.0 };
-            if count <= DENSE_PHOTONS || s.primary.radius2 <= 0.0 {
+            // A slot a warm restart kept has its radius already.
+            if count <= DENSE_PHOTONS || s.primary.radius2 <= 0.0 || s.prior > 0.0 {
                 continue;
             }
             let radius2 = r0_2 * (DENSE_PHOTONS / count).max(MAX_NARROWING.powi(-2));

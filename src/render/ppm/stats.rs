@@ -24,6 +24,12 @@ pub struct PpmStats {
     /// Share of the statistics slots whose estimate restarted with a narrower radius after
     /// the first pass (adaptive radius; 0 before it or when off).
     pub narrowed_share: f64,
+    /// Share of the pixels whose statistics a warm restart kept from the previous epoch (0
+    /// for a cold start).
+    pub kept_share: f64,
+    /// Share of the pixels whose points moved and that a warm restart gave the previous
+    /// estimate of a point near their own.
+    pub nearby_share: f64,
     /// Seconds spent in completed passes.
     pub elapsed_secs: f64,
     /// Seconds spent tracing photons.

@@ -36,6 +36,33 @@ pub struct SessionOptions {
     pub threads: Option<usize>,
 }
 
+/// Photons between two looks at the command channel in an interactive session: 4 chunks,
+/// about 30–60 ms on 2 cores, so a slider reacts well within the 250 ms target.
+pub const INTERACTIVE_BATCH_PHOTONS: u64 = 16_384;
+/// Photons in the first pass of an interactive epoch (doubling up to photons per pass): the
+/// first image of a new setting appears after one small pass.
+pub const INTERACTIVE_FIRST_PASS_PHOTONS: u64 = 16_384;
+/// A new cold interactive epoch first shows a preview at this fraction of the resolution.
+pub const INTERACTIVE_PREVIEW_DIVISOR: u32 = 4;
+
+impl SessionOptions {
+    /// The viewer's options (and `bench edit`'s, which measures what the viewer shows): small
+    /// batches, a photon ramp, a low-resolution preview of a cold epoch, and warm restarts
+    /// after edits.
+    pub fn interactive() -> Self {
+        SessionOptions {
+            ppm: PpmOptions {
+                batch_photons: INTERACTIVE_BATCH_PHOTONS,
+                warm_restarts: true,
+                ..Default::default()
+            },
+            first_pass_photons: Some(INTERACTIVE_FIRST_PASS_PHOTONS),
+            preview_divisor: Some(INTERACTIVE_PREVIEW_DIVISOR),
+            ..Default::default()
+        }
+    }
+}
+
 /// What the session does next ([`SessionState::next`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Next {
@@ -73,6 +100,9 @@ pub struct SessionState {
     pending: Vec<Command>,
     /// A restart is waiting.
     restart_due: bool,
+    /// The waiting restart changes more than the scene's geometry (settings, camera, or a
+    /// plain restart): it starts cold.
+    cold_due: bool,
     pub(super) shutdown: bool,
 }
 
@@ -102,6 +132,7 @@ impl SessionState {
             preview_due: options.preview_divisor.is_some(),
             pending: Vec::new(),
             restart_due: false,
+            cold_due: false,
             shutdown: false,
         }
     }
@@ -112,6 +143,7 @@ impl SessionState {
             return Effect::Ignored;
         }
         let restarts = command.restarts(&self.params);
+        let edit = matches!(command, Command::MoveControlPoint { .. });
         match command {
             // The restart takes the newest set: parameters need no replaying.
             Command::SetParams(p) => self.params = p,
@@ -127,6 +159,7 @@ impl SessionState {
         }
         if restarts {
             self.restart_due = true;
+            self.cold_due |= !edit;
             Effect::Restarts
         } else {
             Effect::Applied
@@ -173,14 +206,19 @@ impl SessionState {
         self.paused || (!self.params.renderer.progressive() && self.passes > 0)
     }
 
-    /// Opens a new epoch: the gathered commands are applied to `scene`.
-    pub fn restart(&mut self, scene: &mut Scene) {
+    /// Opens a new epoch: the gathered commands are applied to `scene`. Returns whether the
+    /// epoch starts warm ([`PpmOptions::warm_restarts`] and only the scene was edited); a
+    /// warm epoch has no preview.
+    pub fn restart(&mut self, scene: &mut Scene) -> bool {
         apply_to_scene(scene, std::mem::take(&mut self.pending));
+        let warm = self.options.ppm.warm_restarts && !self.cold_due;
         self.restart_due = false;
+        self.cold_due = false;
         scene.params = self.params.clone();
         self.epoch += 1;
         self.passes = 0;
-        self.preview_due = self.options.preview_divisor.is_some();
+        self.preview_due = self.options.preview_divisor.is_some() && !warm;
+        warm
     }
 
     /// Photons of the pass after `completed` passes of a render whose full pass is `full`

@@ -226,8 +226,12 @@ fn run(
             Next::Stop => return,
             Next::Wait => None,
             Next::Restart => {
-                state.restart(&mut scene);
-                integrator = make(scene.params.renderer, &scene, &setup);
+                let warm = state.restart(&mut scene);
+                let previous =
+                    std::mem::replace(&mut integrator, make(scene.params.renderer, &scene, &setup));
+                if let Some(kept) = warm.then(|| previous.into_warm_start()).flatten() {
+                    integrator.inherit(&scene, kept);
+                }
                 epoch_start = Instant::now();
                 None
             }

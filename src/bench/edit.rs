@@ -1,0 +1,103 @@
+//! What an edit looks like while it renders: one control point moved in the viewer's kind of
+//! render session ([`SessionOptions::interactive`]), every frame of the new epoch compared with
+//! a reference of the edited scene. Behind `caustic bench edit` (time to an error, warm and
+//! cold restarts) and `caustic view --bench` (what is on screen 100 ms after an edit).
+
+use std::time::{Duration, Instant};
+
+use crate::render::error::errors;
+use crate::render::session::{Command, RenderSession, SessionOptions};
+use crate::scene::Scene;
+
+/// How long after an edit the picture on screen is judged (the drag preview's target).
+pub const ON_SCREEN_AFTER: Duration = Duration::from_millis(100);
+
+/// How one edit is measured.
+#[derive(Clone, Debug)]
+pub struct EditPlan {
+    /// The edit (a [`Command::MoveControlPoint`]).
+    pub edit: Command,
+    /// Passes rendered before the edit (the image a person was looking at).
+    pub before_passes: u32,
+    /// Start the new epoch warm (else cold, with the low-resolution preview, as before warm
+    /// restarts existed).
+    pub warm: bool,
+    /// Stop once the relative MSE is at most this.
+    pub target: f64,
+    /// Give up after this long.
+    pub limit: Duration,
+}
+
+/// What one edit measured; errors against the reference of the edited scene.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EditRun {
+    /// Seconds from the edit to the target relative MSE (`None`: not within the limit).
+    pub to_target: Option<f64>,
+    /// Seconds to the new epoch's first image, and its RMSE.
+    pub first: (f64, f64),
+    /// RMSE of the newest image there was [`ON_SCREEN_AFTER`] the edit (the previous epoch's
+    /// last when none of the new one had come).
+    pub on_screen: f64,
+}
+
+/// Renders `scene` in an interactive session, makes the edit after `before_passes` passes and
+/// follows the new epoch until the target (or the limit). `Err` when the renderer failed.
+pub fn measure_edit(scene: Scene, plan: &EditPlan, reference: &[[f32; 3]]) -> Result<EditRun, String> {
+    let mut options = SessionOptions {
+        every_frame: true,
+        ..SessionOptions::interactive()
+    };
+    options.ppm.warm_restarts = plan.warm;
+    let session = RenderSession::start_with(scene, options, None);
+    let frames = session.frames();
+    let mut edited_at: Option<Instant> = None;
+    let mut first = None;
+    let mut on_screen = None;
+    let mut last = f64::NAN;
+    let mut run = None;
+    while let Ok(frame) = frames.recv_timeout(plan.limit) {
+        let rmse = errors(&frame.radiance, reference).0;
+        let Some(at) = edited_at else {
+            last = rmse;
+            if frame.pass >= plan.before_passes && !frame.preview {
+                session.send(plan.edit.clone());
+                edited_at = Some(Instant::now());
+            }
+            continue;
+        };
+        if frame.epoch == 0 {
+            last = rmse;
+            continue;
+        }
+        let secs = at.elapsed();
+        if secs > ON_SCREEN_AFTER {
+            on_screen.get_or_insert(last);
+        }
+        last = rmse;
+        first.get_or_insert((secs.as_secs_f64(), rmse));
+        let rel_mse = errors(&frame.radiance, reference).1;
+        if rel_mse <= plan.target {
+            run = Some(secs.as_secs_f64());
+            break;
+        }
+        if secs > plan.limit {
+            break;
+        }
+    }
+    let failure = session.failure();
+    session.shutdown();
+    if let Some(f) = failure {
+        return Err(format!("the renderer failed: {f}"));
+    }
+    Ok(EditRun {
+        to_target: run,
+        first: first.unwrap_or((f64::NAN, f64::NAN)),
+        on_screen: on_screen.unwrap_or(last),
+    })
+}
+
+/// The median of `values` (NaN for none).
+pub fn median(mut values: Vec<f64>) -> f64 {
+    values.sort_by(f64::total_cmp);
+    values.get(values.len() / 2).copied().unwrap_or(f64::NAN)
+}

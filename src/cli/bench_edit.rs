@@ -1,0 +1,203 @@
+//! `caustic bench edit`: how soon an edit shows converged. One control point is moved by a
+//! few per cent of its patch's size while the viewer's kind of session renders; the time from
+//! the edit to relative MSE 1e-2 against a (cached) reference of the edited scene is measured
+//! with the new epoch started warm and cold, runs interleaved, medians printed.
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use anyhow::{bail, Result};
+use clap::Parser;
+use glam::DVec3;
+
+use super::bench_output::BenchOutput;
+use super::shared_args::Threads;
+use caustic::bench::edit::{measure_edit, median, EditPlan, EditRun, ON_SCREEN_AFTER};
+use caustic::render::session::Command;
+use caustic::scene::{RendererKind, Scene};
+
+/// `caustic bench edit`.
+#[derive(Parser)]
+pub struct EditArgs {
+    /// Scene file with Bézier patches (default: scenes/inline_patch.toml).
+    pub scene: Option<PathBuf>,
+    /// The patch whose control point moves.
+    #[arg(long, default_value_t = 0)]
+    patch: usize,
+    /// The control point that moves (4i + j; default an inner one).
+    #[arg(long, default_value_t = 5)]
+    point: usize,
+    /// How far it moves, as a share of the patch's bounding-box diagonal, along the surface's
+    /// normal there.
+    #[arg(long, default_value_t = 0.03)]
+    distance: f64,
+    /// Passes rendered before the edit (the image a person was looking at).
+    #[arg(long, default_value_t = 16)]
+    before_passes: u32,
+    /// Runs of each kind of restart (warm and cold, interleaved; the medians are printed).
+    #[arg(long, default_value_t = 5)]
+    runs: u32,
+    /// The relative MSE to reach.
+    #[arg(long, default_value_t = 1e-2)]
+    target: f64,
+    /// Give up on a run after this many seconds.
+    #[arg(long, default_value_t = 60.0)]
+    limit: f64,
+    /// Passes of the edited scene's reference render (cached, as `bench convergence`'s).
+    #[arg(long, default_value_t = 400)]
+    reference_passes: u32,
+    /// Where reference renders are cached (default: ~/.cache/caustic/references).
+    #[arg(long, value_name = "DIR")]
+    reference_dir: Option<PathBuf>,
+    #[command(flatten)]
+    pub threads: Threads,
+}
+
+/// The edit a run makes.
+struct Edit {
+    patch: usize,
+    index: usize,
+    position: DVec3,
+}
+
+/// Runs the measurement.
+pub fn bench_edit(args: EditArgs, out: &mut BenchOutput) -> Result<()> {
+    let path = args
+        .scene
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("scenes/inline_patch.toml"));
+    let mut scene = Scene::load(&path)?;
+    scene.params.renderer = RendererKind::Ppm;
+    if args.runs == 0 || args.before_passes == 0 {
+        bail!("--runs and --before-passes must be at least 1");
+    }
+    if !(args.target > 0.0 && args.limit > 0.0 && args.distance.is_finite()) {
+        bail!("--target and --limit must be positive, --distance finite");
+    }
+    let edit = edit(&scene, &args)?;
+    let mut edited = scene.clone();
+    let mut patch = edited.geometry.patches()[edit.patch].0;
+    patch.points[edit.index] = edit.position;
+    edited.geometry.update_patches(&[(edit.patch, patch)]);
+    let reference = super::bench_convergence::reference(
+        &edited,
+        args.reference_passes,
+        args.reference_dir.as_deref(),
+        Some(format!(
+            "control point {} of patch {} moved to {:?}",
+            edit.index, edit.patch, edit.position
+        )),
+        out,
+    )?;
+    out.say(format!(
+        "Edit of {}: control point {} of patch {} moved by {} % of the patch's size; {} passes before the edit, {}x{}",
+        path.display(),
+        edit.index,
+        edit.patch,
+        100.0 * args.distance,
+        args.before_passes,
+        scene.camera.width,
+        scene.camera.height
+    ));
+    let (mut warm, mut cold) = (Vec::new(), Vec::new());
+    for run in 0..args.runs {
+        for (is_warm, runs) in [(true, &mut warm), (false, &mut cold)] {
+            let mut s = scene.clone();
+            s.params.seed = s.params.seed.wrapping_add(run as u64);
+            let plan = EditPlan {
+                edit: Command::MoveControlPoint {
+                    patch: edit.patch,
+                    index: edit.index,
+                    position: edit.position,
+                },
+                before_passes: args.before_passes,
+                warm: is_warm,
+                target: args.target,
+                limit: Duration::from_secs_f64(args.limit),
+            };
+            let r = measure_edit(s, &plan, &reference).map_err(|e| anyhow::anyhow!(e))?;
+            eprintln!(
+                "  run {} {}: {}",
+                run + 1,
+                if is_warm { "warm" } else { "cold" },
+                r.to_target.map_or("not reached".into(), |t| format!("{t:.3} s"))
+            );
+            runs.push(r);
+        }
+    }
+    report(&warm, &cold, args.target, out);
+    Ok(())
+}
+
+/// The moved point: `--distance` of the patch's diagonal along the surface normal at it.
+fn edit(scene: &Scene, args: &EditArgs) -> Result<Edit> {
+    let patches = scene.geometry.patches();
+    let Some((patch, _)) = patches.get(args.patch) else {
+        bail!(
+            "--patch {}: {} has {} patches",
+            args.patch,
+            scene.source.display(),
+            patches.len()
+        );
+    };
+    if args.point >= 16 {
+        bail!(
+            "--point {}: a bicubic patch has control points 0 to 15",
+            args.point
+        );
+    }
+    let (i, j) = (args.point / 4, args.point % 4);
+    let normal = patch.normal(i as f64 / 3.0, j as f64 / 3.0).unwrap_or(DVec3::Y);
+    let bounds = patch.bounds();
+    let size = (bounds.max - bounds.min).length();
+    Ok(Edit {
+        patch: args.patch,
+        index: args.point,
+        position: patch.points[args.point] + normal * (args.distance * size),
+    })
+}
+
+/// Prints the medians: the line the issue asks for, then the first image after the edit.
+fn report(warm: &[EditRun], cold: &[EditRun], target: f64, out: &mut BenchOutput) {
+    let to_target = |runs: &[EditRun]| {
+        median(
+            runs.iter()
+                .map(|r| r.to_target.unwrap_or(f64::INFINITY))
+                .collect(),
+        )
+    };
+    let (w, c) = (to_target(warm), to_target(cold));
+    out.say(format!(
+        "edit to relative MSE {target:.0e}: warm {w:.2} s, cold {c:.2} s  (medians of {} runs each)",
+        warm.len()
+    ));
+    let first = |runs: &[EditRun]| {
+        (
+            median(runs.iter().map(|r| r.first.0).collect()),
+            median(runs.iter().map(|r| r.first.1).collect()),
+        )
+    };
+    let ((wt, we), (ct, ce)) = (first(warm), first(cold));
+    out.say(format!(
+        "first image after the edit: warm at {:.0} ms, RMSE {we:.3e}; cold at {:.0} ms, RMSE {ce:.3e}",
+        wt * 1e3,
+        ct * 1e3
+    ));
+    let screen = |runs: &[EditRun]| median(runs.iter().map(|r| r.on_screen).collect());
+    let (ws, cs) = (screen(warm), screen(cold));
+    out.say(format!(
+        "on screen {} ms after the edit: RMSE warm {ws:.3e}, cold {cs:.3e} ({:.2}x)",
+        ON_SCREEN_AFTER.as_millis(),
+        ws / cs
+    ));
+    out.set("on_screen_rmse", [ws, cs]);
+    out.set("warm_secs", w);
+    out.set("cold_secs", c);
+    out.set("warm_first_image", [wt, we]);
+    out.set("cold_first_image", [ct, ce]);
+    for (name, runs) in [("warm_runs", warm), ("cold_runs", cold)] {
+        for r in runs {
+            out.push(name, r.to_target);
+        }
+    }
+}

@@ -1,0 +1,182 @@
+//! Warm restarts after an edit: the new epoch keeps what is still valid, converges to the
+//! edited scene's image (mean within 1 % of a cold render), is the same for 1 and 2 threads,
+//! and the session starts it without the low-resolution preview.
+
+use std::path::Path;
+use std::time::Duration;
+
+use caustic::render::ppm::{Control, Ppm, PpmOptions};
+use caustic::render::session::{Command, Frame, RenderSession, SessionOptions};
+use caustic::scene::Scene;
+use glam::DVec3;
+
+/// `scenes/inline_patch.toml` (a glass sheet over a floor, a point light) at `width`, with
+/// `photons` per pass; `antialias` off makes it classic PPM (one eye pass, glass split).
+fn sheet(width: u32, photons: u64, antialias: bool) -> Scene {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/inline_patch.toml");
+    let mut scene = Scene::load(&path).expect("scenes/inline_patch.toml loads");
+    scene.camera.resize(Some(width), None);
+    scene.params.photons_per_pass = photons;
+    scene.params.antialias = antialias;
+    scene
+}
+
+/// The sheet's inner control point 5 raised by `by`.
+fn edited(scene: &Scene, by: f64) -> (Scene, Command) {
+    let mut patch = scene.geometry.patches()[0].0;
+    patch.points[5] += DVec3::Y * by;
+    let mut out = scene.clone();
+    out.geometry.update_patches(&[(0, patch)]);
+    let command = Command::MoveControlPoint {
+        patch: 0,
+        index: 5,
+        position: patch.points[5],
+    };
+    (out, command)
+}
+
+fn options() -> PpmOptions {
+    PpmOptions {
+        warm_restarts: true,
+        ..Default::default()
+    }
+}
+
+fn run(ppm: &mut Ppm, scene: &Scene, passes: u32) {
+    for _ in 0..passes {
+        ppm.run_pass(scene, &mut |_| Control::Continue);
+    }
+}
+
+/// `before` passes of the scene, the edit, then `after` passes warm: the image and the share
+/// of pixels kept.
+fn warm_render(scene: &Scene, edit: &Scene, before: u32, after: u32) -> (Vec<[f32; 3]>, f64) {
+    let mut old = Ppm::new(scene, options());
+    run(&mut old, scene, before);
+    let mut new = Ppm::new(edit, options());
+    new.inherit(edit, old.into_warm_start().expect("a completed pass hands on"));
+    run(&mut new, edit, after);
+    (new.radiance(), new.stats().kept_share + new.stats().nearby_share)
+}
+
+fn mean(image: &[[f32; 3]]) -> f64 {
+    image.iter().map(|p| (p[0] + p[1] + p[2]) as f64).sum::<f64>() / (3 * image.len()) as f64
+}
+
+fn pool(threads: usize) -> rayon::ThreadPool {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("pool")
+}
+
+#[test]
+fn an_unchanged_scene_restarts_where_it_was() {
+    for antialias in [true, false] {
+        let scene = sheet(96, 20_000, antialias);
+        let mut old = Ppm::new(&scene, options());
+        run(&mut old, &scene, 6);
+        let before = old.radiance();
+        let mut new = Ppm::new(&scene, options());
+        new.inherit(&scene, old.into_warm_start().expect("warm start"));
+        run(&mut new, &scene, 1);
+        assert_eq!(
+            new.stats().kept_share,
+            1.0,
+            "antialias {antialias}: every pixel kept"
+        );
+        assert_eq!(new.stats().nearby_share, 0.0);
+        let (a, b) = (mean(&before), mean(&new.radiance()));
+        assert!(
+            (a - b).abs() < 0.02 * a,
+            "antialias {antialias}: one warm pass keeps the image: mean {a} then {b}"
+        );
+    }
+}
+
+#[test]
+fn a_warm_restart_converges_to_the_edited_scene_for_any_thread_count() {
+    for antialias in [true, false] {
+        let scene = sheet(96, 20_000, antialias);
+        let (edit, _) = edited(&scene, 0.1);
+        let (one, warmed) = pool(1).install(|| warm_render(&scene, &edit, 6, 40));
+        let (two, _) = pool(2).install(|| warm_render(&scene, &edit, 6, 40));
+        assert!(
+            one == two,
+            "antialias {antialias}: the same image for 1 and 2 threads"
+        );
+        assert!(warmed > 0.9, "antialias {antialias}: pixels warmed: {warmed}");
+        let mut cold = Ppm::new(&edit, options());
+        run(&mut cold, &edit, 40);
+        let (w, c) = (mean(&one), mean(&cold.radiance()));
+        assert!(
+            (w - c).abs() < 0.01 * c,
+            "antialias {antialias}: warm mean {w} against cold {c}"
+        );
+    }
+}
+
+#[test]
+fn the_moved_sheet_takes_nearby_estimates_and_the_rest_is_kept() {
+    for antialias in [true, false] {
+        let scene = sheet(96, 20_000, antialias);
+        let (edit, _) = edited(&scene, 0.1);
+        let mut old = Ppm::new(&scene, options());
+        run(&mut old, &scene, 4);
+        let mut new = Ppm::new(&edit, options());
+        new.inherit(&edit, old.into_warm_start().expect("warm start"));
+        run(&mut new, &edit, 1);
+        let (kept, nearby) = (new.stats().kept_share, new.stats().nearby_share);
+        assert!(kept > 0.5 && kept < 0.99, "antialias {antialias}: kept {kept}");
+        assert!(nearby > 0.0, "antialias {antialias}: nearby {nearby}");
+    }
+}
+
+fn next_frame(session: &RenderSession) -> Frame {
+    session
+        .frames()
+        .recv_timeout(Duration::from_secs(60))
+        .expect("a frame within a minute")
+}
+
+#[test]
+fn the_session_restarts_warm_after_an_edit_and_cold_after_a_setting() {
+    let scene = sheet(64, 8_000, true);
+    let (_, command) = edited(&scene, 0.05);
+    let session = RenderSession::start_with(
+        scene.clone(),
+        SessionOptions {
+            every_frame: true,
+            ..SessionOptions::interactive()
+        },
+        None,
+    );
+    while next_frame(&session).pass < 3 {}
+    session.send(command);
+    let first = loop {
+        let f = next_frame(&session);
+        if f.epoch == 1 {
+            break f;
+        }
+    };
+    let kept = first.stats.ppm.as_ref().map_or(0.0, |p| p.kept_share);
+    assert!(
+        !first.preview,
+        "a warm epoch opens with a full pass, not a preview"
+    );
+    assert!(kept > 0.8, "most pixels kept: {kept}");
+    // A setting restarts cold: the preview first, nothing kept.
+    let mut params = scene.params.clone();
+    params.initial_radius = Some(0.05);
+    session.send(Command::SetParams(params));
+    let first = loop {
+        let f = next_frame(&session);
+        if f.epoch == 2 {
+            break f;
+        }
+    };
+    assert!(first.preview, "a cold epoch opens with the preview");
+    let f = next_frame(&session);
+    assert_eq!(f.stats.ppm.as_ref().map(|p| p.kept_share), Some(0.0));
+    session.shutdown();
+}
