@@ -9,6 +9,7 @@ mod common;
 
 use std::path::Path;
 
+use caustic::app::handle::{Handle, LightPart, LightRef};
 use caustic::app::overlay::{control_points, PointRef};
 use caustic::app::settings::ViewerSettings;
 use caustic::app::viewer::Status;
@@ -16,7 +17,7 @@ use caustic::app::Viewer;
 use caustic::geometry::BezierPatch;
 use caustic::render::ppm::{Control, Ppm, PpmOptions, PpmStats};
 use caustic::render::session::{Command, Frame, FrameStats};
-use caustic::scene::Scene;
+use caustic::scene::{Light, Scene};
 use egui::{Event, Modifiers, PointerButton, Pos2, Vec2};
 use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
@@ -75,6 +76,11 @@ fn editing_app<'a>() -> App<'a> {
 
 fn viewer<'h>(h: &'h App<'_>) -> &'h Viewer {
     h.state().as_ref().expect("viewer")
+}
+
+/// The selected control points (light handles left out).
+fn selected_points(v: &Viewer) -> Vec<PointRef> {
+    v.selection().filter_map(Handle::control).collect()
 }
 
 fn sent(h: &App<'_>) -> Vec<Command> {
@@ -147,7 +153,7 @@ fn click_selects_drag_moves_by_the_camera_geometry_and_undo_redo_restore() {
     pointer(&mut h, near, PointerButton::Primary, true, Modifiers::NONE);
     pointer(&mut h, near, PointerButton::Primary, false, Modifiers::NONE);
     h.step();
-    assert_eq!(viewer(&h).selection().collect::<Vec<_>>(), vec![r]);
+    assert_eq!(selected_points(viewer(&h)), vec![r]);
 
     // A drag of (40, -25) points moves it in the plane through it parallel to the image.
     let by = Vec2::new(40.0, -25.0);
@@ -211,7 +217,7 @@ fn a_seam_point_moves_with_its_twins_so_the_patches_stay_joined() {
         .expect("a seam point");
     let by = Vec2::new(12.0, -18.0);
     drag(&mut h, s, by, PointerButton::Primary);
-    let twins: Vec<PointRef> = viewer(&h).selection().collect();
+    let twins: Vec<PointRef> = selected_points(viewer(&h));
     assert!(twins.len() >= 2 && twins.contains(&r), "{twins:?}");
     let moved = viewer(&h).patches()[r.patch].points[r.index];
     assert_ne!(moved, patches[r.patch].points[r.index]);
@@ -234,7 +240,7 @@ fn a_whole_patch_moves_as_one_and_the_arrow_keys_nudge_it() {
     h.key_press(egui::Key::A);
     h.step();
     // The patch's 16 points, and the neighbours' points welded to its edges.
-    let selected: Vec<PointRef> = viewer(&h).selection().collect();
+    let selected: Vec<PointRef> = selected_points(viewer(&h));
     assert!((0..16).all(|index| selected.contains(&PointRef {
         patch: r.patch,
         index
@@ -511,7 +517,7 @@ fn shift_drag_on_empty_space_selects_the_points_in_its_rectangle() {
     pointer(&mut h, s, PointerButton::Primary, false, Modifiers::NONE);
     h.run_steps(2);
     assert!(
-        viewer(&h).selection().any(|r| r == first),
+        viewer(&h).selection().any(|r| r == first.into()),
         "the click did not select"
     );
     let proj = viewer(&h).projection().expect("placed").clone();
@@ -530,7 +536,7 @@ fn shift_drag_on_empty_space_selects_the_points_in_its_rectangle() {
     .expect("corners");
     let to = image.center();
     assert!(
-        proj.pick(viewer(&h).patches(), from).is_none(),
+        viewer(&h).handle_at(from).is_none(),
         "the drag must start on empty space"
     );
     let rect = egui::Rect::from_two_pos(from, to);
@@ -557,7 +563,7 @@ fn shift_drag_on_empty_space_selects_the_points_in_its_rectangle() {
     h.event(Event::ModifiersChanged(Modifiers::NONE));
     h.run_steps(2);
 
-    let selected: Vec<PointRef> = viewer(&h).selection().collect();
+    let selected: Vec<PointRef> = selected_points(viewer(&h));
     assert!(
         selected.contains(&first),
         "the box replaced the selection instead of adding"
@@ -612,9 +618,184 @@ fn a_point_outside_the_image_rectangle_can_be_picked() {
     pointer(&mut h, p, PointerButton::Primary, true, Modifiers::NONE);
     pointer(&mut h, p, PointerButton::Primary, false, Modifiers::NONE);
     h.run_steps(2);
-    let selected: Vec<PointRef> = viewer(&h).selection().collect();
+    let selected: Vec<PointRef> = selected_points(viewer(&h));
     assert!(
         selected.contains(&r),
         "the click at {p:?}, outside the image, picked {selected:?}"
     );
+}
+
+/// A floor lit by a spot light and a quad light, with a comment to keep.
+const LIT_FLOOR: &str = r#"# Lights to move.
+[camera]
+position = [0, 3, 7]
+look_at = [0, 0.8, 0]
+fov = 45
+width = 160
+height = 120
+
+[render]
+photons_per_pass = 5000
+
+[materials.white]
+type = "diffuse"
+color = [0.7, 0.7, 0.7]
+
+[[objects]]
+type = "plane"
+point = [0, 0, 0]
+normal = [0, 1, 0]
+material = "white"
+
+# The spot, aimed straight down.
+[[lights]]
+type = "spot"
+position = [-1.2, 2.5, 0]
+direction = [0, -1, 0]
+power = 100
+cone_angle = 40
+
+[[lights]]
+type = "quad"
+corner = [0.6, 2.2, -0.5]
+edge_u = [1, 0, 0]
+edge_v = [0, 0, 1]
+power = 50
+"#;
+
+fn light_app<'a>(dir: &Path) -> App<'a> {
+    let path = dir.join("lit.toml");
+    std::fs::write(&path, LIT_FLOOR).expect("write the scene");
+    let scene = Scene::load(&path).expect("the lit floor loads");
+    let mut h = harness(Harness::builder());
+    let mut v = Viewer::with_pause(&h.ctx, scene, ViewerSettings::default(), true);
+    v.show_frame(flat_frame());
+    *h.state_mut() = Some(v);
+    h.run_steps(2);
+    h
+}
+
+fn light_handle(light: usize, part: LightPart) -> Handle {
+    Handle::Light(LightRef { light, part })
+}
+
+fn on_screen(h: &App<'_>, handle: Handle) -> Pos2 {
+    let v = viewer(h);
+    let q = v.handle_position(handle).expect("the scene has the handle");
+    v.projection().expect("placed").to_screen(q).expect("in front")
+}
+
+fn last_light(commands: &[Command], k: usize) -> Option<Light> {
+    commands.iter().rev().find_map(|c| match c {
+        Command::SetLight { light, value } if *light == k => Some(*value),
+        _ => None,
+    })
+}
+
+#[test]
+fn lights_are_dragged_like_points_undone_and_saved_into_the_file() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = light_app(dir.path());
+    let original: Vec<Light> = viewer(&h).lights().to_vec();
+    let cam = viewer(&h).scene().camera.clone();
+    let depth = |p: DVec3| (p - cam.position).dot(cam.forward);
+
+    // The spot's place: dragged in the image plane, the whole light follows at its depth.
+    let place = light_handle(0, LightPart::Place);
+    let p0 = viewer(&h).handle_position(place).expect("spot");
+    let at = on_screen(&h, place);
+    drag(&mut h, at, Vec2::new(30.0, 0.0), PointerButton::Primary);
+    let spot = last_light(&sent(&h), 0).expect("the drag moved the spot");
+    let Light::Spot {
+        position, direction, ..
+    } = spot
+    else {
+        panic!("still a spot: {spot:?}");
+    };
+    assert_eq!(viewer(&h).lights()[0], spot);
+    assert!(
+        (depth(position) - depth(p0)).abs() < 1e-6 * depth(p0),
+        "depth changed"
+    );
+    assert!(position.x > p0.x + 0.1, "moved right: {position}");
+    assert_eq!(direction, DVec3::NEG_Y, "moving the spot does not turn it");
+
+    // Its aim point: dragging it turns the spot about its (new) place.
+    let aim = light_handle(0, LightPart::Aim);
+    let at = on_screen(&h, aim);
+    drag(&mut h, at, Vec2::new(-25.0, 0.0), PointerButton::Primary);
+    let turned = last_light(&sent(&h), 0).expect("the drag turned the spot");
+    let Light::Spot {
+        position: p1,
+        direction: d1,
+        ..
+    } = turned
+    else {
+        panic!("still a spot");
+    };
+    assert_eq!(p1, position, "turning the spot does not move it");
+    assert!(d1.x < -0.05 && (d1.length() - 1.0).abs() < 1e-12, "turned: {d1}");
+
+    // The quad: its outline moves, its size does not.
+    let quad = light_handle(1, LightPart::Place);
+    let at = on_screen(&h, quad);
+    drag(&mut h, at, Vec2::new(0.0, 20.0), PointerButton::Primary);
+    let moved = last_light(&sent(&h), 1).expect("the drag moved the quad");
+    let (
+        Light::Quad { corner, edge_u, .. },
+        Light::Quad {
+            corner: c0,
+            edge_u: e0,
+            ..
+        },
+    ) = (moved, original[1])
+    else {
+        panic!("still a quad");
+    };
+    assert!(corner.y < c0.y, "dragged down: {corner}");
+    assert_eq!(edge_u, e0);
+
+    // Undo all three (the session is told each time); redo all three.
+    for _ in 0..3 {
+        h.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);
+        h.step();
+    }
+    assert_eq!(viewer(&h).lights(), &original[..]);
+    assert_eq!(last_light(&sent(&h), 0), Some(original[0]));
+    assert_eq!(last_light(&sent(&h), 1), Some(original[1]));
+    for _ in 0..3 {
+        h.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, egui::Key::Z);
+        h.step();
+    }
+    assert_eq!(viewer(&h).lights(), &[turned, moved]);
+
+    // Saved: only the moved keys change; everything else stays as written.
+    let path = dir.path().join("moved.toml");
+    h.state_mut()
+        .as_mut()
+        .expect("viewer")
+        .save_scene_to(path.clone());
+    h.step();
+    let text = std::fs::read_to_string(&path).expect("saved");
+    for kept in [
+        "# Lights to move.",
+        "# The spot, aimed straight down.",
+        "look_at = [0, 0.8, 0]",
+        "edge_u = [1, 0, 0]",
+        "cone_angle = 40",
+    ] {
+        assert!(text.contains(kept), "{kept:?} lost:\n{text}");
+    }
+    let back = Scene::load(&path).expect("the saved scene loads");
+    let Light::Spot {
+        position: p2,
+        direction: d2,
+        ..
+    } = back.lights[0]
+    else {
+        panic!("a spot");
+    };
+    assert_eq!(p2, p1);
+    assert!((d2 - d1).length() < 1e-12, "{d2} vs {d1}");
+    assert_eq!(back.lights[1], moved);
 }

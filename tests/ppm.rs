@@ -576,6 +576,74 @@ fn control_point_moves_render_like_the_edited_scene_built_from_scratch() {
     );
 }
 
+/// Moving a light (here the teapot's sphere light) moves its visible surface by a refit, with
+/// no patch prepared again, refuses another kind of light or a non-finite number, and renders
+/// like the scene saved with the light there and loaded from scratch.
+#[test]
+fn a_moved_light_renders_like_the_scene_written_with_it_there() {
+    let mut scene = Scene::builtin();
+    (scene.camera.width, scene.camera.height) = (64, 48);
+    scene.params.photons_per_pass = 20_000;
+    scene.params.renderer = caustic::scene::RendererKind::Ppm;
+    let caustic::scene::Light::Sphere { center, .. } = scene.lights[0] else {
+        panic!("the teapot is lit by a sphere");
+    };
+    let moved = scene.lights[0].translated(DVec3::new(0.4, 0.3, -0.5));
+    let mut edited = scene.clone();
+    assert!(!edited.set_light(0, caustic::scene::Light::point(DVec3::ZERO, DVec3::ONE)));
+    assert!(!edited.set_light(0, scene.lights[0].translated(DVec3::new(f64::NAN, 0.0, 0.0))));
+    assert!(!edited.set_light(7, moved));
+    assert!(edited.set_light(0, moved));
+    let leaves = |s: &Scene| -> Vec<_> {
+        s.geometry
+            .patch_leaves()
+            .iter()
+            .map(|l| (l.patch, l.bounds))
+            .collect()
+    };
+    assert_eq!(leaves(&edited), leaves(&scene), "no patch re-prepared");
+    let object = scene.light_objects[0].expect("a sphere light has a surface");
+    let new_center = center + DVec3::new(0.4, 0.3, -0.5);
+    let from = new_center + DVec3::new(0.0, 0.0, -3.0);
+    let ray = caustic::geometry::Ray::new(from, (new_center - from).normalize());
+    let hit = edited
+        .geometry
+        .intersect(&ray, f64::INFINITY)
+        .expect("the moved sphere is hit");
+    assert_eq!(hit.object, object);
+    assert!((hit.point - new_center).length() < 0.61);
+
+    let session = RenderSession::start_with(
+        scene.clone(),
+        SessionOptions {
+            start_paused: true,
+            ..Default::default()
+        },
+        None,
+    );
+    session.send(Command::SetLight {
+        light: 0,
+        value: moved,
+    });
+    session.send(Command::Resume);
+    let frame = next_frame(&session, Duration::from_secs(60));
+    session.shutdown();
+    assert!(frame.epoch >= 1);
+    let loaded: Vec<_> = scene.geometry.patches().iter().map(|(p, _)| *p).collect();
+    let text = caustic::scene::save::scene_toml(&edited, &loaded, None).expect("saves");
+    assert!(text.contains("center = ["), "{text}");
+    let mut fresh = Scene::from_str(&text, Path::new("moved.toml"), None).expect("loads");
+    (fresh.camera.width, fresh.camera.height) = (64, 48);
+    assert_eq!(fresh.lights[0], moved);
+    let mut ppm = Ppm::new(&fresh, PpmOptions::default());
+    ppm.run_pass(&fresh, &mut |_| Control::Continue);
+    assert_eq!(
+        &frame.radiance[..],
+        ppm.radiance().as_slice(),
+        "the moved light renders differently"
+    );
+}
+
 /// A uniformly emitting sphere lights every receiver that sees all of it exactly as a point
 /// light of the same power at its centre does. (Photons once started on the sphere's own
 /// surface and half of them hit it again at once: the sphere gave about half the light.)

@@ -9,7 +9,7 @@ use egui::{Pos2, Vec2};
 use glam::DVec3;
 
 use super::editor::CameraMove;
-use super::overlay::PointRef;
+use super::handle::Handle;
 use super::params::PanelParams;
 use super::settings::{DisplayMode, Zoom};
 
@@ -87,12 +87,12 @@ pub enum Action {
     ShowHelp(bool),
     /// Control-net overlay shown or hidden.
     ShowWireframe(bool),
-    /// The control point under the cursor changed.
-    Hover(Option<PointRef>),
-    /// Select a point; `add` toggles it in the selection instead of replacing it.
+    /// The handle (control point or light) under the cursor changed.
+    Hover(Option<Handle>),
+    /// Select a handle; `add` toggles it in the selection instead of replacing it.
     Select {
-        /// The point.
-        point: PointRef,
+        /// The handle.
+        point: Handle,
         /// Shift held.
         add: bool,
     },
@@ -101,7 +101,7 @@ pub enum Action {
     /// Select nothing.
     ClearSelection,
     /// A Shift + left drag on empty space: the rectangle from `from` to `to` (screen points);
-    /// when `done`, every control point inside joins the selection.
+    /// when `done`, every handle inside joins the selection.
     BoxSelect {
         /// Where the drag began.
         from: Pos2,
@@ -110,10 +110,10 @@ pub enum Action {
         /// The button was released.
         done: bool,
     },
-    /// A drag begins on a control point.
+    /// A drag begins on a handle.
     BeginPointDrag {
-        /// The grabbed point.
-        grab: PointRef,
+        /// The grabbed handle.
+        grab: Handle,
         /// Where the button went down (points).
         press: Pos2,
     },
@@ -130,8 +130,8 @@ pub enum Action {
     DragCamera(Vec2),
     /// The mouse was released: the gesture becomes one undo step.
     EndGesture,
-    /// Put a control point at an exact position (the panel's fields).
-    SetPoint(PointRef, DVec3),
+    /// Put a handle at an exact position (the panel's fields).
+    SetPoint(Handle, DVec3),
     /// Move the selection by a step in screen points (arrow keys).
     Nudge(Vec2),
     /// Turn and move the camera to frame the selection (or every patch).

@@ -5,8 +5,9 @@
 use glam::DVec3;
 
 use super::action::{Action, AfterDiscard};
+use super::editor::Editor;
 use super::editor::{Edit, Gesture};
-use super::overlay::{control_points, PointRef};
+use super::handle::{Handle, PointRef};
 use super::settings::EXPOSURE_LIMIT;
 use super::state::Status;
 use super::viewer::Viewer;
@@ -118,7 +119,9 @@ impl Viewer {
                 let Some(projection) = &self.projection else {
                     return;
                 };
-                let inside: Vec<PointRef> = control_points(&self.editor.patches)
+                let inside: Vec<Handle> = self
+                    .editor
+                    .handles()
                     .filter(|(_, q)| projection.to_screen(*q).is_some_and(|s| rect.contains(s)))
                     .map(|(r, _)| r)
                     .collect();
@@ -130,7 +133,7 @@ impl Viewer {
             }
             Action::SelectPatch(patch) => {
                 if patch < self.editor.patches.len() {
-                    let points = (0..16).map(|index| PointRef { patch, index });
+                    let points = (0..16).map(|index| Handle::Control(PointRef { patch, index }));
                     self.editor.selection = points.flat_map(|r| self.editor.welded(r)).collect();
                     self.editor.touch();
                 }
@@ -258,23 +261,29 @@ impl Viewer {
     fn replay(&mut self, edit: Edit) {
         match edit {
             Edit::Points(moves) => {
-                let targets: Vec<(PointRef, DVec3)> =
-                    moves.iter().map(|(r, _, after)| (*r, *after)).collect();
+                let targets: Vec<(Handle, DVec3)> = moves.iter().map(|(r, _, after)| (*r, *after)).collect();
                 self.move_points(&targets);
             }
             Edit::Camera { after, .. } => self.set_camera(after.0, after.1),
         }
     }
 
-    /// Moves control points and tells the render session; returns what changed.
-    fn move_points(&mut self, moves: &[(PointRef, DVec3)]) -> Vec<(PointRef, DVec3, DVec3)> {
+    /// Moves handles (control points, lights) and tells the render session; returns what
+    /// changed.
+    fn move_points(&mut self, moves: &[(Handle, DVec3)]) -> Vec<(Handle, DVec3, DVec3)> {
         let changed = self.editor.set_points(moves);
-        for (r, _, position) in &changed {
-            self.send(Command::MoveControlPoint {
-                patch: r.patch,
-                index: r.index,
-                position: *position,
-            });
+        for (h, _, position) in &changed {
+            if let Handle::Control(r) = h {
+                self.send(Command::MoveControlPoint {
+                    patch: r.patch,
+                    index: r.index,
+                    position: *position,
+                });
+            }
+        }
+        for light in Editor::lights_in(&changed) {
+            let value = self.editor.lights[light];
+            self.send(Command::SetLight { light, value });
         }
         changed
     }

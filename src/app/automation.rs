@@ -119,7 +119,7 @@ impl DragStage {
             let screen = self.press?;
             if self.round == 0 {
                 viewer.apply(Action::BeginPointDrag {
-                    grab: DRAG_POINT,
+                    grab: DRAG_POINT.into(),
                     press: screen,
                 });
             }

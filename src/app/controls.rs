@@ -99,7 +99,7 @@ fn file_menu_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Action>) 
     ui.separator();
     if ui
         .button("Save scene  (Ctrl+Shift+S)")
-        .on_hover_text("Write the scene as edited (camera, parameters, control points) to its file, after you confirm; the built-in scene asks where")
+        .on_hover_text("Write the scene as edited (camera, parameters, control points, lights) to its file, after you confirm; the built-in scene asks where")
         .clicked()
     {
         out.push(Action::SaveScene);
@@ -233,7 +233,7 @@ pub fn side_panel_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Acti
         out.push(Action::SetParams(p));
     }
 
-    if !viewer.patches().is_empty() {
+    if !(viewer.patches().is_empty() && viewer.lights().is_empty()) {
         ui.separator();
         super::edit_panel::edit_panel_ui(viewer, ui, out);
     }

@@ -4,7 +4,7 @@
 use egui::RichText;
 
 use super::action::Action;
-use super::overlay::PointRef;
+use super::handle::{Handle, LightPart};
 use super::state::ViewerState;
 
 /// An editing command offered by both the Edit menu and the side panel.
@@ -36,7 +36,7 @@ fn edit_commands(viewer: &ViewerState) -> [EditCommand; 5] {
             label: "Whole patch",
             keys: "A",
             tip: "Select all 16 control points of the selected point's patch, to move it as one",
-            action: selected.map(|r| Action::SelectPatch(r.patch)),
+            action: selected.and_then(Handle::patch).map(Action::SelectPatch),
         },
         EditCommand {
             label: "Select none",
@@ -101,26 +101,51 @@ pub fn edit_panel_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Acti
     let n = editor.selection.len();
     match editor.selection.first() {
         None => {
-            ui.label(RichText::new("Click a control point to select it (Shift adds).").weak());
+            ui.label(RichText::new("Click a control point or a light to select it (Shift adds).").weak());
         }
         Some(&first) if n == 1 => {
-            ui.label(format!(
-                "Patch {}, point {} (row {}, column {})",
-                first.patch,
-                first.index,
-                first.index / 4,
-                first.index % 4
-            ));
-            // A drag of the field moves about a thousandth of the patch per point.
-            let speed = (editor.patches[first.patch].bounds().diagonal().length() * 1e-3).max(1e-6);
+            let (label, size) = match first {
+                Handle::Control(r) => (
+                    format!(
+                        "Patch {}, point {} (row {}, column {})",
+                        r.patch,
+                        r.index,
+                        r.index / 4,
+                        r.index % 4
+                    ),
+                    editor.patches[r.patch].bounds().diagonal().length(),
+                ),
+                Handle::Light(l) => (
+                    format!(
+                        "Light {}: {}",
+                        l.light,
+                        match l.part {
+                            LightPart::Place => "where it is",
+                            LightPart::Aim => "the point it aims at",
+                        }
+                    ),
+                    editor.aims.get(l.light).copied().unwrap_or(1.0) * 4.0,
+                ),
+            };
+            ui.label(label);
+            // A drag of the field moves about a thousandth of the patch (or scene) per point.
+            let speed = (size * 1e-3).max(1e-6);
             if let Some(p) = coordinates_ui(ui, editor.point(first), speed) {
                 out.push(Action::SetPoint(first, p));
             }
         }
         Some(_) => {
             let patches: std::collections::BTreeSet<usize> =
-                editor.selection.iter().map(|r: &PointRef| r.patch).collect();
-            ui.label(format!("{n} points selected in {} patch(es)", patches.len()));
+                editor.selection.iter().filter_map(|h| h.patch()).collect();
+            let lights = editor.selection.iter().filter(|h| h.patch().is_none()).count();
+            ui.label(match lights {
+                0 => format!("{n} points selected in {} patch(es)", patches.len()),
+                _ => format!(
+                    "{} points selected in {} patch(es), {lights} light handle(s)",
+                    n - lights,
+                    patches.len()
+                ),
+            });
         }
     }
     ui.horizontal_wrapped(|ui| {

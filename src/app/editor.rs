@@ -1,6 +1,6 @@
-//! Shaping patches by hand: the control points as edited, the selection and hover, the
-//! gesture in progress (dragging points, or orbiting/panning/dollying the camera), and the
-//! undo history. The editor only keeps state and does the geometry of a gesture; the viewer
+//! Shaping patches and placing lights by hand: the control points and lights as edited, the
+//! selection and hover of their handles ([`Handle`]), the gesture in progress (dragging
+//! handles, or orbiting/panning/dollying the camera), and the undo history. The editor only keeps state and does the geometry of a gesture; the viewer
 //! ([`super::Viewer::apply`]) carries actions out and tells the render session.
 
 use std::collections::BTreeSet;
@@ -9,11 +9,12 @@ use std::sync::Arc;
 use egui::{Pos2, Vec2};
 use glam::DVec3;
 
+use super::handle::{light_handles, light_place, Handle, LightPart, LightRef};
 use super::navigate;
-use super::overlay::{control_points, overlay_geometry, OverlayProjection, PointRef};
+use super::overlay::{control_points, overlay_geometry, OverlayProjection, PICK_RADIUS};
 use crate::geometry::BezierPatch;
 use crate::gpu::wireframe::WireframeGeometry;
-use crate::scene::{Camera, Scene};
+use crate::scene::{Camera, Light, Scene};
 
 /// Radians of orbit per point dragged.
 const ORBIT_PER_POINT: f64 = 0.008;
@@ -34,16 +35,16 @@ pub enum CameraMove {
 /// A drag in progress.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Gesture {
-    /// Moving the selection by a grabbed control point.
+    /// Moving the selection by a grabbed handle.
     Points {
-        /// The point under the cursor when the drag began.
-        grab: PointRef,
+        /// The handle under the cursor when the drag began.
+        grab: Handle,
         /// Where that point was on screen.
         grab_screen: Pos2,
         /// Where the button went down.
         press: Pos2,
-        /// Every moved point and where it started.
-        start: Vec<(PointRef, DVec3)>,
+        /// Every moved handle and where it started.
+        start: Vec<(Handle, DVec3)>,
     },
     /// Moving the camera.
     Camera {
@@ -59,8 +60,8 @@ pub enum Gesture {
 #[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug, PartialEq)]
 pub enum Edit {
-    /// Control points: `(point, before, after)`.
-    Points(Vec<(PointRef, DVec3, DVec3)>),
+    /// Control points and light handles: `(handle, before, after)`.
+    Points(Vec<(Handle, DVec3, DVec3)>),
     /// The camera pose and orbit pivot.
     Camera {
         /// Before.
@@ -141,12 +142,17 @@ pub struct Editor {
     pub patches: Vec<BezierPatch>,
     /// Control points as the scene file gave them.
     pub loaded: Vec<BezierPatch>,
-    /// Selected control points.
-    pub selection: BTreeSet<PointRef>,
+    /// Lights as edited (scene order).
+    pub lights: Vec<Light>,
+    /// Each light's aim distance: a spot's [`LightPart::Aim`] handle lies this far along its
+    /// axis (where the last drag of it left it).
+    pub aims: Vec<f64>,
+    /// Selected handles.
+    pub selection: BTreeSet<Handle>,
     /// The rectangle of a box selection under way (screen points, corner to corner).
     pub rubber_band: Option<(Pos2, Pos2)>,
-    /// The control point under the cursor.
-    pub hovered: Option<PointRef>,
+    /// The handle under the cursor.
+    pub hovered: Option<Handle>,
     /// The drag in progress.
     pub gesture: Option<Gesture>,
     /// The point the camera orbits and dollies about.
@@ -166,9 +172,17 @@ impl Editor {
     pub fn new(scene: &Scene) -> Self {
         let patches: Vec<BezierPatch> = scene.geometry.patches().iter().map(|(p, _)| *p).collect();
         let cam = &scene.camera;
+        let bounds = scene.geometry.bounds();
+        let aim = if bounds.is_empty() {
+            1.0
+        } else {
+            (0.25 * bounds.diagonal().length()).max(1e-3)
+        };
         Self {
             loaded: patches.clone(),
             patches,
+            lights: scene.lights.clone(),
+            aims: vec![aim; scene.lights.len()],
             selection: BTreeSet::new(),
             rubber_band: None,
             hovered: None,
@@ -182,26 +196,76 @@ impl Editor {
         }
     }
 
-    /// Position of a control point.
-    pub fn point(&self, r: PointRef) -> DVec3 {
-        self.patches[r.patch].points[r.index]
+    /// Position of a handle: a control point, a light's place, a spot's aim point.
+    pub fn point(&self, h: Handle) -> DVec3 {
+        match h {
+            Handle::Control(r) => self.patches[r.patch].points[r.index],
+            Handle::Light(LightRef { light, part }) => {
+                let l = &self.lights[light];
+                match (part, l) {
+                    (LightPart::Aim, Light::Spot { direction, .. }) => {
+                        light_place(l) + *direction * self.aims[light]
+                    }
+                    _ => light_place(l),
+                }
+            }
+        }
     }
 
-    /// `r` and every other control point at the same place (within a billionth of its patch's
-    /// size): the points a seam or a collapsed edge shares, which move together.
-    pub fn welded(&self, r: PointRef) -> Vec<PointRef> {
-        if !self.exists(r) {
+    /// `h` and every other control point at the same place (within a billionth of its patch's
+    /// size): the points a seam or a collapsed edge shares, which move together. A light's
+    /// handle has no twins.
+    pub fn welded(&self, h: Handle) -> Vec<Handle> {
+        if !self.exists(h) {
             return Vec::new();
         }
-        let p = self.point(r);
+        let Handle::Control(r) = h else {
+            return vec![h];
+        };
+        let p = self.point(h);
         let tolerance = 1e-9 * self.patches[r.patch].bounds().diagonal().length();
         let twins = control_points(&self.patches).filter(|(o, q)| *o != r && (*q - p).length() <= tolerance);
-        std::iter::once(r).chain(twins.map(|(o, _)| o)).collect()
+        std::iter::once(h)
+            .chain(twins.map(|(o, _)| Handle::Control(o)))
+            .collect()
     }
 
-    /// Whether `r` names a control point of this scene.
-    pub fn exists(&self, r: PointRef) -> bool {
-        r.patch < self.patches.len() && r.index < 16
+    /// Whether `h` names a handle of this scene.
+    pub fn exists(&self, h: Handle) -> bool {
+        match h {
+            Handle::Control(r) => r.patch < self.patches.len() && r.index < 16,
+            Handle::Light(l) => self
+                .lights
+                .get(l.light)
+                .is_some_and(|light| light_handles(l.light, light).any(|x| x == l)),
+        }
+    }
+
+    /// Every handle with its position: control points patch by patch, then the lights'.
+    pub fn handles(&self) -> impl Iterator<Item = (Handle, DVec3)> + '_ {
+        let controls = control_points(&self.patches).map(|(r, q)| (Handle::Control(r), q));
+        let lights = self
+            .lights
+            .iter()
+            .enumerate()
+            .flat_map(|(k, l)| light_handles(k, l))
+            .map(|r| (Handle::Light(r), self.point(Handle::Light(r))));
+        controls.chain(lights)
+    }
+
+    /// The handle nearest `pointer` within [`PICK_RADIUS`], if any.
+    pub fn pick(&self, proj: &OverlayProjection, pointer: Pos2) -> Option<Handle> {
+        let mut best: Option<(f32, Handle)> = None;
+        for (h, q) in self.handles() {
+            let Some(s) = proj.to_screen(q) else {
+                continue;
+            };
+            let d = s.distance(pointer);
+            if d <= PICK_RADIUS && best.is_none_or(|(b, _)| d < b) {
+                best = Some((d, h));
+            }
+        }
+        best.map(|(_, h)| h)
     }
 
     /// Marks the overlay for rebuilding (hover, selection or points changed).
@@ -212,25 +276,58 @@ impl Editor {
     /// The overlay's geometry, rebuilt if something changed.
     pub fn overlay(&mut self) -> Arc<WireframeGeometry> {
         if self.overlay_stale {
-            self.overlay = Arc::new(overlay_geometry(&self.patches, self.hovered, &self.selection));
+            let lights: Vec<(Light, DVec3)> = (0..self.lights.len())
+                .map(|k| {
+                    let aim = LightRef {
+                        light: k,
+                        part: LightPart::Aim,
+                    };
+                    (self.lights[k], self.point(Handle::Light(aim)))
+                })
+                .collect();
+            self.overlay = Arc::new(overlay_geometry(
+                &self.patches,
+                &lights,
+                self.hovered,
+                &self.selection,
+            ));
             self.generation += 1;
             self.overlay_stale = false;
         }
         self.overlay.clone()
     }
 
-    /// Sets points; returns `(point, before, after)` for those that changed.
-    pub fn set_points(&mut self, moves: &[(PointRef, DVec3)]) -> Vec<(PointRef, DVec3, DVec3)> {
+    /// Puts handles at positions, in order (a light's place before its aim: the aim turns the
+    /// spot from where it then is); returns `(handle, before, after)` for those that changed.
+    pub fn set_points(&mut self, moves: &[(Handle, DVec3)]) -> Vec<(Handle, DVec3, DVec3)> {
         let mut changed = Vec::new();
-        for &(r, p) in moves {
-            if !self.exists(r) || !p.is_finite() {
+        for &(h, p) in moves {
+            if !self.exists(h) || !p.is_finite() {
                 continue;
             }
-            let before = self.point(r);
-            if before != p {
-                self.patches[r.patch].points[r.index] = p;
-                changed.push((r, before, p));
+            let before = self.point(h);
+            if before == p {
+                continue;
             }
+            match h {
+                Handle::Control(r) => self.patches[r.patch].points[r.index] = p,
+                Handle::Light(LightRef { light, part }) => {
+                    let l = self.lights[light];
+                    let place = light_place(&l);
+                    match part {
+                        LightPart::Place => self.lights[light] = l.translated(p - place),
+                        LightPart::Aim => {
+                            let reach = (p - place).length();
+                            if reach <= 1e-9 * (1.0 + place.length()) {
+                                continue;
+                            }
+                            self.lights[light] = l.aimed(p - place);
+                            self.aims[light] = reach;
+                        }
+                    }
+                }
+            }
+            changed.push((h, before, self.point(h)));
         }
         if !changed.is_empty() {
             self.touch();
@@ -238,8 +335,21 @@ impl Editor {
         changed
     }
 
+    /// The lights whose handles are among `changed` (each once, in order).
+    pub fn lights_in(changed: &[(Handle, DVec3, DVec3)]) -> Vec<usize> {
+        let mut out: Vec<usize> = changed
+            .iter()
+            .filter_map(|(h, _, _)| match h {
+                Handle::Light(l) => Some(l.light),
+                Handle::Control(_) => None,
+            })
+            .collect();
+        out.dedup();
+        out
+    }
+
     /// The selected points and where they are: what a drag moves.
-    pub fn selected_points(&self) -> Vec<(PointRef, DVec3)> {
+    pub fn selected_points(&self) -> Vec<(Handle, DVec3)> {
         self.selection.iter().map(|r| (*r, self.point(*r))).collect()
     }
 
@@ -251,7 +361,7 @@ impl Editor {
         proj: &OverlayProjection,
         pointer: Pos2,
         along_view: bool,
-    ) -> Vec<(PointRef, DVec3)> {
+    ) -> Vec<(Handle, DVec3)> {
         let Some(Gesture::Points {
             grab,
             grab_screen,
@@ -309,7 +419,7 @@ impl Editor {
 
     /// A step of `points` screen points in the image plane, at the selection's depth: what
     /// the arrow keys move the selection by.
-    pub fn nudge(&self, proj: &OverlayProjection, step: Vec2) -> Vec<(PointRef, DVec3)> {
+    pub fn nudge(&self, proj: &OverlayProjection, step: Vec2) -> Vec<(Handle, DVec3)> {
         let Some(first) = self.selection.first() else {
             return Vec::new();
         };
@@ -345,7 +455,7 @@ mod tests {
     #[test]
     fn history_undoes_redoes_and_knows_what_is_unsaved() {
         let mut h = History::default();
-        let r = PointRef { patch: 0, index: 1 };
+        let r = Handle::Control(crate::app::handle::PointRef { patch: 0, index: 1 });
         let edit = Edit::Points(vec![(r, DVec3::ZERO, DVec3::X)]);
         assert!(!h.unsaved());
         h.record(edit.clone());

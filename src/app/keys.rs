@@ -14,7 +14,7 @@ pub const HELP: &[(&str, &str)] = &[
     ("Ctrl+Shift+S", "Save the scene as edited (TOML)"),
     (
         "Ctrl+Z / Ctrl+Shift+Z",
-        "Undo / redo an edit (control points, camera)",
+        "Undo / redo an edit (control points, lights, camera)",
     ),
     ("Space", "Pause / resume rendering"),
     ("R", "Restart the render (asks first when passes would be lost)"),
@@ -27,15 +27,15 @@ pub const HELP: &[(&str, &str)] = &[
     ("+ / -", "Zoom in / out (also: mouse wheel over the image)"),
     (
         "Left drag",
-        "Pan the image; on a control point: move it (and the selection)",
+        "Pan the image; on a control point or a light: move it (and the selection); on a spot light's aim point: turn it",
     ),
     (
         "Ctrl + left drag",
-        "On a control point: move it along the line of sight",
+        "On a control point or a light: move it along the line of sight",
     ),
     (
         "Click / Shift+click",
-        "Select a control point / add it to the selection",
+        "Select a control point or a light / add it to the selection",
     ),
     ("A", "Select the whole patch of the selected point"),
     ("Esc", "Select nothing"),
@@ -175,7 +175,7 @@ fn editing_keys(viewer: &ViewerState, ctx: &egui::Context, out: &mut Vec<Action>
         out.push(Action::ClearSelection);
     }
     if pressed(Key::A) {
-        out.extend(selected.map(|r| Action::SelectPatch(r.patch)));
+        out.extend(selected.and_then(|h| h.patch()).map(Action::SelectPatch));
     }
     if selected.is_none() {
         return;

@@ -30,6 +30,7 @@ pub mod editor;
 pub mod error_plot;
 pub mod false_colour;
 pub mod file_dialog;
+pub mod handle;
 pub mod image_view;
 pub mod job;
 pub mod keys;

@@ -10,18 +10,11 @@ use glam::{DMat4, DVec2, DVec3, DVec4};
 
 use crate::geometry::BezierPatch;
 use crate::gpu::wireframe::{Marker, Segment, Uniforms, WireframeGeometry};
-use crate::scene::Camera;
+use crate::scene::{Camera, Light};
 
-/// A control point: patch index in the scene geometry and point `4i + j`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub struct PointRef {
-    /// Patch index.
-    pub patch: usize,
-    /// Control point `4i + j`.
-    pub index: usize,
-}
+pub use super::handle::{Handle, LightPart, LightRef, PointRef};
 
-/// A control point is picked when the cursor is this close (points).
+/// A handle is picked when the cursor is this close (points).
 pub const PICK_RADIUS: f32 = 8.0;
 /// Samples per patch boundary curve.
 const CURVE_SEGMENTS: usize = 16;
@@ -128,21 +121,6 @@ impl OverlayProjection {
             pixels_per_point: ppp,
         }
     }
-
-    /// The control point nearest `pointer` within [`PICK_RADIUS`], if any.
-    pub fn pick(&self, patches: &[BezierPatch], pointer: Pos2) -> Option<PointRef> {
-        let mut best: Option<(f32, PointRef)> = None;
-        for (r, q) in control_points(patches) {
-            let Some(s) = self.to_screen(q) else {
-                continue;
-            };
-            let d = s.distance(pointer);
-            if d <= PICK_RADIUS && best.is_none_or(|(b, _)| d < b) {
-                best = Some((d, r));
-            }
-        }
-        best.map(|(_, r)| r)
-    }
 }
 
 /// Every control point of `patches` with its position, patch by patch.
@@ -165,14 +143,19 @@ const BOUNDARY: [f32; 4] = [1.0, 0.62, 0.2, 0.85];
 const POINT: [f32; 4] = [0.92, 0.95, 1.0, 0.9];
 const POINT_HOVERED: [f32; 4] = [1.0, 0.92, 0.2, 1.0];
 const POINT_SELECTED: [f32; 4] = [1.0, 0.25, 0.45, 1.0];
+const LIGHT: [f32; 4] = [1.0, 0.85, 0.35, 0.95];
+/// Segments of a sphere light's outline circles.
+const CIRCLE_SEGMENTS: usize = 32;
 
-/// The overlay for `patches`: each control net (rows and columns), each patch's four
-/// boundary curves, and a marker per control point; hovered and selected points, and the nets
-/// of patches with a selected point, stand out.
+/// The overlay for `patches` and `lights` (each with its aim point): each control net (rows
+/// and columns), each patch's four boundary curves, a marker per control point, and the lights'
+/// gizmos ([`light_gizmos`]); hovered and selected handles, and the nets of patches with a
+/// selected point, stand out.
 pub fn overlay_geometry(
     patches: &[BezierPatch],
-    hovered: Option<PointRef>,
-    selection: &BTreeSet<PointRef>,
+    lights: &[(Light, DVec3)],
+    hovered: Option<Handle>,
+    selection: &BTreeSet<Handle>,
 ) -> WireframeGeometry {
     let mut g = WireframeGeometry::default();
     let segment = |a: DVec3, b: DVec3, color: [f32; 4], width: f32| Segment {
@@ -182,7 +165,8 @@ pub fn overlay_geometry(
         width,
     };
     for (k, p) in patches.iter().enumerate() {
-        let active = selection.iter().any(|s| s.patch == k) || hovered.is_some_and(|h| h.patch == k);
+        let active =
+            selection.iter().any(|s| s.patch() == Some(k)) || hovered.is_some_and(|h| h.patch() == Some(k));
         let (net, width) = if active { (NET_SELECTED, 1.6) } else { (NET, 1.0) };
         for i in 0..4 {
             for j in 0..3 {
@@ -208,22 +192,105 @@ pub fn overlay_geometry(
             }
         }
         for (index, q) in p.points.iter().enumerate() {
-            let r = PointRef { patch: k, index };
-            let (color, size) = if selection.contains(&r) {
-                (POINT_SELECTED, 9.0)
-            } else if hovered == Some(r) {
-                (POINT_HOVERED, 10.0)
-            } else {
-                (POINT, 5.0)
-            };
-            g.markers.push(Marker {
-                position: f32x3(*q),
-                color,
-                size,
-            });
+            let r = Handle::Control(PointRef { patch: k, index });
+            g.markers
+                .push(handle_marker(*q, r, (POINT, 5.0), hovered, selection));
         }
     }
+    for (k, (light, aim)) in lights.iter().enumerate() {
+        light_gizmos(&mut g, k, light, *aim, hovered, selection);
+    }
     g
+}
+
+/// A handle's marker: hovered and selected ones larger and in their colours.
+fn handle_marker(
+    q: DVec3,
+    h: Handle,
+    (color, size): ([f32; 4], f32),
+    hovered: Option<Handle>,
+    selection: &BTreeSet<Handle>,
+) -> Marker {
+    let (color, size) = if selection.contains(&h) {
+        (POINT_SELECTED, size + 4.0)
+    } else if hovered == Some(h) {
+        (POINT_HOVERED, size + 5.0)
+    } else {
+        (color, size)
+    };
+    Marker {
+        position: f32x3(q),
+        color,
+        size,
+    }
+}
+
+/// Light `k`'s gizmo: a marker at its place (position or centre), and its shape: a spot's
+/// axis to its aim point (a second handle), a quad's outline, a sphere's three great circles.
+fn light_gizmos(
+    g: &mut WireframeGeometry,
+    k: usize,
+    light: &Light,
+    aim: DVec3,
+    hovered: Option<Handle>,
+    selection: &BTreeSet<Handle>,
+) {
+    let handle = |part| Handle::Light(LightRef { light: k, part });
+    let active = [LightPart::Place, LightPart::Aim]
+        .iter()
+        .any(|p| selection.contains(&handle(*p)) || hovered == Some(handle(*p)));
+    let width = if active { 2.0 } else { 1.3 };
+    let mut line = |a: DVec3, b: DVec3| {
+        g.segments.push(Segment {
+            a: f32x3(a),
+            b: f32x3(b),
+            color: LIGHT,
+            width,
+        })
+    };
+    let place = super::handle::light_place(light);
+    match *light {
+        Light::Point { .. } => {}
+        Light::Spot { .. } => line(place, aim),
+        Light::Quad {
+            corner,
+            edge_u,
+            edge_v,
+            ..
+        } => {
+            let c = [corner, corner + edge_u, corner + edge_u + edge_v, corner + edge_v];
+            for i in 0..4 {
+                line(c[i], c[(i + 1) % 4]);
+            }
+        }
+        Light::Sphere { center, radius, .. } => {
+            for (a, b) in [(DVec3::X, DVec3::Y), (DVec3::Y, DVec3::Z), (DVec3::Z, DVec3::X)] {
+                let at = |s: usize| {
+                    let t = std::f64::consts::TAU * s as f64 / CIRCLE_SEGMENTS as f64;
+                    center + radius * (t.cos() * a + t.sin() * b)
+                };
+                for s in 0..CIRCLE_SEGMENTS {
+                    line(at(s), at(s + 1));
+                }
+            }
+        }
+    }
+    g.markers.push(handle_marker(
+        place,
+        handle(LightPart::Place),
+        (LIGHT, 9.0),
+        hovered,
+        selection,
+    ));
+    if matches!(light, Light::Spot { .. }) {
+        g.markers.push(handle_marker(
+            aim,
+            handle(LightPart::Aim),
+            (LIGHT, 6.0),
+            hovered,
+            selection,
+        ));
+    }
 }
 
 #[cfg(test)]

@@ -149,7 +149,8 @@ impl ViewerState {
         self.pending_restart.is_some()
     }
 
-    /// The scene as edited: the panel's parameters, the camera and the control points.
+    /// The scene as edited: the panel's parameters, the camera, the control points and the
+    /// lights.
     pub fn edited_scene(&self) -> Scene {
         let mut scene = self.scene.clone();
         self.params.apply_to(&mut scene);
@@ -165,6 +166,11 @@ impl ViewerState {
         if !edits.is_empty() {
             scene.geometry.update_patches(&edits);
         }
+        for (k, light) in self.editor.lights.iter().enumerate() {
+            if scene.lights.get(k) != Some(light) {
+                scene.set_light(k, *light);
+            }
+        }
         scene
     }
 
@@ -173,8 +179,18 @@ impl ViewerState {
         &self.editor.patches
     }
 
-    /// The selected control points.
-    pub fn selection(&self) -> impl Iterator<Item = super::overlay::PointRef> + '_ {
+    /// The lights as edited (scene order).
+    pub fn lights(&self) -> &[crate::scene::Light] {
+        &self.editor.lights
+    }
+
+    /// Where a handle (control point or light) is now, if the scene has it.
+    pub fn handle_position(&self, h: super::handle::Handle) -> Option<glam::DVec3> {
+        self.editor.exists(h).then(|| self.editor.point(h))
+    }
+
+    /// The selected handles (control points and lights).
+    pub fn selection(&self) -> impl Iterator<Item = super::handle::Handle> + '_ {
         self.editor.selection.iter().copied()
     }
 
@@ -190,7 +206,7 @@ impl ViewerState {
 
     /// Whether the overlay is shown and can be edited.
     pub fn editing(&self) -> bool {
-        self.settings.show_wireframe && !self.editor.patches.is_empty()
+        self.settings.show_wireframe && !(self.editor.patches.is_empty() && self.editor.lights.is_empty())
     }
 
     /// The open reference.

@@ -1,4 +1,4 @@
-//! The mouse over the image, as actions: hover and pick control points, click to select
+//! The mouse over the image, as actions: hover and pick handles (control points and lights), click to select
 //! (Shift adds), drag a point (Ctrl: along the line of sight), and move the camera — right
 //! drag orbits, Shift + right or middle drag pans, Ctrl + right drag dollies. Dragging
 //! elsewhere with the left button pans the image (see [`super::image_view`]).
@@ -7,16 +7,17 @@ use egui::{PointerButton, Pos2, Response};
 
 use super::action::Action;
 use super::editor::{CameraMove, Editor, Gesture};
-use super::overlay::{OverlayProjection, PointRef};
+use super::handle::Handle;
+use super::overlay::OverlayProjection;
 
-/// The control point a left drag starting at the press position would grab (with the
-/// overlay as placed in the last frame), if the overlay is shown.
+/// The handle a left drag starting at the press position would grab (with the overlay as
+/// placed in the last frame), if the overlay is shown.
 pub fn grab_at(
     editor: &Editor,
     projection: Option<&OverlayProjection>,
     press: Option<Pos2>,
-) -> Option<PointRef> {
-    projection?.pick(&editor.patches, press?)
+) -> Option<Handle> {
+    editor.pick(projection?, press?)
 }
 
 /// Actions for this frame's pointer activity over the image view.
@@ -32,7 +33,7 @@ pub fn view_actions(
         let hovered = response
             .hover_pos()
             .filter(|_| editing)
-            .and_then(|p| projection.pick(&editor.patches, p));
+            .and_then(|p| editor.pick(projection, p));
         if hovered != editor.hovered {
             out.push(Action::Hover(hovered));
         }
@@ -44,10 +45,7 @@ pub fn view_actions(
     // Clicks select.
     if response.clicked() && editing {
         let shift = response.ctx.input(|i| i.modifiers.shift);
-        match response
-            .hover_pos()
-            .and_then(|p| projection.pick(&editor.patches, p))
-        {
+        match response.hover_pos().and_then(|p| editor.pick(projection, p)) {
             Some(point) => out.push(Action::Select { point, add: shift }),
             None if !shift && !editor.selection.is_empty() => out.push(Action::ClearSelection),
             None => {}

@@ -192,6 +192,12 @@ impl Viewer {
         self.projection.as_ref()
     }
 
+    /// The handle (control point or light) a press at `pointer` would grab, with the overlay
+    /// as placed in the last frame.
+    pub fn handle_at(&self, pointer: egui::Pos2) -> Option<super::handle::Handle> {
+        self.editor.pick(self.projection.as_ref()?, pointer)
+    }
+
     /// Replaces the scene (a successful open).
     fn replace_scene(&mut self, scene: Scene) {
         let scene = photon_mapped(scene);

@@ -326,6 +326,31 @@ impl SceneGeometry {
         self.update_patches(&[(patch, edited)]).is_some()
     }
 
+    /// Puts the sphere of object `object` (an area light's surface) at `sphere` and refits the
+    /// BVH; `false` when no sphere belongs to that object.
+    pub fn move_sphere(&mut self, object: u32, sphere: Sphere) -> bool {
+        let Some(k) = self.spheres.iter().position(|(_, o)| *o == object) else {
+            return false;
+        };
+        self.spheres[k].0 = sphere;
+        self.primitive_bounds[k] = sphere.bounds();
+        self.bvh.refit(&self.primitive_bounds);
+        true
+    }
+
+    /// Puts the quad of object `object` (an area light's surface) at `quad` and refits the
+    /// BVH; `false` when no quad belongs to that object.
+    pub fn move_quad(&mut self, object: u32, quad: Quad) -> bool {
+        let Some(k) = self.quads.iter().position(|(_, o)| *o == object) else {
+            return false;
+        };
+        self.quads[k].0 = quad;
+        // Quads follow the spheres among the primitives (see `GeometryBuilder::build`).
+        self.primitive_bounds[self.spheres.len() + k] = quad.bounds();
+        self.bvh.refit(&self.primitive_bounds);
+        true
+    }
+
     /// Replaces patches (`(index, new patch)`; a later entry for the same index wins) and
     /// re-prepares only them: their leaves are subdivided again, and the BVH is refit when
     /// every edited patch keeps its number of leaves, or rebuilt over the unchanged bounds of

@@ -6,7 +6,7 @@
 use glam::{DVec2, DVec3};
 
 /// A light source.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Light {
     /// Isotropic point light.
     Point {
@@ -113,6 +113,51 @@ impl Light {
             edge_u,
             edge_v,
             radiance: power / (std::f64::consts::PI * area),
+        }
+    }
+
+    /// The same light moved by `delta` (turned and sized as it was).
+    pub fn translated(&self, delta: DVec3) -> Light {
+        let mut light = *self;
+        match &mut light {
+            Light::Point { position, .. } | Light::Spot { position, .. } => *position += delta,
+            Light::Sphere { center, .. } => *center += delta,
+            Light::Quad { corner, .. } => *corner += delta,
+        }
+        light
+    }
+
+    /// A spot light turned to shine along `direction` (normalised; a zero or non-finite
+    /// direction, or another kind of light, leaves it as it is).
+    pub fn aimed(&self, direction: DVec3) -> Light {
+        let mut light = *self;
+        if let (Light::Spot { direction: d, .. }, Some(n)) = (&mut light, direction.try_normalize()) {
+            *d = n;
+        }
+        light
+    }
+
+    /// Whether every number of the light is finite.
+    pub fn is_finite(&self) -> bool {
+        match *self {
+            Light::Point { position, intensity } => position.is_finite() && intensity.is_finite(),
+            Light::Spot {
+                position,
+                direction,
+                intensity,
+                ..
+            } => position.is_finite() && direction.is_finite() && intensity.is_finite(),
+            Light::Sphere {
+                center,
+                radius,
+                radiance,
+            } => center.is_finite() && radius.is_finite() && radiance.is_finite(),
+            Light::Quad {
+                corner,
+                edge_u,
+                edge_v,
+                radiance,
+            } => corner.is_finite() && edge_u.is_finite() && edge_v.is_finite() && radiance.is_finite(),
         }
     }
 

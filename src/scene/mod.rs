@@ -130,6 +130,45 @@ impl Scene {
         }
     }
 
+    /// Puts light `k` where `light` says (moved or turned; the same kind): an area light's
+    /// visible surface moves with it, by a refit of the BVH (nothing is subdivided or rebuilt).
+    /// Returns `false`, changing nothing, for an index out of range, another kind of light or
+    /// a non-finite number.
+    pub fn set_light(&mut self, k: usize, light: Light) -> bool {
+        let Some(old) = self.lights.get(k) else {
+            return false;
+        };
+        if std::mem::discriminant(old) != std::mem::discriminant(&light) || !light.is_finite() {
+            return false;
+        }
+        if let Some(object) = self.light_objects.get(k).copied().flatten() {
+            let moved = match light {
+                Light::Sphere { center, radius, .. } => self
+                    .geometry
+                    .move_sphere(object, crate::geometry::Sphere { center, radius }),
+                Light::Quad {
+                    corner,
+                    edge_u,
+                    edge_v,
+                    ..
+                } => self.geometry.move_quad(
+                    object,
+                    crate::geometry::Quad {
+                        corner,
+                        edge_u,
+                        edge_v,
+                    },
+                ),
+                Light::Point { .. } | Light::Spot { .. } => true,
+            };
+            if !moved {
+                return false;
+            }
+        }
+        self.lights[k] = light;
+        true
+    }
+
     /// Whether something blocks the way from the surface point `point` (geometric normal
     /// `normal`) to the sample `ls` of light `light`: the shadow ray of
     /// [`light::LightSample::shadow_ray`], passing the light's own surface.

@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use glam::DVec3;
 use toml_edit::{Array, DocumentMut, Item, Table, Value};
 
-use super::{Camera, RenderParams, Scene};
+use super::{Camera, Light, RenderParams, Scene};
 use crate::files::{write_atomically, WriteError};
 use crate::geometry::{BezierPatch, Window};
 
@@ -125,6 +125,9 @@ pub fn scene_toml(
         write_render(&mut doc, scene);
     }
     write_patches(&mut doc, scene, loaded);
+    if let Some(o) = &original {
+        write_changed_lights(&mut doc, scene, &o.lights);
+    }
     if let (Some(base), Some(out)) = (&scene.base_dir, out_dir) {
         let same = base
             .canonicalize()
@@ -256,6 +259,48 @@ fn write_changed_camera(doc: &mut DocumentMut, scene: &Scene, original: &Camera)
         .unwrap_or(implied.focal_distance);
     if (focal - c.focal_distance).abs() > 1e-12 * c.focal_distance {
         t.insert("focal_distance", toml_edit::value(c.focal_distance));
+    }
+}
+
+/// Writes into each `[[lights]]` table only what moved since `original` (the lights the file
+/// gives): a point or spot light's `position`, a spot's `direction`, a sphere's `center`, a
+/// quad's `corner` (its edges move with it). Every other key stays as written.
+fn write_changed_lights(doc: &mut DocumentMut, scene: &Scene, original: &[Light]) {
+    let Some(tables) = doc.get_mut("lights").and_then(Item::as_array_of_tables_mut) else {
+        return;
+    };
+    for ((t, light), before) in tables.iter_mut().zip(&scene.lights).zip(original) {
+        if light == before {
+            continue;
+        }
+        let mut set = |key: &str, now: DVec3, was: DVec3| {
+            if now != was {
+                t.insert(key, toml_edit::value(vec3(now)));
+            }
+        };
+        match (*light, *before) {
+            (Light::Point { position: p, .. }, Light::Point { position: q, .. }) => set("position", p, q),
+            (
+                Light::Spot {
+                    position: p,
+                    direction: d,
+                    ..
+                },
+                Light::Spot {
+                    position: q,
+                    direction: e,
+                    ..
+                },
+            ) => {
+                set("position", p, q);
+                if !same_direction(d, e) {
+                    set("direction", d, e);
+                }
+            }
+            (Light::Sphere { center: p, .. }, Light::Sphere { center: q, .. }) => set("center", p, q),
+            (Light::Quad { corner: p, .. }, Light::Quad { corner: q, .. }) => set("corner", p, q),
+            _ => {}
+        }
     }
 }
 

@@ -27,6 +27,14 @@ pub enum Command {
         /// New position.
         position: DVec3,
     },
+    /// Puts light `light` where `value` says (moved or turned, the same kind); restarts.
+    /// An area light's surface moves with it; no patch is re-prepared.
+    SetLight {
+        /// Light index in the scene.
+        light: usize,
+        /// The light as it now is.
+        value: crate::scene::Light,
+    },
     /// Stop between batches, keeping everything.
     Pause,
     /// Continue after [`Command::Pause`].
@@ -43,7 +51,10 @@ impl Command {
     pub fn restarts(&self, current: &RenderParams) -> bool {
         match self {
             Command::SetParams(p) => p.restarts_from(current),
-            Command::SetCamera(_) | Command::MoveControlPoint { .. } | Command::Restart => true,
+            Command::SetCamera(_)
+            | Command::MoveControlPoint { .. }
+            | Command::SetLight { .. }
+            | Command::Restart => true,
             Command::Pause | Command::Resume | Command::Shutdown => false,
         }
     }
@@ -55,8 +66,8 @@ impl Command {
     }
 }
 
-/// Whether a command's values are valid for a scene with `patches` patches.
-pub(super) fn valid(command: &Command, patches: usize) -> bool {
+/// Whether a command's values are valid for a scene with `patches` patches and `lights`.
+pub(super) fn valid(command: &Command, patches: usize, lights: &[crate::scene::Light]) -> bool {
     match command {
         Command::SetParams(p) => p.validate().is_ok(),
         Command::SetCamera(c) => {
@@ -70,6 +81,9 @@ pub(super) fn valid(command: &Command, patches: usize) -> bool {
             index,
             position,
         } => *patch < patches && *index < 16 && position.is_finite(),
+        Command::SetLight { light, value } => lights
+            .get(*light)
+            .is_some_and(|l| std::mem::discriminant(l) == std::mem::discriminant(value) && value.is_finite()),
         Command::Pause | Command::Resume | Command::Restart | Command::Shutdown => true,
     }
 }
@@ -83,6 +97,9 @@ pub(super) fn apply_to_scene(scene: &mut Scene, commands: Vec<Command>) {
     for command in commands {
         match command {
             Command::SetCamera(c) => scene.camera = c,
+            Command::SetLight { light, value } => {
+                scene.set_light(light, value);
+            }
             Command::MoveControlPoint {
                 patch,
                 index,

@@ -93,6 +93,8 @@ pub struct SessionState {
     /// the rest for the next epoch.
     pub params: RenderParams,
     patches: usize,
+    /// The scene's lights (their kinds, for checking [`Command::SetLight`]).
+    lights: Vec<crate::scene::Light>,
     /// Passes completed in this epoch (the ray-traced frame counts as one).
     pub passes: u32,
     pub(super) preview_due: bool,
@@ -128,6 +130,7 @@ impl SessionState {
             paused: options.start_paused,
             params: scene.params.clone(),
             patches: scene.geometry.patches().len(),
+            lights: scene.lights.clone(),
             passes: 0,
             preview_due: options.preview_divisor.is_some(),
             pending: Vec::new(),
@@ -139,7 +142,7 @@ impl SessionState {
 
     /// Takes a command.
     pub fn apply(&mut self, command: Command) -> Effect {
-        if !valid(&command, self.patches) {
+        if !valid(&command, self.patches, &self.lights) {
             return Effect::Ignored;
         }
         let restarts = command.restarts(&self.params);
@@ -153,9 +156,10 @@ impl SessionState {
                 self.shutdown = true;
                 return Effect::Shutdown;
             }
-            Command::SetCamera(_) | Command::MoveControlPoint { .. } | Command::Restart => {
-                self.pending.push(command)
-            }
+            Command::SetCamera(_)
+            | Command::MoveControlPoint { .. }
+            | Command::SetLight { .. }
+            | Command::Restart => self.pending.push(command),
         }
         if restarts {
             self.restart_due = true;
