@@ -14,6 +14,7 @@ use caustic::render::session::{Command, Frame, RenderSession, SessionOptions};
 use caustic::scene::Scene;
 use caustic::settings::IndexKind;
 use common::lighting::{closed_form, mean_red, plane_lit_by, LIGHT_KINDS, PLANE};
+use common::pool;
 use glam::{DVec2, DVec3};
 
 /// The closed form ρ/π · I cos θ / r² at the plane point seen through each pixel centre.
@@ -185,14 +186,6 @@ fn render_passes(scene: &Scene, options: PpmOptions, passes: u32) -> Vec<[f32; 3
         ppm.run_pass(scene, &mut |_| Control::Continue);
     }
     ppm.radiance()
-}
-
-/// A thread pool of `threads` threads.
-fn pool(threads: usize) -> rayon::ThreadPool {
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .expect("pool")
 }
 
 #[test]

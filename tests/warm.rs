@@ -10,6 +10,9 @@ use caustic::render::session::{Command, Frame, RenderSession, SessionOptions};
 use caustic::scene::Scene;
 use glam::DVec3;
 
+mod common;
+use common::pool;
+
 /// `scenes/inline_patch.toml` (a glass sheet over a floor, a point light) at `width`, with
 /// `photons` per pass; `antialias` off makes it classic PPM (one eye pass, glass split).
 fn sheet(width: u32, photons: u64, antialias: bool) -> Scene {
@@ -61,13 +64,6 @@ fn warm_render(scene: &Scene, edit: &Scene, before: u32, after: u32) -> (Vec<[f3
 
 fn mean(image: &[[f32; 3]]) -> f64 {
     image.iter().map(|p| (p[0] + p[1] + p[2]) as f64).sum::<f64>() / (3 * image.len()) as f64
-}
-
-fn pool(threads: usize) -> rayon::ThreadPool {
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .expect("pool")
 }
 
 #[test]

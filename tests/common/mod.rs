@@ -107,3 +107,11 @@ pub fn shared_edges(patches: &[BezierPatch]) -> Vec<SharedEdge> {
 #[cfg(feature = "viewer")]
 pub mod gpu;
 pub mod lighting;
+
+/// A rayon thread pool of `threads` threads (for determinism across thread counts).
+pub fn pool(threads: usize) -> rayon::ThreadPool {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("pool")
+}
