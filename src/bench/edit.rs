@@ -9,6 +9,9 @@ use crate::render::error::errors;
 use crate::render::session::{Command, RenderSession, SessionOptions};
 use crate::scene::Scene;
 
+/// How long a pass before the edit may take at most.
+const BEFORE_EDIT_WAIT: Duration = Duration::from_secs(120);
+
 /// How long after an edit the picture on screen is judged (the drag preview's target).
 pub const ON_SCREEN_AFTER: Duration = Duration::from_millis(100);
 
@@ -55,7 +58,12 @@ pub fn measure_edit(scene: Scene, plan: &EditPlan, reference: &[[f32; 3]]) -> Re
     let mut on_screen = None;
     let mut last = f64::NAN;
     let mut run = None;
-    while let Ok(frame) = frames.recv_timeout(plan.limit) {
+    // Before the edit, passes may take long; after it, the limit counts.
+    let wait = |edited_at: Option<Instant>| match edited_at {
+        None => BEFORE_EDIT_WAIT,
+        Some(at) => plan.limit.saturating_sub(at.elapsed()),
+    };
+    while let Ok(frame) = frames.recv_timeout(wait(edited_at)) {
         let rmse = errors(&frame.radiance, reference).0;
         let Some(at) = edited_at else {
             last = rmse;
