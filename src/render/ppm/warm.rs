@@ -39,10 +39,12 @@ use crate::scene::Scene;
 
 /// The most a kept pixel's previous estimate counts for, in full passes of photons: after `k`
 /// passes of the new epoch the old light's share is at most `PRIOR_PASSES/(PRIOR_PASSES + k)`.
-/// Chosen with `caustic bench edit` on `scenes/inline_patch.toml` (medians of 3 runs, time to
-/// relative MSE 1e-2 after the edit: 2 passes 0.71 s, 4 passes 0.63 s, 8 passes 0.55 s; cold
-/// 0.62–0.69 s): a smaller prior lets the new photons' noise at the kept, narrow radii through,
-/// a larger one keeps the old light where the edit changed it.
+/// Chosen with `caustic bench edit` on `scenes/inline_patch.toml` (time to relative MSE 1e-2
+/// after the edit; development build, medians of 3 runs: 2 passes 0.71 s, 4 passes 0.63 s,
+/// 8 passes 0.55 s, cold 0.62–0.69 s; release, medians of 5: 8 passes 0.51–0.56 s, 12 passes
+/// 0.54 s, 16 passes 0.53 s, cold 0.62–0.67 s): a smaller prior lets the new photons' noise at
+/// the kept, narrow radii through; from 8 on, the old light where the edit changed it (the
+/// caustic's moved edge) is what is left.
 pub const PRIOR_PASSES: f64 = 8.0;
 
 /// Where an epoch's random streams start: a warm epoch continues the previous one's, so its
