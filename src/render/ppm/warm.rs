@@ -33,6 +33,7 @@ use super::radius::IndirectScale;
 use super::visible::VisiblePoint;
 use super::Ppm;
 use glam::{DVec3, Vec3};
+use rayon::prelude::*;
 
 use crate::geometry::Aabb;
 use crate::scene::Scene;
@@ -279,31 +280,51 @@ impl Ppm {
         };
         let cap = PRIOR_PASSES * self.photons_per_pass as f64;
         let now = self.point_records();
-        let (old, new) = (runs(&warm.slots), runs(&self.slots));
         let mut light = vec![PriorLight::default(); self.direct.len()];
         let mut carried = vec![false; self.slots.len()];
-        let (mut i, mut kept) = (0, 0usize);
-        for (pixel, range) in &new {
-            while i < old.len() && old[i].0 < *pixel {
-                i += 1;
-            }
-            let Some((_, old_range)) = old.get(i).filter(|(q, _)| q == pixel) else {
+        // Pixels and their slots, as runs of slots: one slot a pixel (stochastic) needs no
+        // search, so both sides are simply zipped.
+        let (old, new) = if self.stochastic && warm.slots.len() == self.slots.len() {
+            let one = |s: &[Slot]| {
+                s.iter()
+                    .enumerate()
+                    .map(|(k, s)| (s.pixel, k..k + 1))
+                    .collect::<Vec<_>>()
+            };
+            (one(&warm.slots), one(&self.slots))
+        } else {
+            (runs(&warm.slots), runs(&self.slots))
+        };
+        // Whether each run's points all carry, decided in parallel.
+        let carries: Vec<Option<(usize, DVec3)>> = new
+            .par_iter()
+            .enumerate()
+            .map(|(n, (pixel, range))| {
+                let o = if old.get(n).is_some_and(|(q, _)| q == pixel) {
+                    Some(n)
+                } else {
+                    old.binary_search_by_key(pixel, |(q, _)| *q).ok()
+                };
+                let old_range = &old[o?].1;
+                (old_range.len() == range.len()).then_some(())?;
+                let mut first = None;
+                for (from, to) in old_range.clone().zip(range.clone()) {
+                    let f = carry(&warm.points[from], &now[to], warm.slots[from].primary.radius2)?;
+                    first.get_or_insert((o?, f));
+                }
+                first
+            })
+            .collect();
+        let mut kept = 0usize;
+        for ((pixel, range), first) in new.iter().zip(carries) {
+            let Some((o, first)) = first else {
                 continue;
             };
-            if old_range.len() != range.len() {
-                continue;
-            }
-            let pairs = || old_range.clone().zip(range.clone());
-            let factor = |(from, to): (usize, usize)| {
-                carry(&warm.points[from], &now[to], warm.slots[from].primary.radius2)
-            };
-            if !pairs().all(|pair| factor(pair).is_some()) {
-                continue;
-            }
-            let first = factor((old_range.start, range.start)).unwrap_or(DVec3::ONE);
+            let old_range = &old[o].1;
             light[*pixel as usize] = warm.light[*pixel as usize].capped(PRIOR_PASSES, first);
-            for (from, to) in pairs() {
-                let factor = factor((from, to)).unwrap_or(DVec3::ONE);
+            for (from, to) in old_range.clone().zip(range.clone()) {
+                let factor = carry(&warm.points[from], &now[to], warm.slots[from].primary.radius2)
+                    .unwrap_or(DVec3::ONE);
                 let mut slot = warm.slots[from];
                 let scale = if slot.prior > cap { cap / slot.prior } else { 1.0 };
                 slot.primary.tau *= scale * factor;
@@ -341,7 +362,7 @@ impl Ppm {
         let near = left.padded(warm.initial_radius2.sqrt());
         let old: Vec<VisiblePoint> = warm
             .points
-            .iter()
+            .par_iter()
             .enumerate()
             .filter(|(_, r)| r.weight != Vec3::ZERO && near.contains(r.position.as_dvec3()))
             .map(|(k, r)| VisiblePoint {
@@ -353,25 +374,31 @@ impl Ppm {
             })
             .collect();
         let grid = super::HashGrid::build(&old);
+        // Each slot left: the nearest previous point whose radius holds it, found in parallel.
+        let found: Vec<(usize, u32, DVec3)> = now
+            .par_iter()
+            .enumerate()
+            .filter(|(to, new)| !carried[*to] && new.weight != Vec3::ZERO)
+            .filter_map(|(to, new)| {
+                let p = new.position.as_dvec3();
+                let (o, _) = grid
+                    .candidates(p)
+                    .iter()
+                    .map(|&k| &old[k as usize])
+                    .filter(|o| o.normal.dot(new.normal.as_dvec3()) >= 0.9)
+                    .map(|o| (o, (o.position - p).length_squared()))
+                    .filter(|(o, d2)| *d2 <= o.radius2)
+                    .min_by(|a, b| a.1.total_cmp(&b.1))?;
+                Some((
+                    to,
+                    o.slot,
+                    new.weight.as_dvec3() / o.weight.max(DVec3::splat(1e-30)),
+                ))
+            })
+            .collect();
         let mut warmed = std::collections::BTreeSet::new();
-        for (to, new) in now.iter().enumerate() {
-            if carried[to] || new.weight == Vec3::ZERO {
-                continue;
-            }
-            let p = new.position.as_dvec3();
-            let nearest = grid
-                .candidates(p)
-                .iter()
-                .map(|&k| &old[k as usize])
-                .filter(|o| o.normal.dot(new.normal.as_dvec3()) >= 0.9)
-                .map(|o| (o, (o.position - p).length_squared()))
-                .filter(|(o, d2)| *d2 <= o.radius2)
-                .min_by(|a, b| a.1.total_cmp(&b.1));
-            let Some((o, _)) = nearest else {
-                continue;
-            };
-            let factor = new.weight.as_dvec3() / o.weight.max(DVec3::splat(1e-30));
-            let mut slot = warm.slots[o.slot as usize];
+        for (to, from, factor) in found {
+            let mut slot = warm.slots[from as usize];
             let scale = if slot.prior > cap { cap / slot.prior } else { 1.0 };
             slot.primary.tau *= scale * factor;
             slot.indirect.tau *= scale * factor;
