@@ -175,8 +175,8 @@ fn view_menu_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Action>) 
     ui.separator();
     let mut nets = viewer.settings.show_wireframe;
     if ui
-        .checkbox(&mut nets, "Control nets  (W)")
-        .on_hover_text("Draw the patches' control nets and boundary curves over the image, to pick and drag")
+        .checkbox(&mut nets, "Control nets and lights  (W)")
+        .on_hover_text("Draw the patches' control nets and boundary curves and the lights' gizmos over the image, to pick and drag")
         .changed()
     {
         out.push(Action::ShowWireframe(nets));

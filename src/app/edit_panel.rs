@@ -90,9 +90,9 @@ pub fn edit_panel_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Acti
     ui.heading("Edit");
     let mut nets = viewer.settings.show_wireframe;
     if ui
-        .checkbox(&mut nets, "Show control nets")
+        .checkbox(&mut nets, "Show control nets and lights")
         .on_hover_text(
-            "Draw the control nets over the image; click a point to select it, drag to move it (W)",
+            "Draw the control nets and the lights over the image; click a point or a light to select it, drag to move it (W)",
         )
         .changed()
     {
