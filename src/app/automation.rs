@@ -443,10 +443,10 @@ fn drag_preview_error(viewer: &Viewer) -> Result<String, String> {
     let edited = viewer.edited_scene();
     let position = edited.geometry.patches()[DRAG_POINT.patch].0.points[DRAG_POINT.index];
     let mut before = edited.clone();
-    let mut patch = before.geometry.patches()[DRAG_POINT.patch].0;
-    patch.points[DRAG_POINT.index] =
-        viewer.scene().geometry.patches()[DRAG_POINT.patch].0.points[DRAG_POINT.index];
-    before.geometry.update_patches(&[(DRAG_POINT.patch, patch)]);
+    let start = viewer.scene().geometry.patches()[DRAG_POINT.patch].0.points[DRAG_POINT.index];
+    before
+        .geometry
+        .set_control_point(DRAG_POINT.patch, DRAG_POINT.index, start);
     let reference = {
         let options = crate::render::session::SessionOptions {
             max_passes: Some(PREVIEW_REFERENCE_PASSES),

@@ -4,6 +4,7 @@
 use egui::RichText;
 
 use super::action::Action;
+use super::editor::Editor;
 use super::handle::{Handle, LightPart};
 use super::state::ViewerState;
 
@@ -98,56 +99,7 @@ pub fn edit_panel_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Acti
     {
         out.push(Action::ShowWireframe(nets));
     }
-    let n = editor.selection.len();
-    match editor.selection.first() {
-        None => {
-            ui.label(RichText::new("Click a control point or a light to select it (Shift adds).").weak());
-        }
-        Some(&first) if n == 1 => {
-            let (label, size) = match first {
-                Handle::Control(r) => (
-                    format!(
-                        "Patch {}, point {} (row {}, column {})",
-                        r.patch,
-                        r.index,
-                        r.index / 4,
-                        r.index % 4
-                    ),
-                    editor.patches[r.patch].bounds().diagonal().length(),
-                ),
-                Handle::Light(l) => (
-                    format!(
-                        "Light {}: {}",
-                        l.light,
-                        match l.part {
-                            LightPart::Place => "where it is",
-                            LightPart::Aim => "the point it aims at",
-                        }
-                    ),
-                    editor.aims.get(l.light).copied().unwrap_or(1.0) * 4.0,
-                ),
-            };
-            ui.label(label);
-            // A drag of the field moves about a thousandth of the patch (or scene) per point.
-            let speed = (size * 1e-3).max(1e-6);
-            if let Some(p) = coordinates_ui(ui, editor.point(first), speed) {
-                out.push(Action::SetPoint(first, p));
-            }
-        }
-        Some(_) => {
-            let patches: std::collections::BTreeSet<usize> =
-                editor.selection.iter().filter_map(|h| h.patch()).collect();
-            let lights = editor.selection.iter().filter(|h| h.patch().is_none()).count();
-            ui.label(match lights {
-                0 => format!("{n} points selected in {} patch(es)", patches.len()),
-                _ => format!(
-                    "{} points selected in {} patch(es), {lights} light handle(s)",
-                    n - lights,
-                    patches.len()
-                ),
-            });
-        }
-    }
+    selection_ui(editor, ui, out);
     ui.horizontal_wrapped(|ui| {
         for c in edit_commands(viewer) {
             let tip = format!("{} ({})", c.tip, c.keys);
@@ -173,5 +125,67 @@ pub fn edit_panel_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Acti
         .clicked()
     {
         out.push(Action::SaveScene);
+    }
+}
+
+/// What is selected: a hint when nothing is, one handle's name and exact x/y/z fields, or a
+/// count of the points, patches and light handles.
+fn selection_ui(editor: &Editor, ui: &mut egui::Ui, out: &mut Vec<Action>) {
+    let n = editor.selection.len();
+    match editor.selection.first() {
+        None => {
+            ui.label(RichText::new("Click a control point or a light to select it (Shift adds).").weak());
+        }
+        Some(&first) if n == 1 => {
+            let (label, size) = handle_label(editor, first);
+            ui.label(label);
+            // A drag of the field moves about a thousandth of the patch (or scene) per point.
+            let speed = (size * 1e-3).max(1e-6);
+            if let Some(p) = coordinates_ui(ui, editor.point(first), speed) {
+                out.push(Action::SetPoint(first, p));
+            }
+        }
+        Some(_) => {
+            let patches: std::collections::BTreeSet<usize> =
+                editor.selection.iter().filter_map(|h| h.patch()).collect();
+            let lights = editor.selection.iter().filter(|h| h.patch().is_none()).count();
+            ui.label(match lights {
+                0 => format!("{n} points selected in {} patch(es)", patches.len()),
+                _ => format!(
+                    "{} points selected in {} patch(es), {lights} light handle(s)",
+                    n - lights,
+                    patches.len()
+                ),
+            });
+        }
+    }
+}
+
+/// A handle's name in the panel and the size its fields step by a thousandth of: its patch's
+/// diagonal, or for a light four times its aim distance (the scene's diagonal until a drag of
+/// the aim changed it).
+fn handle_label(editor: &Editor, h: Handle) -> (String, f64) {
+    match h {
+        Handle::Control(r) => (
+            format!(
+                "Patch {}, point {} (row {}, column {})",
+                r.patch,
+                r.index,
+                r.index / 4,
+                r.index % 4
+            ),
+            editor.patches[r.patch].bounds().diagonal().length(),
+        ),
+        Handle::Light(l) => (
+            format!(
+                "Light {}: {}",
+                l.light,
+                match l.part {
+                    LightPart::Place => "where it is",
+                    LightPart::Aim => "the point it aims at",
+                }
+            ),
+            editor.aims.get(l.light).copied().unwrap_or(1.0) * 4.0,
+        ),
     }
 }

@@ -76,9 +76,9 @@ pub fn bench_edit(args: EditArgs, out: &mut BenchOutput) -> Result<()> {
     }
     let edit = edit(&scene, &args)?;
     let mut edited = scene.clone();
-    let mut patch = edited.geometry.patches()[edit.patch].0;
-    patch.points[edit.index] = edit.position;
-    edited.geometry.update_patches(&[(edit.patch, patch)]);
+    edited
+        .geometry
+        .set_control_point(edit.patch, edit.index, edit.position);
     let reference = super::bench_convergence::reference(
         &edited,
         args.reference_passes,

@@ -137,6 +137,12 @@ impl Light {
         light
     }
 
+    /// Whether `new` may take this light's place in a scene: the same kind of light (an area
+    /// light's surface keeps its shape), every number finite.
+    pub fn can_become(&self, new: &Light) -> bool {
+        std::mem::discriminant(self) == std::mem::discriminant(new) && new.is_finite()
+    }
+
     /// Whether every number of the light is finite.
     pub fn is_finite(&self) -> bool {
         match *self {

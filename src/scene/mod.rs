@@ -138,7 +138,7 @@ impl Scene {
         let Some(old) = self.lights.get(k) else {
             return false;
         };
-        if std::mem::discriminant(old) != std::mem::discriminant(&light) || !light.is_finite() {
+        if !old.can_become(&light) {
             return false;
         }
         if let Some(object) = self.light_objects.get(k).copied().flatten() {

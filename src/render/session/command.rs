@@ -81,9 +81,7 @@ pub(super) fn valid(command: &Command, patches: usize, lights: &[crate::scene::L
             index,
             position,
         } => *patch < patches && *index < 16 && position.is_finite(),
-        Command::SetLight { light, value } => lights
-            .get(*light)
-            .is_some_and(|l| std::mem::discriminant(l) == std::mem::discriminant(value) && value.is_finite()),
+        Command::SetLight { light, value } => lights.get(*light).is_some_and(|l| l.can_become(value)),
         Command::Pause | Command::Resume | Command::Restart | Command::Shutdown => true,
     }
 }
