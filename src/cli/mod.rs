@@ -6,9 +6,11 @@ mod bench_convergence;
 mod bench_edit;
 mod bench_output;
 mod export;
+mod farm;
 mod memory;
 mod render;
 mod render_report;
+mod shard;
 mod shared_args;
 mod tessellation;
 mod view;
@@ -40,6 +42,11 @@ enum Command {
     View(view::ViewArgs),
     /// Render a scene to an image (PNG: tonemapped sRGB; EXR: linear float).
     Render(render::RenderArgs),
+    /// Merge part files of one render (from `render --shard K/N`) into one image.
+    Merge(shard::MergeArgs),
+    /// Print a batch script or manifest that renders a scene's shards on Slurm or Kubernetes
+    /// and merges them.
+    Farm(farm::FarmArgs),
     /// Write a scene's Bézier patches, tessellated, as a Wavefront OBJ file.
     ExportObj(export::ExportArgs),
     /// Measure performance; prints figures (nothing is asserted).
@@ -62,13 +69,15 @@ pub fn run() -> Result<()> {
     use_threads(match &command {
         Command::View(a) => a.threads.threads,
         Command::Render(a) => a.threads.threads,
-        Command::ExportObj(_) => None,
+        Command::ExportObj(_) | Command::Merge(_) | Command::Farm(_) => None,
         Command::Bench { what, .. } => what.threads(),
     })?;
     match command {
         Command::View(args) => view::view(args, launched),
         Command::Render(args) => render::render(args),
         Command::ExportObj(args) => export::export_obj(args),
+        Command::Merge(args) => shard::merge(args),
+        Command::Farm(args) => farm::farm(args),
         Command::Bench { what, json } => bench::bench(what, json),
     }
 }

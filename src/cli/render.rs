@@ -18,8 +18,8 @@ use caustic::render::session::{Frame, FrameStats, SessionOptions};
 use caustic::render::{image_metadata, Image, Layer};
 use caustic::scene::{RendererKind, Scene};
 use caustic::settings::limits;
-use caustic::settings::IndexKind;
 use caustic::settings::RenderParams;
+use caustic::settings::{IndexKind, RadiusSchedule};
 use caustic::tev::TevStream;
 
 /// `caustic render`'s flags.
@@ -69,6 +69,11 @@ pub struct RenderArgs {
     /// Print the summary as JSON on stdout (progress and warnings stay on stderr).
     #[arg(long)]
     json: bool,
+    /// Render shard K of N: the passes i ≡ K (mod N) of 0..--passes, photon mapped with the
+    /// global radius schedule (this flag sets both), into an EXR part file holding their exact sums, for
+    /// `caustic merge` (see README, "Rendering on a cluster").
+    #[arg(long, value_name = "K/N", value_parser = caustic::render::shard::Shard::parse)]
+    shard: Option<caustic::render::shard::Shard>,
     #[command(flatten)]
     ppm: PpmArgs,
 }
@@ -76,12 +81,13 @@ pub struct RenderArgs {
 /// Photon-mapping flags of `render`.
 #[derive(clap::Args, Clone, Debug)]
 pub struct PpmArgs {
-    /// Photon mapping: passes to run (default 16, or what --from records).
+    /// Photon mapping: passes to run (default 16, or what --from records); with --shard,
+    /// the passes of the whole render, of which the shard renders its own.
     #[arg(long)]
-    passes: Option<u32>,
+    pub(super) passes: Option<u32>,
     /// Photon mapping: stop after this many seconds even if passes remain.
     #[arg(long, allow_negative_numbers = true)]
-    time_limit: Option<f64>,
+    pub(super) time_limit: Option<f64>,
     /// Photon mapping: photons per pass (default: the scene's).
     #[arg(long)]
     photons: Option<u64>,
@@ -127,12 +133,18 @@ pub struct PpmArgs {
     #[arg(long, value_name = "on|off", action = clap::ArgAction::Set,
           value_parser = clap::builder::BoolishValueParser::new())]
     adaptive_radius: Option<bool>,
+    /// Photon mapping: how the radius shrinks pass by pass: each point's own statistics
+    /// (per-point, Hachisuka et al. 2008) or one global schedule in which every pass is an
+    /// independent estimate (global, Knaus & Zwicker 2011; needed by --shard) (default: the
+    /// scene's `radius_schedule`, or per-point).
+    #[arg(long, value_enum)]
+    pub radius_schedule: Option<RadiusSchedule>,
 }
 
 impl PpmArgs {
     /// Lays the photon-mapping flags given over the scene's parameters and checks the result
     /// with [`RenderParams::validate`]; an error names the flag.
-    fn overlay(&self, params: &mut RenderParams) -> Result<()> {
+    pub(super) fn overlay(&self, params: &mut RenderParams) -> Result<()> {
         if let Some(p) = self.photons {
             params.photons_per_pass = p;
         }
@@ -163,6 +175,9 @@ impl PpmArgs {
         if let Some(on) = self.adaptive_radius {
             params.adaptive_radius = on;
         }
+        if let Some(schedule) = self.radius_schedule {
+            params.radius_schedule = schedule;
+        }
         params.validate().map_err(|e| {
             let flag = match e.field {
                 "photons_per_pass" => "--photons",
@@ -186,6 +201,14 @@ pub fn render(args: RenderArgs) -> Result<()> {
     args.overwrite.check([out])?;
     let mut report = Report::new(args.json);
     let (mut scene, recorded, exposure) = scene_to_render(&args, &mut report)?;
+    if let Some(shard) = args.shard {
+        let total = args
+            .ppm
+            .passes
+            .or(recorded.as_ref().and_then(|r| r.passes))
+            .unwrap_or(16);
+        return super::shard::render_shard(&mut scene, shard, total, &args.ppm, out, args.overwrite.force);
+    }
     let reference = match &args.reference {
         Some(path) => {
             let reference = Reference::open(path)?;

@@ -12,7 +12,7 @@ use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
 use super::limits;
-use super::{IndexKind, RendererKind};
+use super::{IndexKind, RadiusSchedule, RendererKind};
 
 /// Every render setting, with the defaults a scene file's `[render]` table starts from.
 /// Camera settings (pose, lens, image size) belong to the scene's camera.
@@ -79,6 +79,12 @@ pub struct RenderParams {
     pub stratified_eye_rays: bool,
     /// Photon mapping: the spatial index over visible points (the image does not depend on it).
     pub index: IndexKind,
+    /// Photon mapping: how the radius shrinks pass by pass. Per point (default) keeps each
+    /// point's statistics from pass to pass; global (Knaus & Zwicker 2011) makes every pass
+    /// an independent estimate at a radius all points follow, so passes can be split across
+    /// machines and merged. With the global schedule α, the initial radii and the emission
+    /// guide are fixed by a pilot pass every machine repeats.
+    pub radius_schedule: RadiusSchedule,
 }
 
 impl Default for RenderParams {
@@ -101,6 +107,7 @@ impl Default for RenderParams {
             guided_emission: true,
             stratified_eye_rays: true,
             index: IndexKind::HashGrid,
+            radius_schedule: RadiusSchedule::PerPoint,
         }
     }
 }
@@ -151,8 +158,13 @@ impl RenderParams {
     }
 
     /// Whether going from `old` to these values discards the accumulated image: every change
-    /// does except α and the photon counts, which apply from the next pass.
+    /// does except α and the photon counts, which apply from the next pass (with the global
+    /// radius schedule α and the photon counts restart too: every pass must follow one
+    /// schedule).
     pub fn restarts_from(&self, old: &RenderParams) -> bool {
+        if self.radius_schedule == RadiusSchedule::Global || old.radius_schedule == RadiusSchedule::Global {
+            return self != old;
+        }
         let kept = RenderParams {
             alpha: old.alpha,
             photons_per_pass: old.photons_per_pass,

@@ -34,7 +34,13 @@ impl Integrator for PhotonMapping {
         ppm.alpha = plan.params.alpha;
         let (w, h) = ppm.size();
         let full = plan.params.pass_photons(ppm.is_stochastic(), w as u64 * h as u64);
-        ppm.photons_per_pass = plan.pass_photons(ppm.stats().passes, full);
+        // The global schedule's passes are estimates of one kind, whatever process renders
+        // them: every one is full (no ramp).
+        ppm.photons_per_pass = if ppm.pass_sums().is_some() {
+            full
+        } else {
+            plan.pass_photons(ppm.stats().passes, full)
+        };
         ppm.run_pass(scene, control) == PassOutcome::Completed
     }
 

@@ -36,7 +36,7 @@ impl Ppm {
     /// (the pass is then traced again, so the half-written buffers do not matter).
     pub(super) fn trace_stochastic_eye_pass(&mut self, scene: &Scene) -> bool {
         let (w, h) = (self.width as u64, self.height as u64);
-        let pass = self.offset.passes + self.stats.passes as u64;
+        let pass = self.stream_pass();
         let (direct_light, seed) = (self.direct_light, self.seed);
         let sequences = self
             .stratified_eye_rays
@@ -105,7 +105,7 @@ impl Ppm {
     /// `slot` holding its pixel. `None` when interrupted.
     pub(super) fn trace_classic_eye_pass(&self, scene: &Scene) -> Option<(Vec<DVec3>, Vec<VisiblePoint>)> {
         let (w, h) = (self.width as u64, self.height as u64);
-        let pass = self.offset.passes + self.stats.passes as u64;
+        let pass = self.stream_pass();
         let (direct_light, seed) = (self.direct_light, self.seed);
         let interrupt = self.interrupt.as_deref();
         let skipped = std::sync::atomic::AtomicBool::new(false);
@@ -210,7 +210,7 @@ impl Ppm {
             scene,
             &self.points,
             |k| self.points[k].slot as u64,
-            self.offset.passes + self.stats.passes as u64,
+            self.stream_pass(),
             self.seed,
         );
         for (vp, l) in self.points.iter().zip(light) {

@@ -23,6 +23,7 @@
 
 mod estimate;
 mod eye_pass;
+mod global;
 mod index;
 mod photon_pass;
 mod radius;
@@ -46,10 +47,12 @@ pub use hash_grid::HashGrid;
 pub use kd_tree::KdTree;
 use visible::VisiblePoint;
 
+use crate::render::shard::{PassSums, Shard};
 use crate::scene::Scene;
-use crate::settings::IndexKind;
+use crate::settings::{IndexKind, RadiusSchedule};
 
 pub use estimate::{Estimate, Restart, Slot};
+pub use global::schedule_factor;
 pub use index::SpatialIndex;
 pub use photon_pass::DEFAULT_BATCH_PHOTONS;
 use radius::IndirectScale;
@@ -78,6 +81,9 @@ pub struct PpmOptions {
     /// pixel), so that an epoch can hand a warm restart its statistics ([`warm`]); classic
     /// PPM keeps its points anyway.
     pub warm_restarts: bool,
+    /// With the global radius schedule: which of the render's passes this process renders
+    /// (every pass when it is `0/1`); ignored with per-point statistics.
+    pub shard: Shard,
 }
 
 impl Default for PpmOptions {
@@ -86,6 +92,7 @@ impl Default for PpmOptions {
             force_stochastic: false,
             batch_photons: DEFAULT_BATCH_PHOTONS,
             warm_restarts: false,
+            shard: Shard::default(),
         }
     }
 }
@@ -161,6 +168,8 @@ pub struct Ppm {
     last_points: Vec<warm::PointRecord>,
     /// Per pixel, the light seen directly that a warm restart kept (empty when cold).
     prior_light: Vec<warm::PriorLight>,
+    /// The global radius schedule's state (`None`: per-point statistics).
+    global: Option<global::Global>,
 }
 
 /// Asked often during a pass (from any thread); returning true abandons the pass. The render
@@ -239,6 +248,8 @@ impl Ppm {
             inherited: None,
             last_points: Vec::new(),
             prior_light: Vec::new(),
+            global: (scene.params.radius_schedule == RadiusSchedule::Global)
+                .then(|| global::Global::new(options.shard, scene.params.alpha, cam.width, cam.height)),
         }
     }
 
@@ -270,7 +281,21 @@ impl Ppm {
 
     /// Runs one pass: eye pass if needed, photons in batches (calling `control(&mut α)`
     /// between batches; `Abort` drops the pass), then the radius/flux update.
+    /// With the global radius schedule, the pass is the next of this process's shard, an
+    /// independent estimate ([`global`]).
     pub fn run_pass(&mut self, scene: &Scene, control: &mut dyn FnMut(&mut f64) -> Control) -> PassOutcome {
+        if self.global.is_some() {
+            return self.run_global_pass(scene, control);
+        }
+        self.run_statistics_pass(scene, control)
+    }
+
+    /// A pass of per-point statistics (also the global schedule's pilot pass).
+    fn run_statistics_pass(
+        &mut self,
+        scene: &Scene,
+        control: &mut dyn FnMut(&mut f64) -> Control,
+    ) -> PassOutcome {
         let start = Instant::now();
         if self.interrupted() {
             return PassOutcome::Aborted;
@@ -284,13 +309,8 @@ impl Ppm {
                 vp.radius2 = self.slots[vp.slot as usize].reach2();
             }
         }
-        let index_start = Instant::now();
-        self.stats.eye_secs += (index_start - start).as_secs_f64();
-        let index = match self.index {
-            IndexKind::HashGrid => SpatialIndex::Grid(HashGrid::build(&self.points)),
-            IndexKind::KdTree => SpatialIndex::Kd(KdTree::build(&self.points)),
-        };
-        self.stats.index_secs += index_start.elapsed().as_secs_f64();
+        self.stats.eye_secs += start.elapsed().as_secs_f64();
+        let index = self.build_index();
         if self.interrupted() {
             return PassOutcome::Aborted;
         }
@@ -305,9 +325,44 @@ impl Ppm {
         PassOutcome::Completed
     }
 
+    /// The spatial index over this pass's visible points.
+    fn build_index(&mut self) -> SpatialIndex {
+        let start = Instant::now();
+        let index = match self.index {
+            IndexKind::HashGrid => SpatialIndex::Grid(HashGrid::build(&self.points)),
+            IndexKind::KdTree => SpatialIndex::Kd(KdTree::build(&self.points)),
+        };
+        self.stats.index_secs += start.elapsed().as_secs_f64();
+        index
+    }
+
+    /// The pass whose random streams the eye pass and light samples use.
+    fn stream_pass(&self) -> u64 {
+        match &self.global {
+            Some(g) => g.stream_pass(),
+            None => self.offset.passes + self.stats.passes as u64,
+        }
+    }
+
+    /// The random stream index of this pass's first photon.
+    fn first_photon(&self) -> u64 {
+        match &self.global {
+            Some(g) => g.first_photon(),
+            None => self.offset.photons + self.stats.photons,
+        }
+    }
+
+    /// With the global radius schedule, the exact sums of the passes rendered so far.
+    pub fn pass_sums(&self) -> Option<&PassSums> {
+        self.global.as_ref().map(|g| &g.sums)
+    }
+
     /// Linear RGB radiance per pixel: `τ/(π R² N_emitted)` of every slot of the pixel plus the
-    /// mean of the light seen directly.
+    /// mean of the light seen directly (with the global schedule, the mean of the passes).
     pub fn radiance(&self) -> Vec<[f32; 3]> {
+        if let Some(g) = &self.global {
+            return g.sums.mean();
+        }
         let mut out = vec![DVec3::ZERO; self.direct.len()];
         if self.stats.photons > 0 {
             let emitted = self.stats.photons as f64;

@@ -143,7 +143,7 @@ impl Ppm {
         let mut deposits: Vec<Deposit> = Vec::new();
         let mut counts = PhotonCounts::default();
         let mut tally = self.guide.as_ref().map(EmissionGuide::tally);
-        let (photons, first_photon) = (self.pass_photons, self.offset.photons + self.stats.photons);
+        let (photons, first_photon) = (self.pass_photons, self.first_photon());
         let points = &self.points;
         let split = self.indirect_scale != IndirectScale::Off;
         for i in c * CHUNK..((c + 1) * CHUNK).min(photons) {

@@ -182,6 +182,11 @@ impl Ppm {
     /// What this epoch hands to the next after an edit: `None` when it learned nothing (no
     /// pass completed and nothing inherited).
     pub fn into_warm_start(mut self) -> Option<WarmStart> {
+        if self.global.is_some() {
+            // Every pass of the global schedule is its own estimate at a scheduled radius:
+            // there are no per-point statistics to keep.
+            return None;
+        }
         if self.stats.passes == 0 {
             return self.inherited;
         }
@@ -246,7 +251,8 @@ impl Ppm {
     ///
     /// [`PpmOptions::warm_restarts`]: super::PpmOptions::warm_restarts
     pub fn inherit(&mut self, scene: &Scene, warm: WarmStart) {
-        if warm.size != (self.width, self.height)
+        if self.global.is_some()
+            || warm.size != (self.width, self.height)
             || warm.stochastic != self.stochastic
             || warm.points.len() != warm.slots.len()
             || self.stats.passes > 0

@@ -1,0 +1,168 @@
+//! `caustic render --shard K/N`: one shard of a render with the global radius schedule, its
+//! passes' exact sums written as a part file ([`caustic::render::shard::part`]) for
+//! `caustic merge`; and `caustic merge`.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{bail, Context, Result};
+
+use super::render::PpmArgs;
+use super::shared_args::Overwrite;
+use caustic::render::image_metadata;
+use caustic::render::ppm::{Control, PassOutcome, Ppm, PpmOptions};
+use caustic::render::shard::{Part, Shard};
+use caustic::scene::{RendererKind, Scene};
+use caustic::settings::RadiusSchedule;
+
+/// Renders shard `shard` of a `total`-pass render of `scene` into the part file `out`.
+pub fn render_shard(
+    scene: &mut Scene,
+    shard: Shard,
+    total: u32,
+    args: &PpmArgs,
+    out: &Path,
+    force: bool,
+) -> Result<()> {
+    if !out.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr")) {
+        bail!(
+            "{}: a shard is written as an EXR part file (use .exr)",
+            out.display()
+        );
+    }
+    if args.time_limit.is_some() {
+        bail!("--time-limit cannot be used with --shard: a part holds whole passes, chosen by their number");
+    }
+    if total == 0 {
+        bail!("--passes must be at least 1");
+    }
+    args.overlay(&mut scene.params)?;
+    // A shard is photon mapping with the global schedule, whatever the scene's renderer.
+    scene.params.renderer = RendererKind::Ppm;
+    scene.params.radius_schedule = RadiusSchedule::Global;
+    if !force && out.exists() {
+        bail!(
+            "{}: the file exists; choose another name or pass --force to overwrite it",
+            out.display()
+        );
+    }
+    let start = Instant::now();
+    let mut ppm = Ppm::new(
+        scene,
+        PpmOptions {
+            shard,
+            ..Default::default()
+        },
+    );
+    let (w, h) = ppm.size();
+    ppm.photons_per_pass = scene
+        .params
+        .pass_photons(ppm.is_stochastic(), w as u64 * h as u64);
+    let count = shard.passes_of(total);
+    let bar = indicatif::ProgressBar::new(count as u64).with_style(
+        indicatif::ProgressStyle::with_template("{msg} [{bar:40}] pass {pos}/{len}, {elapsed} (eta {eta})")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    bar.set_message(format!("shard {shard} of {total} passes, {w}x{h}"));
+    for _ in 0..count {
+        if ppm.run_pass(scene, &mut |_| Control::Continue) != PassOutcome::Completed {
+            bail!("pass abandoned");
+        }
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    let sums = ppm
+        .pass_sums()
+        .cloned()
+        .context("the global schedule keeps sums")?;
+    let settings = toml::to_string(&scene.params).context("writing the settings")?;
+    let mut metadata = image_metadata(scene, RendererKind::Ppm.name(), None);
+    metadata.push(("caustic:shard".into(), shard.to_string()));
+    let part = Part::new(sums, total, metadata, settings);
+    part.write(out, force)?;
+    let s = ppm.stats();
+    println!(
+        "shard {shard}: {} of {total} passes, {} photons in {:.2} s ({:.2} passes/s) → {}",
+        count,
+        s.photons,
+        start.elapsed().as_secs_f64(),
+        count as f64 / start.elapsed().as_secs_f64().max(1e-9),
+        out.display()
+    );
+    Ok(())
+}
+
+/// `caustic merge`'s flags.
+#[derive(clap::Args)]
+pub struct MergeArgs {
+    /// Part files (from `render --shard`, or earlier merges) of one render.
+    #[arg(required = true, num_args = 1..)]
+    parts: Vec<PathBuf>,
+    /// The merged part file (.exr): the mean of every pass in RGB, the sums for further merges.
+    #[arg(short, long)]
+    out: PathBuf,
+    /// Accept parts that together hold fewer than the render's passes (the image is the mean
+    /// of those they hold).
+    #[arg(long)]
+    partial: bool,
+    #[command(flatten)]
+    overwrite: Overwrite,
+}
+
+/// Adds the parts' sums and writes the merged part; refuses parts of different renders or
+/// overlapping passes, naming the files and what differs.
+pub fn merge(args: MergeArgs) -> Result<()> {
+    if !args
+        .out
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
+    {
+        bail!(
+            "{}: the merge is written as an EXR part file (use .exr)",
+            args.out.display()
+        );
+    }
+    args.overwrite.check([args.out.as_path()])?;
+    let start = Instant::now();
+    let mut parts = args.parts.iter();
+    let first = parts.next().context("no parts given")?;
+    let mut merged = Part::read(first)?;
+    for path in parts {
+        let part = Part::read(path)?;
+        merged.merge(first, &part, path)?;
+    }
+    let (done, total) = (merged.sums.passes().len(), merged.total_passes);
+    if !merged.is_complete() && !args.partial {
+        bail!(
+            "the parts hold {done} of the render's {total} passes (missing: {}); pass --partial to merge them anyway",
+            missing(merged.sums.passes(), total)
+        );
+    }
+    merged.write(&args.out, args.overwrite.force)?;
+    let error = merged
+        .sums
+        .relative_error()
+        .map_or(String::new(), |e| format!(", estimated relative error {e:.2e}"));
+    println!(
+        "merged {} parts: {done} of {total} passes{error} in {:.2} s → {}",
+        args.parts.len(),
+        start.elapsed().as_secs_f64(),
+        args.out.display()
+    );
+    Ok(())
+}
+
+/// The first few passes of `0..total` not in `passes` (ascending).
+fn missing(passes: &[u32], total: u32) -> String {
+    let gaps: Vec<String> = (0..total)
+        .filter(|p| passes.binary_search(p).is_err())
+        .take(8)
+        .map(|p| p.to_string())
+        .collect();
+    let more = (total as usize - passes.len()).saturating_sub(gaps.len());
+    if more > 0 {
+        format!("{} and {more} more", gaps.join(", "))
+    } else {
+        gaps.join(", ")
+    }
+}

@@ -1,0 +1,241 @@
+//! The global radius schedule (Knaus & Zwicker 2011, "Progressive photon mapping: a
+//! probabilistic approach", §4): pass `i` (0-based) gathers photons at the radius
+//! `r_{i+1}² = r_1² · Π_{k=1}^{i} (k + α)/(k + 1)` — the paper's `r²_{i+1} = r²_i (i + α)/(i + 1)` —
+//! and its estimate `Φ/(π r² N_emitted)` stands alone: no photon count or flux carries to
+//! the next pass. The image is the mean of the passes, whose variance falls and whose bias
+//! shrinks with the radius as per-point PPM's do; since the passes are independent, they can be
+//! rendered in any order on any machine ([`crate::render::shard`]).
+//!
+//! What per-point PPM learns from earlier passes is fixed here by a **pilot pass** that every
+//! process repeats identically (it depends only on the scene and its seed): the initial radius,
+//! each pixel's (or point's) automatic indirect radius and adaptive narrowing — its `r_1` —
+//! and the emission guide, which learns from the pilot only and then stays as it is. The pilot
+//! is not one of the image's passes. Pass `i` uses the eye-pass and light-sample streams of
+//! pass `i + 1` and the photon streams from `(i + 1)·2³²` (a pass holds fewer than 2³²
+//! photons), so its numbers depend on `(seed, i)` alone.
+
+use std::time::Instant;
+
+use glam::DVec3;
+
+use super::radius::IndirectScale;
+use super::{Control, Estimate, PassOutcome, Ppm, Restart};
+use crate::render::shard::{PassSums, Shard};
+use crate::scene::Scene;
+
+/// `r_{i+1}² / r_1²` for pass `i` (0-based) of the global schedule with `alpha`:
+/// `Π_{k=1}^{i} (k + α)/(k + 1)`, multiplied in order (the same bits on every machine).
+pub fn schedule_factor(pass: u64, alpha: f64) -> f64 {
+    (1..=pass).fold(1.0, |f, k| f * (k as f64 + alpha) / (k as f64 + 1.0))
+}
+
+/// The global schedule's state in a [`Ppm`].
+pub(super) struct Global {
+    shard: Shard,
+    /// α, fixed for the render.
+    alpha: f64,
+    /// Per slot, the pilot's radii² `r_1²` (primary, indirect); empty before the pilot.
+    pilot: Vec<(f64, f64)>,
+    /// Classic PPM: per pixel, the light seen directly by the one eye pass.
+    classic_direct: Vec<DVec3>,
+    /// This shard's passes completed.
+    done: u32,
+    /// The stream position: 0 for the pilot, `i + 1` for pass `i`.
+    stream: u64,
+    /// The passes' exact sums.
+    pub(super) sums: PassSums,
+}
+
+impl Global {
+    /// Before the pilot pass, for shard `shard` of a `width`×`height` render with `alpha`.
+    pub(super) fn new(shard: Shard, alpha: f64, width: u32, height: u32) -> Self {
+        Self {
+            shard,
+            alpha,
+            pilot: Vec::new(),
+            classic_direct: Vec::new(),
+            done: 0,
+            stream: 0,
+            sums: PassSums::new(width, height),
+        }
+    }
+
+    /// The pass index of the eye pass's and light samples' streams.
+    pub(super) fn stream_pass(&self) -> u64 {
+        self.stream
+    }
+
+    /// The stream index of the pass's first photon.
+    pub(super) fn first_photon(&self) -> u64 {
+        self.stream << 32
+    }
+}
+
+impl Ppm {
+    /// The next pass of this process's shard: the pilot first (once), then the pass's own eye
+    /// pass, photons at the scheduled radii and its estimate added to the sums.
+    pub(super) fn run_global_pass(
+        &mut self,
+        scene: &Scene,
+        control: &mut dyn FnMut(&mut f64) -> Control,
+    ) -> PassOutcome {
+        if self.global.as_ref().is_some_and(|g| g.pilot.is_empty()) {
+            if let Some(g) = &mut self.global {
+                g.stream = 0;
+            }
+            if self.run_statistics_pass(scene, control) == PassOutcome::Aborted {
+                return PassOutcome::Aborted;
+            }
+            self.finish_pilot();
+        }
+        let start = Instant::now();
+        let Some(g) = &mut self.global else {
+            return PassOutcome::Aborted;
+        };
+        let pass = g.shard.pass(g.done);
+        g.stream = pass + 1;
+        if self.interrupted() || (self.stochastic && !self.trace_stochastic_eye_pass(scene)) {
+            return PassOutcome::Aborted;
+        }
+        let Some(g) = &self.global else {
+            return PassOutcome::Aborted;
+        };
+        let factor = schedule_factor(pass, g.alpha);
+        for (s, &(primary, indirect)) in self.slots.iter_mut().zip(&g.pilot) {
+            s.primary = Estimate {
+                radius2: primary * factor,
+                ..Default::default()
+            };
+            s.indirect = Estimate {
+                radius2: indirect * factor,
+                ..Default::default()
+            };
+        }
+        for vp in &mut self.points {
+            vp.radius2 = self.slots[vp.slot as usize].reach2();
+        }
+        self.stats.eye_secs += start.elapsed().as_secs_f64();
+        let index = self.build_index();
+        if self.interrupted() {
+            return PassOutcome::Aborted;
+        }
+        let photon_start = Instant::now();
+        let Some(gathered) = self.photon_pass(scene, &index, control) else {
+            return PassOutcome::Aborted;
+        };
+        self.stats.photon_secs += photon_start.elapsed().as_secs_f64();
+        self.area_direct.iter_mut().for_each(|a| *a = DVec3::ZERO);
+        self.sample_area_lights(scene);
+        // This pass's estimate per pixel.
+        let emitted = self.pass_photons as f64;
+        let mut values = vec![DVec3::ZERO; self.direct.len()];
+        for (k, s) in self.slots.iter().enumerate() {
+            let primary = Estimate {
+                tau: gathered.phi[2 * k].as_dvec3(),
+                ..s.primary
+            };
+            let indirect = Estimate {
+                tau: gathered.phi[2 * k + 1].as_dvec3(),
+                ..s.indirect
+            };
+            values[s.pixel as usize] += primary.radiance(emitted) + indirect.radiance(emitted);
+        }
+        let Some(g) = &mut self.global else {
+            return PassOutcome::Aborted;
+        };
+        let seen = if self.stochastic {
+            &self.pass_direct
+        } else {
+            &g.classic_direct
+        };
+        for (i, v) in values.iter_mut().enumerate() {
+            *v += seen[i] + self.area_direct.get(i).copied().unwrap_or_default();
+        }
+        g.sums.add_pass(pass as u32, &values, self.pass_photons);
+        g.done += 1;
+        let counts = gathered.counts;
+        self.stats.passes += 1;
+        if self.stochastic {
+            self.stats.eye_passes += 1;
+        }
+        self.stats.photons += self.pass_photons;
+        self.stats.bounces += counts.bounces;
+        self.stats.deposits += counts.deposits;
+        self.stats.useful_paths += counts.useful;
+        self.stats.visible_points = self.points.len();
+        let radii = self.slots.iter().filter(|s| s.primary.radius2 > 0.0);
+        let (sum, n) = radii.fold((0.0, 0usize), |(sum, n), s| {
+            (sum + s.primary.radius2.sqrt(), n + 1)
+        });
+        self.stats.mean_radius = sum / n.max(1) as f64;
+        self.stats.elapsed_secs += start.elapsed().as_secs_f64();
+        PassOutcome::Completed
+    }
+
+    /// After the pilot pass: each slot's `r_1` (the initial radius, narrowed where the pilot
+    /// found photons dense; the indirect estimate's chosen scale), the directly seen light of
+    /// a classic eye pass; the statistics start again at pass 0 (the pilot's time stays in
+    /// the elapsed time).
+    fn finish_pilot(&mut self) {
+        let r0_2 = self.initial_radius2;
+        let indirect = match self.indirect_scale {
+            IndirectScale::Fixed(k) => r0_2 * k * k,
+            _ => 0.0,
+        };
+        let pilot: Vec<(f64, f64)> = self
+            .slots
+            .iter()
+            .map(|s| {
+                let primary = if s.restart == Restart::Pending {
+                    s.primary.radius2
+                } else {
+                    r0_2
+                };
+                (primary, indirect)
+            })
+            .collect();
+        for s in &mut self.slots {
+            s.restart = Restart::None;
+        }
+        let classic_direct = if self.stochastic {
+            Vec::new()
+        } else {
+            let eye = self.stats.eye_passes.max(1) as f64;
+            self.direct.iter().map(|d| *d / eye).collect()
+        };
+        if let Some(g) = &mut self.global {
+            g.pilot = pilot;
+            g.classic_direct = classic_direct;
+        }
+        let s = &mut self.stats;
+        s.passes = 0;
+        s.photons = 0;
+        s.bounces = 0;
+        s.deposits = 0;
+        s.useful_paths = 0;
+        if self.stochastic {
+            s.eye_passes = 0;
+        }
+        s.skipped.push(
+            "per-point statistics: every pass is an independent estimate (global radius schedule)".into(),
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_schedule_follows_the_recurrence() {
+        let alpha = 0.7;
+        let mut r2 = 1.0;
+        for i in 1..50u64 {
+            // r²_{i+1} = r²_i (i + α)/(i + 1), with pass i (0-based) at r_{i+1}.
+            r2 *= (i as f64 + alpha) / (i as f64 + 1.0);
+            assert!((schedule_factor(i, alpha) - r2).abs() < 1e-15);
+        }
+        assert_eq!(schedule_factor(0, alpha), 1.0);
+        assert_eq!(schedule_factor(10, 1.0), 1.0, "α = 1 keeps the radius");
+    }
+}

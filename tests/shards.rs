@@ -1,0 +1,281 @@
+//! Independent passes with the global radius schedule (Knaus & Zwicker 2011): shards merged
+//! equal the one-process render bit for bit (fixed-point sums), for any thread count; every
+//! merge refusal has its message; merges merge again; the global schedule converges to the
+//! per-point image; and the command line's shard → merge → `render --from` round trip.
+
+use std::path::Path;
+
+use caustic::render::image_metadata;
+use caustic::render::ppm::{Control, Ppm, PpmOptions};
+use caustic::render::shard::{Part, PassSums, Shard};
+use caustic::scene::Scene;
+use caustic::settings::{RadiusSchedule, RendererKind};
+
+mod common;
+use common::{caustic, pool, text};
+
+/// `scenes/inline_patch.toml` (a glass sheet over a floor under a point light: a caustic) at
+/// `width` pixels, photon mapped with the global schedule; `antialias` off makes it classic PPM.
+fn sheet(width: u32, antialias: bool) -> Scene {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/inline_patch.toml");
+    let mut scene = Scene::load(&path).expect("scenes/inline_patch.toml loads");
+    scene.camera.resize(Some(width), None);
+    scene.params.renderer = RendererKind::Ppm;
+    scene.params.photons_per_pass = 20_000;
+    scene.params.min_photons_per_pixel = 0.0;
+    scene.params.antialias = antialias;
+    scene.params.radius_schedule = RadiusSchedule::Global;
+    scene
+}
+
+/// The sums of shard `shard` of a `total`-pass render.
+fn shard_sums(scene: &Scene, shard: Shard, total: u32) -> PassSums {
+    let mut ppm = Ppm::new(
+        scene,
+        PpmOptions {
+            shard,
+            ..Default::default()
+        },
+    );
+    ppm.photons_per_pass = scene.params.photons_per_pass;
+    for _ in 0..shard.passes_of(total) {
+        ppm.run_pass(scene, &mut |_| Control::Continue);
+    }
+    ppm.pass_sums().expect("global schedule").clone()
+}
+
+/// A part of `sums` as `render --shard` writes it.
+fn part(scene: &Scene, sums: PassSums, total: u32) -> Part {
+    let settings = toml::to_string(&scene.params).expect("settings");
+    Part::new(sums, total, image_metadata(scene, "ppm", None), settings)
+}
+
+#[test]
+fn merged_shards_equal_the_one_process_render_bit_for_bit() {
+    for antialias in [false, true] {
+        let scene = sheet(40, antialias);
+        for (n, total) in [(2u32, 6u32), (3, 7), (4, 9)] {
+            let one = pool(2).install(|| shard_sums(&scene, Shard::default(), total));
+            assert_eq!(one.passes().len(), total as usize);
+            let mut merged = PassSums::new(one.size().0, one.size().1);
+            for k in 0..n {
+                // Shards on one thread, the one-process render on two.
+                let s = pool(1).install(|| shard_sums(&scene, Shard { index: k, count: n }, total));
+                merged.add(&s).expect("disjoint shards");
+            }
+            assert_eq!(
+                merged, one,
+                "{n} shards of {total} passes (antialias {antialias})"
+            );
+            let (a, b) = (merged.mean(), one.mean());
+            assert!(a
+                .iter()
+                .zip(&b)
+                .all(|(x, y)| x.map(f32::to_bits) == y.map(f32::to_bits)));
+            assert!(one.mean().iter().any(|p| p[0] > 0.0), "the image is not black");
+        }
+    }
+}
+
+#[test]
+fn part_files_round_trip_and_merges_merge_again() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scene = sheet(32, true);
+    let total = 8;
+    let paths: Vec<_> = (0..4)
+        .map(|k| {
+            let path = dir.path().join(format!("part_{k}.exr"));
+            let sums = shard_sums(&scene, Shard { index: k, count: 4 }, total);
+            part(&scene, sums, total).write(&path, false).expect("writes");
+            path
+        })
+        .collect();
+    let read: Vec<Part> = paths.iter().map(|p| Part::read(p).expect("reads")).collect();
+    let expected = shard_sums(&scene, Shard { index: 1, count: 4 }, total);
+    assert_eq!(read[1].sums, expected, "a part reads back exactly");
+    // (0 + 1) and (2 + 3), written, read and merged again.
+    let mut left = read[0].clone();
+    left.merge(&paths[0], &read[1], &paths[1]).expect("0 and 1 merge");
+    let mut right = read[2].clone();
+    right
+        .merge(&paths[2], &read[3], &paths[3])
+        .expect("2 and 3 merge");
+    let (lp, rp) = (dir.path().join("left.exr"), dir.path().join("right.exr"));
+    left.write(&lp, false).expect("writes");
+    right.write(&rp, false).expect("writes");
+    let mut all = Part::read(&lp).expect("reads");
+    all.merge(&lp, &Part::read(&rp).expect("reads"), &rp)
+        .expect("merges merge");
+    assert!(all.is_complete());
+    assert_eq!(all.sums, shard_sums(&scene, Shard::default(), total));
+    assert_eq!(all.get("caustic:passes"), Some("8"));
+    assert_eq!(all.get("caustic:pass_list"), Some("0-7"));
+}
+
+#[test]
+fn every_merge_refusal_names_what_differs() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scene = sheet(24, true);
+    let write = |name: &str, scene: &Scene, shard: Shard, total: u32, edit: &dyn Fn(&mut Part)| {
+        let path = dir.path().join(name);
+        let mut p = part(scene, shard_sums(scene, shard, total), total);
+        edit(&mut p);
+        p.write(&path, false).expect("writes");
+        path
+    };
+    let none = |_: &mut Part| {};
+    let base = write("base.exr", &scene, Shard { index: 0, count: 2 }, 4, &none);
+    let refusal = |other: &Path| -> String {
+        let ours = Part::read(&base).expect("reads");
+        let theirs = Part::read(other).expect("reads");
+        ours.check_joins(&base, &theirs, other)
+            .expect_err("refused")
+            .to_string()
+    };
+    let other_shard = Shard { index: 1, count: 2 };
+    let version = write("version.exr", &scene, other_shard, 4, &|p: &mut Part| {
+        for (k, v) in &mut p.metadata {
+            if k == "Software" {
+                *v = "caustic 0.0.1".into();
+            }
+        }
+    });
+    assert!(
+        refusal(&version).contains("written by different programs"),
+        "{}",
+        refusal(&version)
+    );
+    let mut small = scene.clone();
+    small.camera.resize(Some(20), None);
+    let size = write("size.exr", &small, other_shard, 4, &none);
+    assert!(
+        refusal(&size).contains("image sizes differ: 24x"),
+        "{}",
+        refusal(&size)
+    );
+    let mut alpha = scene.clone();
+    alpha.params.alpha = 0.5;
+    let settings = write("alpha.exr", &alpha, other_shard, 4, &none);
+    assert!(
+        refusal(&settings).contains("render settings differ: alpha 0.7 and 0.5"),
+        "{}",
+        refusal(&settings)
+    );
+    // Another scene text (the same settings and size).
+    let text = scene.text.replace("[camera]", "# another scene\n[camera]");
+    assert_ne!(text, *scene.text);
+    let mut moved = Scene::from_str(&text, &scene.source, scene.base_dir.as_deref()).expect("loads");
+    moved.camera.resize(Some(24), None);
+    moved.params = scene.params.clone();
+    let scene_file = write("scene.exr", &moved, other_shard, 4, &none);
+    assert!(
+        refusal(&scene_file).contains("scenes differ"),
+        "{}",
+        refusal(&scene_file)
+    );
+    let longer = write("longer.exr", &scene, other_shard, 6, &none);
+    assert!(
+        refusal(&longer).contains("different lengths: 4 and 6 passes"),
+        "{}",
+        refusal(&longer)
+    );
+    let overlap = write("overlap.exr", &scene, Shard { index: 0, count: 4 }, 4, &none);
+    assert!(
+        refusal(&overlap).contains("both hold pass 0"),
+        "{}",
+        refusal(&overlap)
+    );
+    let fine = write("fine.exr", &scene, other_shard, 4, &none);
+    let ours = Part::read(&base).expect("reads");
+    ours.check_joins(&base, &Part::read(&fine).expect("reads"), &fine)
+        .expect("the other shard joins");
+    // What is not a part says so.
+    let half = dir.path().join("half.exr");
+    std::fs::write(&half, &std::fs::read(&fine).expect("read")[..1000]).expect("write");
+    let e = Part::read(&half).expect_err("half a file").to_string();
+    assert!(e.contains("half.exr") && e.contains("not a readable EXR"), "{e}");
+}
+
+#[test]
+fn the_global_schedule_converges_to_the_per_point_image() {
+    let mut global = sheet(48, true);
+    global.params.photons_per_pass = 40_000;
+    let mut per_point = global.clone();
+    per_point.params.radius_schedule = RadiusSchedule::PerPoint;
+    let render = |scene: &Scene| {
+        let mut ppm = Ppm::new(scene, PpmOptions::default());
+        ppm.photons_per_pass = scene.params.photons_per_pass;
+        for _ in 0..48 {
+            ppm.run_pass(scene, &mut |_| Control::Continue);
+        }
+        let image = ppm.radiance();
+        image.iter().map(|p| (p[0] + p[1] + p[2]) as f64).sum::<f64>() / image.len() as f64
+    };
+    let (g, p) = (render(&global), render(&per_point));
+    assert!((g / p - 1.0).abs() < 0.01, "global {g} vs per-point {p}");
+}
+
+#[test]
+fn the_command_line_shards_merges_refuses_and_renders_a_merge_again() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = |name: &str| dir.path().join(name).display().to_string();
+    let render = |shard: &str, out: &str| {
+        let args = [
+            "render",
+            "scenes/inline_patch.toml",
+            "--shard",
+            shard,
+            "--passes",
+            "5",
+            "--width",
+            "32",
+            "--photons",
+            "20000",
+            "--min-photons-per-pixel",
+            "0",
+            "--out",
+            out,
+        ];
+        let run = caustic(&args);
+        assert!(run.status.success(), "{}", text(&run));
+    };
+    for k in 0..3 {
+        render(&format!("{k}/3"), &d(&format!("part_{k}.exr")));
+    }
+    let merge = caustic(&[
+        "merge",
+        &d("part_0.exr"),
+        &d("part_1.exr"),
+        &d("part_2.exr"),
+        "--out",
+        &d("image.exr"),
+    ]);
+    assert!(merge.status.success(), "{}", text(&merge));
+    assert!(text(&merge).contains("5 of 5 passes"), "{}", text(&merge));
+    // Missing a part: refused unless --partial.
+    let partial = caustic(&["merge", &d("part_0.exr"), &d("part_2.exr"), "--out", &d("p.exr")]);
+    assert!(!partial.status.success());
+    assert!(
+        text(&partial).contains("hold 3 of the render's 5 passes (missing: 1, 4)"),
+        "{}",
+        text(&partial)
+    );
+    // Overlapping parts: refused, naming both files.
+    let twice = caustic(&["merge", &d("image.exr"), &d("part_1.exr"), "--out", &d("t.exr")]);
+    assert!(!twice.status.success());
+    assert!(
+        text(&twice).contains("part_1.exr: the pass lists overlap: both hold pass 1"),
+        "{}",
+        text(&twice)
+    );
+    // The merge rendered again from what it records: the same pixels.
+    let again = caustic(&["render", "--from", &d("image.exr"), "--out", &d("again.exr")]);
+    assert!(again.status.success(), "{}", text(&again));
+    let pixels = |p: &str| image::open(p).expect("EXR opens").to_rgb32f().into_raw();
+    assert_eq!(pixels(&d("again.exr")), pixels(&d("image.exr")));
+    // And the one-process shard 0/1 has the same sums.
+    render("0/1", &d("one.exr"));
+    let one = Part::read(Path::new(&d("one.exr"))).expect("reads");
+    let merged = Part::read(Path::new(&d("image.exr"))).expect("reads");
+    assert_eq!(one.sums, merged.sums);
+}
