@@ -96,8 +96,12 @@ mod tests {
     #[test]
     fn parse_names_what_is_wrong() {
         assert_eq!(Shard::parse("2/4"), Ok(Shard { index: 2, count: 4 }));
-        assert!(Shard::parse("4/4").expect_err("refused").contains("K must be below N"));
-        assert!(Shard::parse("0/0").expect_err("refused").contains("N must be at least 1"));
+        assert!(Shard::parse("4/4")
+            .expect_err("refused")
+            .contains("K must be below N"));
+        assert!(Shard::parse("0/0")
+            .expect_err("refused")
+            .contains("N must be at least 1"));
         assert!(Shard::parse("x/2").expect_err("refused").contains("whole number"));
         assert!(Shard::parse("3").expect_err("refused").contains("expected K/N"));
     }
