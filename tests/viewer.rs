@@ -697,3 +697,82 @@ fn the_replace_and_restart_questions_answer_enter_and_escape() {
         assert_eq!(restarted, restarts, "{key:?}");
     }
 }
+
+/// Part `k` of `n` of a `total`-pass global-schedule render of `scene`, written to `path`.
+fn write_part(scene: &Scene, k: u32, n: u32, total: u32, path: &Path) {
+    use caustic::render::shard::{Part, Shard};
+    let mut scene = scene.clone();
+    scene.params.radius_schedule = caustic::settings::RadiusSchedule::Global;
+    let shard = Shard { index: k, count: n };
+    let mut ppm = Ppm::new(
+        &scene,
+        PpmOptions {
+            shard,
+            ..Default::default()
+        },
+    );
+    ppm.photons_per_pass = scene.params.photons_per_pass;
+    for _ in 0..shard.passes_of(total) {
+        ppm.run_pass(&scene, &mut |_| Control::Continue);
+    }
+    let sums = ppm.pass_sums().expect("global").clone();
+    let settings = toml::to_string(&scene.params).expect("settings");
+    let metadata = caustic::render::image_metadata(&scene, "ppm", None);
+    Part::new(sums, total, metadata, settings)
+        .write(path, true)
+        .expect("writes");
+}
+
+#[test]
+fn watching_a_folder_merges_each_new_part_and_skips_what_does_not_belong() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scene = ball();
+    write_part(&scene, 0, 3, 6, &dir.path().join("part_0.exr"));
+    let mut h = harness(ball(), false);
+    viewer_mut(&mut h).watch_folder(dir.path().to_path_buf());
+    step_until(&mut h, "the first part", |v| {
+        v.watching().is_some_and(|w| w.passes == 2) && v.frame().is_some_and(|f| f.pass == 2)
+    });
+    let w = viewer(&h).watching().expect("watching").clone();
+    assert_eq!((w.total, w.parts), (6, 1));
+    assert!(w.relative_error.is_some_and(|e| e > 0.0 && e.is_finite()));
+    assert!(viewer(&h).params.paused, "the renderer pauses while watching");
+    // A new part lands: the image now holds 4 passes.
+    write_part(&scene, 1, 3, 6, &dir.path().join("part_1.exr"));
+    step_until(&mut h, "the second part", |v| {
+        v.frame().is_some_and(|f| f.pass == 4)
+    });
+    let frame = viewer(&h).frame().expect("frame");
+    assert!(
+        frame.radiance.iter().any(|p| p[0] > 0.0),
+        "the merged image is not black"
+    );
+    h.get_by_label("Render folder");
+    // A part of another render (another α) is skipped with a message in the status bar.
+    let mut other = ball();
+    other.params.alpha = 0.5;
+    write_part(&other, 2, 3, 6, &dir.path().join("part_x.exr"));
+    step_until(
+        &mut h,
+        "the foreign part's message",
+        |v| matches!(v.status(), Some(Status::Error(s)) if s.contains("part_x.exr: not merged: render settings differ: alpha 0.7 and 0.5")),
+    );
+    // Half a file (a copy in progress) too.
+    let whole = std::fs::read(dir.path().join("part_1.exr")).expect("read");
+    std::fs::write(dir.path().join("part_y.exr"), &whole[..whole.len() / 2]).expect("write");
+    step_until(
+        &mut h,
+        "the half file's message",
+        |v| matches!(v.status(), Some(Status::Error(s)) if s.contains("part_y.exr: not a readable EXR")),
+    );
+    assert_eq!(
+        viewer(&h).watching().map(|w| w.passes),
+        Some(4),
+        "neither was merged"
+    );
+    h.get_by_label("Stop watching").click();
+    h.step();
+    h.step();
+    assert!(viewer(&h).watching().is_none());
+    assert!(!viewer(&h).params.paused, "rendering again");
+}

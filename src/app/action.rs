@@ -31,6 +31,12 @@ pub enum Action {
     PickScene,
     /// Open a scene file (asks first when there are unsaved edits).
     OpenScene(PathBuf),
+    /// Show the folder dialog for a render folder to watch.
+    PickWatchFolder,
+    /// Watch this render folder: show its parts merged as they land (`view --watch`).
+    WatchFolder(PathBuf),
+    /// Stop watching the render folder and render the scene again.
+    StopWatching,
     /// Show the open dialog for a reference image (.exr, .pfm).
     PickReference,
     /// Compare with this reference image.

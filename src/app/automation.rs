@@ -28,6 +28,8 @@ pub struct LaunchOptions {
     pub launched: Instant,
     /// A reference image to compare with from the start.
     pub reference: Option<crate::render::compare::Reference>,
+    /// A render folder to watch from the start (`view --watch`).
+    pub watch: Option<PathBuf>,
 }
 
 impl Default for LaunchOptions {
@@ -39,6 +41,7 @@ impl Default for LaunchOptions {
             bench: false,
             launched: Instant::now(),
             reference: None,
+            watch: None,
         }
     }
 }

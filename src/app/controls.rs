@@ -82,6 +82,22 @@ fn file_menu_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Action>) 
         out.push(Action::SendToTev(crate::tev::DEFAULT_ADDRESS.into()));
     }
     ui.separator();
+    if viewer.watching().is_some() {
+        if ui
+            .button("Stop watching")
+            .on_hover_text("Stop merging the render folder's parts and render the scene again")
+            .clicked()
+        {
+            out.push(Action::StopWatching);
+        }
+    } else if ui
+        .button("Watch a render folder...")
+        .on_hover_text("Show the parts a farm writes into a folder (caustic render --shard), merged as they land, with the passes done and the error estimate")
+        .clicked()
+    {
+        out.push(Action::PickWatchFolder);
+    }
+    ui.separator();
     if ui
         .button("Open reference...")
         .on_hover_text("Compare with a reference image (.exr or .pfm of the render's size): the true error in the plot, difference views and A/B; you can also drop one on the window")
@@ -225,6 +241,10 @@ pub fn status_ui(viewer: &ViewerState, ui: &mut egui::Ui) {
 
 /// Parameters, actions, statistics and the convergence plot.
 pub fn side_panel_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Action>) {
+    if let Some(w) = viewer.watching() {
+        watching_ui(w, ui, out);
+        ui.separator();
+    }
     let mut p = viewer.params.clone();
     render_section_ui(viewer, &mut p, ui, out);
     photon_mapping_section_ui(&mut p, viewer.ranges, ui);
@@ -715,4 +735,30 @@ fn replace_question(ctx: &egui::Context, id: &'static str, text: &str) -> Option
         no: "Cancel",
     }
     .ask(ctx)
+}
+
+/// The watched render folder: passes done out of the total, parts, error estimate.
+fn watching_ui(w: &super::watch::WatchSummary, ui: &mut egui::Ui, out: &mut Vec<Action>) {
+    ui.heading("Render folder");
+    ui.label(RichText::new(w.dir.display().to_string()).weak())
+        .on_hover_text("The folder whose parts are merged as they land");
+    if w.total == 0 {
+        ui.label("Waiting for the first part...");
+    } else {
+        let done = w.passes as f32 / w.total as f32;
+        ui.add(egui::ProgressBar::new(done).text(format!("{} of {} passes", w.passes, w.total)))
+            .on_hover_text("Passes merged out of the render's total");
+        ui.label(format!("{} parts, {} photons", w.parts, w.photons));
+        let error = w
+            .relative_error
+            .map_or("error estimate after two passes".to_owned(), |e| {
+                format!("error estimate {:.2} %", 100.0 * e)
+            });
+        ui.label(error).on_hover_text(
+            "Relative RMS error of the image, estimated from the spread of its independent passes",
+        );
+    }
+    if ui.button("Stop watching").clicked() {
+        out.push(Action::StopWatching);
+    }
 }

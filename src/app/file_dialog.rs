@@ -30,6 +30,8 @@ pub struct FileRequest {
     pub file_name: Option<String>,
     /// A save dialog (a new file name) rather than an open one (an existing file).
     pub save: bool,
+    /// A folder is chosen, not a file (`save` is then ignored).
+    pub folder: bool,
 }
 
 /// How a native dialog is shown: returns the chosen path, or `None` for a cancel or when it
@@ -52,7 +54,9 @@ pub fn rfd_dialog(request: &FileRequest) -> Option<PathBuf> {
     if let Some(dir) = &request.directory {
         dialog = dialog.set_directory(dir);
     }
-    if request.save {
+    if request.folder {
+        dialog.pick_folder()
+    } else if request.save {
         dialog.save_file()
     } else {
         dialog.pick_file()
@@ -252,6 +256,15 @@ impl InWindow {
     /// Takes the file name as the answer, or explains why not.
     fn confirm(&mut self) {
         let name = self.name.trim();
+        if self.request.folder {
+            let path = self.folder.join(name);
+            if path.is_dir() {
+                self.answer = Some(Some(path));
+            } else {
+                self.message = Some(format!("{}: no such folder", path.display()));
+            }
+            return;
+        }
         if name.is_empty() {
             self.message = Some("type a file name, or pick one above".to_owned());
             return;
@@ -348,7 +361,11 @@ impl InWindow {
             ui.colored_label(ui.visuals().warn_fg_color, message);
         }
         ui.horizontal(|ui| {
-            let verb = if self.request.save { "Save" } else { "Open" };
+            let verb = match (self.request.folder, self.request.save) {
+                (true, _) => "Choose this folder",
+                (false, true) => "Save",
+                (false, false) => "Open",
+            };
             confirm |= ui.button(verb).clicked();
             if ui.button("Cancel").clicked() {
                 self.answer = Some(None);
@@ -394,6 +411,7 @@ mod tests {
             directory: Some(dir.path().to_path_buf()),
             file_name: Some("fr".into()),
             save: true,
+            folder: false,
         });
         // The text file is filtered out; folders come first.
         let names: Vec<&str> = w.entries.iter().map(|e| e.name.as_str()).collect();

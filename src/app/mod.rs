@@ -19,6 +19,7 @@
 //!   one can be shown) and file writes off the UI thread; [`tev_send`]: the frame
 //!   to a running tev.
 //! - [`keys`], [`settings`], [`automation`]: shortcuts, stored preferences, scripted runs.
+//! - [`watch`]: a render folder's parts merged as a farm writes them (`view --watch`).
 
 pub mod action;
 mod apply;
@@ -46,6 +47,8 @@ pub mod state;
 pub mod tev_send;
 pub mod view_input;
 pub mod viewer;
+pub mod watch;
+mod watch_folder;
 
 use std::path::PathBuf;
 
@@ -88,6 +91,7 @@ impl eframe::App for CausticApp {
 /// closes. A scene that fails to load is reported in the window over the built-in scene.
 pub fn run(scene_path: Option<PathBuf>, mut launch: LaunchOptions) -> anyhow::Result<()> {
     let reference = launch.reference.take();
+    let watch = launch.watch.take();
     let (scene, error) = match &scene_path {
         None => (Scene::builtin(), None),
         Some(p) => match Scene::load(p) {
@@ -133,6 +137,9 @@ pub fn run(scene_path: Option<PathBuf>, mut launch: LaunchOptions) -> anyhow::Re
             }
             if let Some(r) = reference {
                 viewer.set_reference(r);
+            }
+            if let Some(dir) = watch {
+                viewer.watch_folder(dir);
             }
             Ok(Box::new(CausticApp {
                 viewer,

@@ -30,6 +30,7 @@ impl Viewer {
             directory: self.settings.last_directory.clone(),
             file_name: None,
             save: false,
+            folder: false,
         };
         let native = self.native_dialog();
         self.reference.picking = Some(FileDialog::open(

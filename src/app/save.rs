@@ -85,6 +85,7 @@ impl SaveFlow {
             directory,
             file_name: Some(file_name),
             save: true,
+            folder: false,
         };
         let dialog = FileDialog::open("caustic-save-dialog", ctx, native, request);
         self.dialog = Some((dialog, snapshot));

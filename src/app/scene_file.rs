@@ -81,6 +81,7 @@ impl Viewer {
             directory: self.settings.last_directory.clone(),
             file_name: Some(name),
             save: true,
+            folder: false,
         };
         let native = self.native_dialog();
         self.scene_dialog = Some(FileDialog::open(

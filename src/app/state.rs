@@ -70,9 +70,16 @@ pub struct ViewerState {
     pub(super) confirm_restart: bool,
     /// The reference image compared with, and its loading.
     pub(super) reference: ReferenceState,
+    /// The render folder being watched, where it stands (`None`: not watching).
+    pub(super) watching: Option<super::watch::WatchSummary>,
 }
 
 impl ViewerState {
+    /// The render folder being watched and where it stands.
+    pub fn watching(&self) -> Option<&super::watch::WatchSummary> {
+        self.watching.as_ref()
+    }
+
     /// The state of a viewer that has just opened `scene` (parameters as in its file, with
     /// `paused`), with `settings` from storage.
     pub(super) fn new(scene: Scene, settings: ViewerSettings, paused: bool) -> Self {
@@ -100,6 +107,7 @@ impl ViewerState {
             allow_close: false,
             confirm_restart: false,
             reference: ReferenceState::default(),
+            watching: None,
             scene,
         }
     }

@@ -53,6 +53,14 @@ pub struct Viewer {
     pub(super) scene_dialog: Option<FileDialog>,
     /// A frame being sent to tev.
     pub(super) tev: TevSend,
+    /// The render folder being watched ([`super::watch`]).
+    pub(super) watch: Option<super::watch::FolderWatch>,
+    /// The folder dialog for a render folder to watch.
+    pub(super) watch_picking: Option<FileDialog>,
+    /// The part whose scene the viewer shows while watching.
+    pub(super) watch_scene_from: Option<PathBuf>,
+    /// Added to watched images' epochs, so they follow the session's frames.
+    pub(super) watch_epoch_base: u64,
 }
 
 impl std::ops::Deref for Viewer {
@@ -115,6 +123,10 @@ impl Viewer {
             overlay_installed: false,
             scene_dialog: None,
             tev: TevSend::default(),
+            watch: None,
+            watch_picking: None,
+            watch_scene_from: None,
+            watch_epoch_base: 0,
         }
     }
 
@@ -200,8 +212,18 @@ impl Viewer {
 
     /// Replaces the scene (a successful open).
     fn replace_scene(&mut self, scene: Scene) {
+        self.replace_scene_with(scene, false);
+    }
+
+    /// Replaces the scene with its renderer paused (a watched render's scene).
+    pub(super) fn replace_scene_paused(&mut self, scene: Scene) {
+        self.replace_scene_with(scene, true);
+    }
+
+    fn replace_scene_with(&mut self, scene: Scene, paused: bool) {
         let scene = photon_mapped(scene);
         self.params = PanelParams::from_scene(&scene);
+        self.params.paused = paused;
         self.ranges = Ranges::for_scene(&scene);
         self.editor = Editor::new(&scene);
         self.projection = None;
@@ -232,6 +254,7 @@ impl Viewer {
             directory: self.settings.last_directory.clone(),
             file_name: None,
             save: false,
+            folder: false,
         };
         self.picking = Some(FileDialog::open(
             "caustic-open-dialog",
@@ -372,6 +395,7 @@ impl Viewer {
         }
         self.poll_scene_dialog();
         self.poll_reference();
+        self.poll_watch();
         if let Some(status) = self.tev.poll() {
             self.status = Some(status);
         }
@@ -501,6 +525,7 @@ impl Viewer {
             self.picking.as_ref(),
             self.scene_dialog.as_ref(),
             self.reference.picking.as_ref(),
+            self.watch_picking.as_ref(),
             self.save.file_dialog(),
         ]
         .into_iter()
@@ -527,7 +552,11 @@ impl Viewer {
     fn central_ui(&mut self, ui: &mut egui::Ui, actions: &mut Vec<Action>) {
         let Some(frame) = &self.frame else {
             self.probe = None;
-            let text = if self.params.paused {
+            let waiting;
+            let text = if let Some(w) = &self.watching {
+                waiting = format!("Watching {}: waiting for the first part...", w.dir.display());
+                waiting.as_str()
+            } else if self.params.paused {
                 "Paused before the first pass: press Space or Resume"
             } else {
                 "Rendering the first pass..."

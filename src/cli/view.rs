@@ -33,6 +33,11 @@ pub struct ViewArgs {
     /// in the convergence plot, the difference views and the A/B toggle (B).
     #[arg(long, value_name = "FILE")]
     pub reference: Option<PathBuf>,
+    /// Watch a render folder instead of rendering: the parts `caustic render --shard` writes
+    /// there (by a Slurm or Kubernetes farm) are merged and shown as they land, with the
+    /// passes done and the error estimate.
+    #[arg(long, value_name = "DIR", conflicts_with = "scene")]
+    pub watch: Option<PathBuf>,
 }
 
 /// Opens the viewer (only with the `viewer` feature).
@@ -46,7 +51,13 @@ pub fn view(args: ViewArgs, launched: std::time::Instant) -> Result<()> {
         bench,
         threads: _,
         reference,
+        watch,
     } = args;
+    if let Some(dir) = &watch {
+        if !dir.is_dir() {
+            bail!("--watch {}: no such folder", dir.display());
+        }
+    }
     let reference = reference
         .map(|p| caustic::render::compare::Reference::open(&p))
         .transpose()?;
@@ -65,6 +76,7 @@ pub fn view(args: ViewArgs, launched: std::time::Instant) -> Result<()> {
         bench,
         launched,
         reference,
+        watch,
     };
     caustic::app::run(scene, launch)
 }

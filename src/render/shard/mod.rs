@@ -1,6 +1,6 @@
 //! Rendering in independent passes, split across processes or machines: which passes a
 //! shard renders ([`Shard`]), their exact sums ([`PassSums`]), the part file a shard writes and
-//! the merge of parts ([`part`]).
+//! the merge of parts ([`part`]) and of a folder's parts as they land ([`folder`]).
 //!
 //! With the global radius schedule (Knaus & Zwicker 2011, "Progressive photon mapping: a
 //! probabilistic approach"; [`crate::settings::RadiusSchedule::Global`]) every pass `i` is an
@@ -9,9 +9,11 @@
 //! sums over the number of passes. Sums are kept in fixed point ([`sums`]), so adding them
 //! in any order gives the same bits: `N` merged shards equal one process, bit for bit.
 
+pub mod folder;
 pub mod part;
 pub mod sums;
 
+pub use folder::{FolderMerge, ScanReport};
 pub use part::{MergeError, Part, PartError};
 pub use sums::PassSums;
 

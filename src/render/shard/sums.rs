@@ -176,22 +176,22 @@ impl PassSums {
 
     /// The estimated relative error of the image: the root mean square over pixels of the
     /// standard error of each pixel's mean luminance (from the passes' spread, which is
-    /// known because they are independent), over the image's mean luminance. `None` with fewer
-    /// than two passes or a black image.
+    /// known because they are independent), over the root mean square of the luminance — the
+    /// measure of [`crate::render::error::relative_error_estimate`]. `None` with fewer than two
+    /// passes or a black image.
     pub fn relative_error(&self) -> Option<f64> {
         let n = self.passes.len() as f64;
         if n < 2.0 {
             return None;
         }
-        let (mut variance, mut mean) = (0.0, 0.0);
+        let (mut variance, mut square) = (0.0, 0.0);
         for (s, sq) in self.rgb.iter().zip(&self.lum2) {
             let m = luminance(DVec3::new(real(s[0]), real(s[1]), real(s[2]))) / n;
             let sample_variance = ((real(*sq) / n - m * m) * n / (n - 1.0)).max(0.0);
             variance += sample_variance / n;
-            mean += m;
+            square += m * m;
         }
-        let pixels = self.rgb.len().max(1) as f64;
-        (mean > 0.0).then(|| (variance / pixels).sqrt() / (mean / pixels))
+        (square > 0.0).then(|| (variance / square).sqrt())
     }
 }
 
