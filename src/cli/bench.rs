@@ -70,6 +70,9 @@ pub enum BenchCommand {
     /// Photon mapping: resident memory (current and peak) of a long stochastic render (open
     /// aperture), sampled every --every passes.
     Memory(super::memory::MemoryArgs),
+    /// Sharded rendering: each shard's time and peak memory, the merge's over all parts, and
+    /// the projected wall time of a long render on many machines.
+    Shards(super::bench_shards::ShardsArgs),
     /// What exact patches buy: ray-traced renders with exact patches (prepared and per-ray)
     /// and with patches tessellated at several resolutions, timed, with each one's RMSE
     /// against the exact render (CSV and a log-log plot on request).
@@ -102,6 +105,7 @@ impl BenchCommand {
             BenchCommand::Convergence(args) => args.threads.threads,
             BenchCommand::Edit(args) => args.threads.threads,
             BenchCommand::Memory(args) => args.threads.threads,
+            BenchCommand::Shards(args) => args.threads.threads,
             BenchCommand::Tessellation(args) => args.threads.threads,
             _ => None,
         }
@@ -116,6 +120,7 @@ pub fn bench(what: BenchCommand, json: bool) -> Result<()> {
         BenchCommand::Convergence(_) => "convergence",
         BenchCommand::Edit(_) => "edit",
         BenchCommand::Memory(_) => "memory",
+        BenchCommand::Shards(_) => "shards",
         BenchCommand::Whitted { .. } => "whitted",
         BenchCommand::Tessellation(_) => "tessellation",
     };
@@ -143,6 +148,7 @@ pub fn bench(what: BenchCommand, json: bool) -> Result<()> {
             threads,
         } => bench_whitted(scene.as_deref(), width, &threads, &mut out),
         BenchCommand::Memory(args) => super::memory::bench_memory(args, &mut out),
+        BenchCommand::Shards(args) => super::bench_shards::bench_shards(args, &mut out),
         BenchCommand::Tessellation(args) => super::tessellation::bench_tessellation(args, &mut out),
         BenchCommand::Ppm {
             scene,

@@ -17,7 +17,7 @@ use caustic::bench::reference::{default_cache_dir, ReferenceRecord};
 use caustic::render::ppm::Ppm;
 use caustic::render::session::SessionOptions;
 use caustic::scene::{RendererKind, Scene};
-use caustic::settings::IndexKind;
+use caustic::settings::{IndexKind, RadiusSchedule};
 use caustic::settings::RenderParams;
 
 /// A configuration measured: the scene's parameters with one thing changed.
@@ -57,6 +57,9 @@ pub enum Config {
     /// reference.
     #[value(name = "path")]
     PathTracer,
+    /// The defaults with the global radius schedule (Knaus & Zwicker 2011): every pass an
+    /// independent estimate, as sharded renders need.
+    GlobalSchedule,
 }
 
 impl Config {
@@ -75,6 +78,7 @@ impl Config {
             Config::RadiusX4 => "initial radius x4",
             Config::KdTree => "kd-tree",
             Config::PathTracer => "path tracer",
+            Config::GlobalSchedule => "default, global radius schedule",
         }
     }
 
@@ -109,6 +113,7 @@ impl Config {
             Config::RadiusX4 => p.initial_radius = Some(4.0 * auto_radius),
             Config::KdTree => p.index = IndexKind::KdTree,
             Config::PathTracer => p.renderer = RendererKind::Path,
+            Config::GlobalSchedule => p.radius_schedule = RadiusSchedule::Global,
         }
         p
     }

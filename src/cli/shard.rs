@@ -16,19 +16,9 @@ use caustic::scene::{RendererKind, Scene};
 use caustic::settings::RadiusSchedule;
 
 /// Renders shard `shard` of a `total`-pass render of `scene` into the part file `out`.
-pub fn render_shard(
-    scene: &mut Scene,
-    shard: Shard,
-    total: u32,
-    args: &PpmArgs,
-    out: &Path,
-    force: bool,
-) -> Result<()> {
+pub fn render_shard(scene: &mut Scene, shard: Shard, total: u32, args: &PpmArgs, out: &Path, force: bool) -> Result<()> {
     if !out.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr")) {
-        bail!(
-            "{}: a shard is written as an EXR part file (use .exr)",
-            out.display()
-        );
+        bail!("{}: a shard is written as an EXR part file (use .exr)", out.display());
     }
     if args.time_limit.is_some() {
         bail!("--time-limit cannot be used with --shard: a part holds whole passes, chosen by their number");
@@ -37,16 +27,38 @@ pub fn render_shard(
         bail!("--passes must be at least 1");
     }
     args.overlay(&mut scene.params)?;
+    if !force && out.exists() {
+        bail!("{}: the file exists; choose another name or pass --force to overwrite it", out.display());
+    }
+    let start = Instant::now();
+    let count = shard.passes_of(total);
+    let bar = indicatif::ProgressBar::new(count as u64).with_style(
+        indicatif::ProgressStyle::with_template("{msg} [{bar:40}] pass {pos}/{len}, {elapsed} (eta {eta})")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    bar.set_message(format!(
+        "shard {shard} of {total} passes, {}x{}",
+        scene.camera.width, scene.camera.height
+    ));
+    let (part, photons) = shard_part(scene, shard, total, || bar.inc(1))?;
+    bar.finish_and_clear();
+    part.write(out, force)?;
+    println!(
+        "shard {shard}: {count} of {total} passes, {photons} photons in {:.2} s ({:.2} passes/s) → {}",
+        start.elapsed().as_secs_f64(),
+        count as f64 / start.elapsed().as_secs_f64().max(1e-9),
+        out.display()
+    );
+    Ok(())
+}
+
+/// Renders shard `shard` of a `total`-pass render of `scene` (photon mapping with the global
+/// schedule, whatever the scene says), calling `pass_done` after each pass: its part, and the
+/// photons it emitted.
+pub fn shard_part(scene: &mut Scene, shard: Shard, total: u32, mut pass_done: impl FnMut()) -> Result<(Part, u64)> {
     // A shard is photon mapping with the global schedule, whatever the scene's renderer.
     scene.params.renderer = RendererKind::Ppm;
     scene.params.radius_schedule = RadiusSchedule::Global;
-    if !force && out.exists() {
-        bail!(
-            "{}: the file exists; choose another name or pass --force to overwrite it",
-            out.display()
-        );
-    }
-    let start = Instant::now();
     let mut ppm = Ppm::new(
         scene,
         PpmOptions {
@@ -55,41 +67,30 @@ pub fn render_shard(
         },
     );
     let (w, h) = ppm.size();
-    ppm.photons_per_pass = scene
-        .params
-        .pass_photons(ppm.is_stochastic(), w as u64 * h as u64);
-    let count = shard.passes_of(total);
-    let bar = indicatif::ProgressBar::new(count as u64).with_style(
-        indicatif::ProgressStyle::with_template("{msg} [{bar:40}] pass {pos}/{len}, {elapsed} (eta {eta})")
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-    );
-    bar.set_message(format!("shard {shard} of {total} passes, {w}x{h}"));
-    for _ in 0..count {
+    ppm.photons_per_pass = scene.params.pass_photons(ppm.is_stochastic(), w as u64 * h as u64);
+    for _ in 0..shard.passes_of(total) {
         if ppm.run_pass(scene, &mut |_| Control::Continue) != PassOutcome::Completed {
             bail!("pass abandoned");
         }
-        bar.inc(1);
+        pass_done();
     }
-    bar.finish_and_clear();
-    let sums = ppm
-        .pass_sums()
-        .cloned()
-        .context("the global schedule keeps sums")?;
+    let sums = ppm.pass_sums().cloned().context("the global schedule keeps sums")?;
     let settings = toml::to_string(&scene.params).context("writing the settings")?;
     let mut metadata = image_metadata(scene, RendererKind::Ppm.name(), None);
     metadata.push(("caustic:shard".into(), shard.to_string()));
-    let part = Part::new(sums, total, metadata, settings);
-    part.write(out, force)?;
-    let s = ppm.stats();
-    println!(
-        "shard {shard}: {} of {total} passes, {} photons in {:.2} s ({:.2} passes/s) → {}",
-        count,
-        s.photons,
-        start.elapsed().as_secs_f64(),
-        count as f64 / start.elapsed().as_secs_f64().max(1e-9),
-        out.display()
-    );
-    Ok(())
+    Ok((Part::new(sums, total, metadata, settings), ppm.stats().photons))
+}
+
+/// The parts at `paths` merged (in order), refusing parts of other renders and overlapping
+/// passes.
+pub fn merge_parts(paths: &[PathBuf]) -> Result<Part> {
+    let (first, rest) = paths.split_first().context("no parts given")?;
+    let mut merged = Part::read(first)?;
+    for path in rest {
+        let part = Part::read(path)?;
+        merged.merge(first, &part, path)?;
+    }
+    Ok(merged)
 }
 
 /// `caustic merge`'s flags.
@@ -124,13 +125,7 @@ pub fn merge(args: MergeArgs) -> Result<()> {
     }
     args.overwrite.check([args.out.as_path()])?;
     let start = Instant::now();
-    let mut parts = args.parts.iter();
-    let first = parts.next().context("no parts given")?;
-    let mut merged = Part::read(first)?;
-    for path in parts {
-        let part = Part::read(path)?;
-        merged.merge(first, &part, path)?;
-    }
+    let merged = merge_parts(&args.parts)?;
     let (done, total) = (merged.sums.passes().len(), merged.total_passes);
     if !merged.is_complete() && !args.partial {
         bail!(
