@@ -17,8 +17,8 @@ use caustic::bench::reference::{default_cache_dir, ReferenceRecord};
 use caustic::render::ppm::Ppm;
 use caustic::render::session::SessionOptions;
 use caustic::scene::{RendererKind, Scene};
-use caustic::settings::{IndexKind, RadiusSchedule};
 use caustic::settings::RenderParams;
+use caustic::settings::{IndexKind, RadiusSchedule};
 
 /// A configuration measured: the scene's parameters with one thing changed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]

@@ -69,7 +69,10 @@ pub fn bench_shards(args: ShardsArgs, out: &mut BenchOutput) -> Result<()> {
     }
     let passes = args.passes.unwrap_or(args.parts);
     if passes < args.parts {
-        bail!("--passes {passes} is fewer than --parts {}: some parts would be empty", args.parts);
+        bail!(
+            "--passes {passes} is fewer than --parts {}: some parts would be empty",
+            args.parts
+        );
     }
     let mut scene = load_scene(args.scene.as_deref())?;
     for (flag, v) in [("--width", args.width), ("--height", args.height)] {

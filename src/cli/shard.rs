@@ -16,9 +16,19 @@ use caustic::scene::{RendererKind, Scene};
 use caustic::settings::RadiusSchedule;
 
 /// Renders shard `shard` of a `total`-pass render of `scene` into the part file `out`.
-pub fn render_shard(scene: &mut Scene, shard: Shard, total: u32, args: &PpmArgs, out: &Path, force: bool) -> Result<()> {
+pub fn render_shard(
+    scene: &mut Scene,
+    shard: Shard,
+    total: u32,
+    args: &PpmArgs,
+    out: &Path,
+    force: bool,
+) -> Result<()> {
     if !out.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr")) {
-        bail!("{}: a shard is written as an EXR part file (use .exr)", out.display());
+        bail!(
+            "{}: a shard is written as an EXR part file (use .exr)",
+            out.display()
+        );
     }
     if args.time_limit.is_some() {
         bail!("--time-limit cannot be used with --shard: a part holds whole passes, chosen by their number");
@@ -28,7 +38,10 @@ pub fn render_shard(scene: &mut Scene, shard: Shard, total: u32, args: &PpmArgs,
     }
     args.overlay(&mut scene.params)?;
     if !force && out.exists() {
-        bail!("{}: the file exists; choose another name or pass --force to overwrite it", out.display());
+        bail!(
+            "{}: the file exists; choose another name or pass --force to overwrite it",
+            out.display()
+        );
     }
     let start = Instant::now();
     let count = shard.passes_of(total);
@@ -55,7 +68,12 @@ pub fn render_shard(scene: &mut Scene, shard: Shard, total: u32, args: &PpmArgs,
 /// Renders shard `shard` of a `total`-pass render of `scene` (photon mapping with the global
 /// schedule, whatever the scene says), calling `pass_done` after each pass: its part, and the
 /// photons it emitted.
-pub fn shard_part(scene: &mut Scene, shard: Shard, total: u32, mut pass_done: impl FnMut()) -> Result<(Part, u64)> {
+pub fn shard_part(
+    scene: &mut Scene,
+    shard: Shard,
+    total: u32,
+    mut pass_done: impl FnMut(),
+) -> Result<(Part, u64)> {
     // A shard is photon mapping with the global schedule, whatever the scene's renderer.
     scene.params.renderer = RendererKind::Ppm;
     scene.params.radius_schedule = RadiusSchedule::Global;
@@ -67,14 +85,19 @@ pub fn shard_part(scene: &mut Scene, shard: Shard, total: u32, mut pass_done: im
         },
     );
     let (w, h) = ppm.size();
-    ppm.photons_per_pass = scene.params.pass_photons(ppm.is_stochastic(), w as u64 * h as u64);
+    ppm.photons_per_pass = scene
+        .params
+        .pass_photons(ppm.is_stochastic(), w as u64 * h as u64);
     for _ in 0..shard.passes_of(total) {
         if ppm.run_pass(scene, &mut |_| Control::Continue) != PassOutcome::Completed {
             bail!("pass abandoned");
         }
         pass_done();
     }
-    let sums = ppm.pass_sums().cloned().context("the global schedule keeps sums")?;
+    let sums = ppm
+        .pass_sums()
+        .cloned()
+        .context("the global schedule keeps sums")?;
     let settings = toml::to_string(&scene.params).context("writing the settings")?;
     let mut metadata = image_metadata(scene, RendererKind::Ppm.name(), None);
     metadata.push(("caustic:shard".into(), shard.to_string()));

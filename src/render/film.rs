@@ -204,18 +204,7 @@ pub fn read_metadata(path: &Path) -> Result<Metadata, String> {
         Some(Format::Exr) => {
             let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| e.to_string())?;
             let header = meta.headers.first().ok_or("the file has no image")?;
-            let mut pairs: Metadata = header
-                .own_attributes
-                .other
-                .iter()
-                .filter_map(|(k, v)| match v {
-                    exr::meta::attribute::AttributeValue::Text(t) => Some((
-                        String::from_utf8_lossy(k.bytes()).into_owned(),
-                        String::from_utf8_lossy(t.bytes()).into_owned(),
-                    )),
-                    _ => None,
-                })
-                .collect();
+            let mut pairs = exr_text_attributes(header.own_attributes.other.iter());
             pairs.sort();
             Ok(pairs)
         }
@@ -239,6 +228,26 @@ pub fn read_metadata(path: &Path) -> Result<Metadata, String> {
         }
         None => Err("not a .png or .exr file".into()),
     }
+}
+
+/// The string attributes among an EXR header's `attributes`, as UTF-8 pairs (in their order).
+pub fn exr_text_attributes<'a>(
+    attributes: impl Iterator<
+        Item = (
+            &'a exr::meta::attribute::Text,
+            &'a exr::meta::attribute::AttributeValue,
+        ),
+    >,
+) -> Metadata {
+    attributes
+        .filter_map(|(k, v)| match v {
+            exr::meta::attribute::AttributeValue::Text(t) => Some((
+                String::from_utf8_lossy(k.bytes()).into_owned(),
+                String::from_utf8_lossy(t.bytes()).into_owned(),
+            )),
+            _ => None,
+        })
+        .collect()
 }
 
 /// The names of the channels of an EXR file (sorted, as OpenEXR stores them).

@@ -115,15 +115,9 @@ impl Ppm {
             vp.radius2 = self.slots[vp.slot as usize].reach2();
         }
         self.stats.eye_secs += start.elapsed().as_secs_f64();
-        let index = self.build_index();
-        if self.interrupted() {
-            return PassOutcome::Aborted;
-        }
-        let photon_start = Instant::now();
-        let Some(gathered) = self.photon_pass(scene, &index, control) else {
+        let Some(gathered) = self.gather(scene, control) else {
             return PassOutcome::Aborted;
         };
-        self.stats.photon_secs += photon_start.elapsed().as_secs_f64();
         self.area_direct.iter_mut().for_each(|a| *a = DVec3::ZERO);
         self.sample_area_lights(scene);
         // This pass's estimate per pixel.

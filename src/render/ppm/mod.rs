@@ -310,19 +310,30 @@ impl Ppm {
             }
         }
         self.stats.eye_secs += start.elapsed().as_secs_f64();
-        let index = self.build_index();
-        if self.interrupted() {
-            return PassOutcome::Aborted;
-        }
-        let photon_start = Instant::now();
-        let Some(gathered) = self.photon_pass(scene, &index, control) else {
+        let Some(gathered) = self.gather(scene, control) else {
             return PassOutcome::Aborted;
         };
-        self.stats.photon_secs += photon_start.elapsed().as_secs_f64();
         self.sample_area_lights(scene);
         self.update(gathered);
         self.stats.elapsed_secs += start.elapsed().as_secs_f64();
         PassOutcome::Completed
+    }
+
+    /// Builds the index over this pass's visible points and traces its photons: what they
+    /// handed each slot (`None` when the pass was interrupted or aborted).
+    fn gather(
+        &mut self,
+        scene: &Scene,
+        control: &mut dyn FnMut(&mut f64) -> Control,
+    ) -> Option<photon_pass::Gathered> {
+        let index = self.build_index();
+        if self.interrupted() {
+            return None;
+        }
+        let start = Instant::now();
+        let gathered = self.photon_pass(scene, &index, control)?;
+        self.stats.photon_secs += start.elapsed().as_secs_f64();
+        Some(gathered)
     }
 
     /// The spatial index over this pass's visible points.

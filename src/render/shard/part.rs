@@ -15,7 +15,7 @@
 use std::path::{Path, PathBuf};
 
 use super::sums::{parse_passes, passes_text, PassSums, SumsClash};
-use crate::render::film::Metadata;
+use crate::render::film::{exr_text_attributes, Metadata};
 use crate::render::provenance;
 
 /// Marks a part file (its format version).
@@ -261,19 +261,8 @@ impl Part {
         let image = exr::prelude::read_first_flat_layer_from_file(path)
             .map_err(|e| error(format!("not a readable EXR image (half written?): {e}")))?;
         let layer = &image.layer_data;
-        let mut metadata: Metadata = layer
-            .attributes
-            .other
-            .iter()
-            .chain(image.attributes.other.iter())
-            .filter_map(|(k, v)| match v {
-                exr::meta::attribute::AttributeValue::Text(t) => Some((
-                    String::from_utf8_lossy(k.bytes()).into_owned(),
-                    String::from_utf8_lossy(t.bytes()).into_owned(),
-                )),
-                _ => None,
-            })
-            .collect();
+        let mut metadata =
+            exr_text_attributes(layer.attributes.other.iter().chain(image.attributes.other.iter()));
         metadata.sort();
         metadata.dedup_by(|a, b| a.0 == b.0);
         let get = |key: &str| metadata.iter().find(|(k, _)| k == key).map(|(_, v)| v.as_str());
