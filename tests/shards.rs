@@ -279,3 +279,42 @@ fn the_command_line_shards_merges_refuses_and_renders_a_merge_again() {
     let merged = Part::read(Path::new(&d("image.exr"))).expect("reads");
     assert_eq!(one.sums, merged.sums);
 }
+
+#[test]
+fn a_watched_folder_merges_new_parts_ignores_hidden_and_redundant_ones_and_rebuilds_after_a_rewrite() {
+    use caustic::render::shard::FolderMerge;
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scene = sheet(24, true);
+    let total = 6;
+    let write = |k: u32, name: &str| {
+        let sums = shard_sums(&scene, Shard { index: k, count: 3 }, total);
+        part(&scene, sums, total).write(&dir.path().join(name), true).expect("writes");
+    };
+    let mut folder = FolderMerge::new();
+    write(0, "part_0.exr");
+    // A part being written under its temporary name is not read.
+    std::fs::write(dir.path().join(".part_1.exr.partial"), b"half").expect("write");
+    let report = folder.scan(dir.path()).expect("scans");
+    assert!(report.changed && report.skipped.is_empty(), "{report:?}");
+    assert_eq!(folder.merged().map(|p| p.sums.passes().to_vec()), Some(vec![0, 3]));
+    // Nothing new: nothing changes.
+    assert!(!folder.scan(dir.path()).expect("scans").changed);
+    write(1, "part_1.exr");
+    write(2, "part_2.exr");
+    assert!(folder.scan(dir.path()).expect("scans").changed);
+    let all = folder.merged().expect("merged").clone();
+    assert!(all.is_complete());
+    assert_eq!(all.sums, shard_sums(&scene, Shard::default(), total));
+    // The farm's own merge beside its parts adds nothing and is not an error.
+    all.write(&dir.path().join("image.exr"), false).expect("writes");
+    let report = folder.scan(dir.path()).expect("scans");
+    assert!(!report.changed && report.skipped.is_empty(), "{report:?}");
+    assert_eq!(folder.parts_merged(), 3);
+    // A part rewritten in place (a shard run again): everything is merged again, same sums.
+    std::thread::sleep(std::time::Duration::from_millis(20));
+    write(1, "part_1.exr");
+    let generation = folder.generation();
+    assert!(folder.scan(dir.path()).expect("scans").changed);
+    assert!(folder.generation() > generation);
+    assert_eq!(folder.merged().map(|p| &p.sums), Some(&all.sums));
+}
