@@ -268,6 +268,27 @@ fn the_command_line_shards_merges_refuses_and_renders_a_merge_again() {
         "{}",
         text(&twice)
     );
+    // A missing part, and flags that report on a whole render, are refused.
+    let missing = caustic(&["merge", &d("part_0.exr"), &d("nope.exr"), "--out", &d("m.exr")]);
+    assert!(
+        text(&missing).contains("nope.exr: no such file"),
+        "{}",
+        text(&missing)
+    );
+    let json = caustic(&[
+        "render",
+        "scenes/inline_patch.toml",
+        "--shard",
+        "0/2",
+        "--json",
+        "--out",
+        &d("j.exr"),
+    ]);
+    assert!(
+        !json.status.success() && text(&json).contains("merge the parts"),
+        "{}",
+        text(&json)
+    );
     // The merge rendered again from what it records: the same pixels.
     let again = caustic(&["render", "--from", &d("image.exr"), "--out", &d("again.exr")]);
     assert!(again.status.success(), "{}", text(&again));
@@ -288,7 +309,9 @@ fn a_watched_folder_merges_new_parts_ignores_hidden_and_redundant_ones_and_rebui
     let total = 6;
     let write = |k: u32, name: &str| {
         let sums = shard_sums(&scene, Shard { index: k, count: 3 }, total);
-        part(&scene, sums, total).write(&dir.path().join(name), true).expect("writes");
+        part(&scene, sums, total)
+            .write(&dir.path().join(name), true)
+            .expect("writes");
     };
     let mut folder = FolderMerge::new();
     write(0, "part_0.exr");
@@ -296,7 +319,10 @@ fn a_watched_folder_merges_new_parts_ignores_hidden_and_redundant_ones_and_rebui
     std::fs::write(dir.path().join(".part_1.exr.partial"), b"half").expect("write");
     let report = folder.scan(dir.path()).expect("scans");
     assert!(report.changed && report.skipped.is_empty(), "{report:?}");
-    assert_eq!(folder.merged().map(|p| p.sums.passes().to_vec()), Some(vec![0, 3]));
+    assert_eq!(
+        folder.merged().map(|p| p.sums.passes().to_vec()),
+        Some(vec![0, 3])
+    );
     // Nothing new: nothing changes.
     assert!(!folder.scan(dir.path()).expect("scans").changed);
     write(1, "part_1.exr");

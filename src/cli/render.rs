@@ -202,6 +202,9 @@ pub fn render(args: RenderArgs) -> Result<()> {
     let mut report = Report::new(args.json);
     let (mut scene, recorded, exposure) = scene_to_render(&args, &mut report)?;
     if let Some(shard) = args.shard {
+        if args.reference.is_some() || args.tev.is_some() || args.json {
+            bail!("--reference, --tev and --json report on a whole render: merge the parts, then compare or view the merged image");
+        }
         let total = args
             .ppm
             .passes

@@ -258,6 +258,9 @@ impl Part {
             path: path.to_owned(),
             message,
         };
+        if !path.is_file() {
+            return Err(error("no such file".into()));
+        }
         let image = exr::prelude::read_first_flat_layer_from_file(path)
             .map_err(|e| error(format!("not a readable EXR image (half written?): {e}")))?;
         let layer = &image.layer_data;
