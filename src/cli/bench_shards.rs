@@ -3,7 +3,7 @@
 //! merge's time and peak memory over all the parts, and from them the wall time of a render of
 //! any length on any number of machines.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
@@ -13,6 +13,7 @@ use super::load_scene;
 use super::shard::{merge_parts, shard_part};
 use super::shared_args::Threads;
 use caustic::render::shard::Shard;
+use caustic::scene::Scene;
 
 /// `bench shards`'s flags.
 #[derive(clap::Args)]
@@ -62,6 +63,62 @@ fn reset_peak() {
     let _ = std::fs::write("/proc/self/clear_refs", "5");
 }
 
+/// What rendering the parts took.
+struct Rendered {
+    /// The part files, in shard order.
+    paths: Vec<PathBuf>,
+    /// Seconds, all shards together.
+    secs: f64,
+    /// The largest peak resident memory of a shard, MiB.
+    peak: f64,
+    /// Passes rendered (without the pilots).
+    passes: u32,
+}
+
+/// Renders the `parts` shards of a `passes`-pass render of `scene` one after another into
+/// `dir`, printing each one's figures.
+fn render_parts(
+    scene: &Scene,
+    parts: u32,
+    passes: u32,
+    dir: &Path,
+    out: &mut BenchOutput,
+) -> Result<Rendered> {
+    let mut done = Rendered {
+        paths: Vec::new(),
+        secs: 0.0,
+        peak: 0.0,
+        passes: 0,
+    };
+    for k in 0..parts {
+        let shard = Shard {
+            index: k,
+            count: parts,
+        };
+        reset_peak();
+        let start = Instant::now();
+        let mut scene = scene.clone();
+        let (part, photons) = shard_part(&mut scene, shard, passes, || {})?;
+        let secs = start.elapsed().as_secs_f64();
+        let peak = peak_mib().unwrap_or(0.0);
+        let path = dir.join(format!("part_{k}.exr"));
+        part.write(&path, true)?;
+        let count = shard.passes_of(passes);
+        out.say(format!(
+            "  shard {shard}: {count} passes (and the pilot) in {secs:.2} s, {photons} photons, peak {peak:.0} MiB"
+        ));
+        out.push(
+            "shards",
+            serde_json::json!({ "shard": shard.to_string(), "passes": count, "seconds": secs, "photons": photons, "peak_mib": peak }),
+        );
+        done.secs += secs;
+        done.peak = done.peak.max(peak);
+        done.passes += count;
+        done.paths.push(path);
+    }
+    Ok(done)
+}
+
 /// Renders the parts, merges them, prints the figures.
 pub fn bench_shards(args: ShardsArgs, out: &mut BenchOutput) -> Result<()> {
     if args.parts == 0 || args.project_machines == 0 || args.project_passes == 0 {
@@ -104,34 +161,23 @@ pub fn bench_shards(args: ShardsArgs, out: &mut BenchOutput) -> Result<()> {
     out.set("size", [args.width, args.height]);
     out.set("parts", args.parts);
     out.set("passes", passes);
-    let mut paths = Vec::new();
-    let (mut render_secs, mut shard_peak, mut rendered) = (0.0, 0.0f64, 0u32);
-    for k in 0..args.parts {
-        let shard = Shard {
-            index: k,
-            count: args.parts,
-        };
-        reset_peak();
-        let start = Instant::now();
-        let mut scene = scene.clone();
-        let (part, photons) = shard_part(&mut scene, shard, passes, || {})?;
-        let secs = start.elapsed().as_secs_f64();
-        let peak = peak_mib().unwrap_or(0.0);
-        let path = dir.join(format!("part_{k}.exr"));
-        part.write(&path, true)?;
-        let count = shard.passes_of(passes);
-        out.say(format!(
-            "  shard {shard}: {count} passes (and the pilot) in {secs:.2} s, {photons} photons, peak {peak:.0} MiB"
-        ));
-        out.push(
-            "shards",
-            serde_json::json!({ "shard": shard.to_string(), "passes": count, "seconds": secs, "photons": photons, "peak_mib": peak }),
-        );
-        render_secs += secs;
-        shard_peak = shard_peak.max(peak);
-        rendered += count;
-        paths.push(path);
+    let rendered = render_parts(&scene, args.parts, passes, &dir, out)?;
+    merge_and_project(&args, rendered, &dir, out)?;
+    if temporary {
+        let _ = std::fs::remove_dir_all(&dir);
     }
+    Ok(())
+}
+
+/// Merges the parts, prints the merge's time and peak memory and the projection of
+/// `--project-passes` passes on `--project-machines` machines.
+fn merge_and_project(args: &ShardsArgs, rendered: Rendered, dir: &Path, out: &mut BenchOutput) -> Result<()> {
+    let Rendered {
+        paths,
+        secs: render_secs,
+        peak: shard_peak,
+        passes: rendered,
+    } = rendered;
     reset_peak();
     let start = Instant::now();
     let merged = merge_parts(&paths)?;
@@ -167,8 +213,5 @@ pub fn bench_shards(args: ShardsArgs, out: &mut BenchOutput) -> Result<()> {
     out.set("merge_peak_mib", merge_peak);
     out.set("part_mib", part_mib);
     out.set("projected_seconds", projected);
-    if temporary {
-        let _ = std::fs::remove_dir_all(&dir);
-    }
     Ok(())
 }

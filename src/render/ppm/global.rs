@@ -97,9 +97,26 @@ impl Ppm {
         if self.interrupted() || (self.stochastic && !self.trace_stochastic_eye_pass(scene)) {
             return PassOutcome::Aborted;
         }
-        let Some(g) = &self.global else {
+        self.schedule_radii(pass);
+        self.stats.eye_secs += start.elapsed().as_secs_f64();
+        let Some(gathered) = self.gather(scene, control) else {
             return PassOutcome::Aborted;
         };
+        self.area_direct.iter_mut().for_each(|a| *a = DVec3::ZERO);
+        self.sample_area_lights(scene);
+        let values = self.pass_values(&gathered.phi);
+        if let Some(g) = &mut self.global {
+            g.sums.add_pass(pass as u32, &values, self.pass_photons);
+            g.done += 1;
+        }
+        self.count_pass(gathered.counts);
+        self.stats.elapsed_secs += start.elapsed().as_secs_f64();
+        PassOutcome::Completed
+    }
+
+    /// Every slot's estimates emptied and set to pass `pass`'s radii, `r_1² ·` [`schedule_factor`].
+    fn schedule_radii(&mut self, pass: u64) {
+        let Some(g) = &self.global else { return };
         let factor = schedule_factor(pass, g.alpha);
         for (s, &(primary, indirect)) in self.slots.iter_mut().zip(&g.pilot) {
             s.primary = Estimate {
@@ -114,56 +131,52 @@ impl Ppm {
         for vp in &mut self.points {
             vp.radius2 = self.slots[vp.slot as usize].reach2();
         }
-        self.stats.eye_secs += start.elapsed().as_secs_f64();
-        let Some(gathered) = self.gather(scene, control) else {
-            return PassOutcome::Aborted;
-        };
-        self.area_direct.iter_mut().for_each(|a| *a = DVec3::ZERO);
-        self.sample_area_lights(scene);
-        // This pass's estimate per pixel.
+    }
+
+    /// This pass's estimate per pixel: the flux `phi` each slot's estimates gathered over
+    /// `π r² N_emitted`, plus the light the pass saw directly.
+    fn pass_values(&self, phi: &[glam::Vec3]) -> Vec<DVec3> {
         let emitted = self.pass_photons as f64;
         let mut values = vec![DVec3::ZERO; self.direct.len()];
         for (k, s) in self.slots.iter().enumerate() {
             let primary = Estimate {
-                tau: gathered.phi[2 * k].as_dvec3(),
+                tau: phi[2 * k].as_dvec3(),
                 ..s.primary
             };
             let indirect = Estimate {
-                tau: gathered.phi[2 * k + 1].as_dvec3(),
+                tau: phi[2 * k + 1].as_dvec3(),
                 ..s.indirect
             };
             values[s.pixel as usize] += primary.radiance(emitted) + indirect.radiance(emitted);
         }
-        let Some(g) = &mut self.global else {
-            return PassOutcome::Aborted;
-        };
-        let seen = if self.stochastic {
-            &self.pass_direct
-        } else {
-            &g.classic_direct
+        let seen = match (&self.global, self.stochastic) {
+            (_, true) => &self.pass_direct,
+            (Some(g), false) => &g.classic_direct,
+            (None, false) => &self.direct,
         };
         for (i, v) in values.iter_mut().enumerate() {
             *v += seen[i] + self.area_direct.get(i).copied().unwrap_or_default();
         }
-        g.sums.add_pass(pass as u32, &values, self.pass_photons);
-        g.done += 1;
-        let counts = gathered.counts;
-        self.stats.passes += 1;
+        values
+    }
+
+    /// A completed pass in the statistics.
+    fn count_pass(&mut self, counts: super::photon::PhotonCounts) {
+        let s = &mut self.stats;
+        s.passes += 1;
         if self.stochastic {
-            self.stats.eye_passes += 1;
+            s.eye_passes += 1;
         }
-        self.stats.photons += self.pass_photons;
-        self.stats.bounces += counts.bounces;
-        self.stats.deposits += counts.deposits;
-        self.stats.useful_paths += counts.useful;
-        self.stats.visible_points = self.points.len();
+        s.photons += self.pass_photons;
+        s.bounces += counts.bounces;
+        s.deposits += counts.deposits;
+        s.useful_paths += counts.useful;
+        s.visible_points = self.points.len();
         let radii = self.slots.iter().filter(|s| s.primary.radius2 > 0.0);
         let (sum, n) = radii.fold((0.0, 0usize), |(sum, n), s| {
             (sum + s.primary.radius2.sqrt(), n + 1)
         });
-        self.stats.mean_radius = sum / n.max(1) as f64;
-        self.stats.elapsed_secs += start.elapsed().as_secs_f64();
-        PassOutcome::Completed
+        s.mean_radius = sum / n.max(1) as f64;
     }
 
     /// After the pilot pass: each slot's `r_1` (the initial radius, narrowed where the pilot

@@ -290,37 +290,7 @@ impl Part {
             .and_then(|v| v.parse::<u64>().ok())
             .ok_or_else(|| error(format!("its {PART_PHOTONS} is missing or not a number")))?;
         let (w, h) = (layer.size.0, layer.size.1);
-        let n = w * h;
-        let channel = |name: &str| -> Result<&Vec<u32>, PartError> {
-            let c = layer
-                .channel_data
-                .list
-                .iter()
-                .find(|c| c.name.to_string() == name)
-                .ok_or_else(|| error(format!("channel {name} is missing")))?;
-            match &c.sample_data {
-                exr::prelude::FlatSamples::U32(v) if v.len() == n => Ok(v),
-                _ => Err(error(format!("channel {name} is not {n} u32 samples"))),
-            }
-        };
-        let mut quantities: Vec<Vec<i128>> = Vec::with_capacity(4);
-        for quantity in QUANTITIES {
-            let words: Vec<&Vec<u32>> = (0..4)
-                .map(|w| channel(&format!("caustic.sum.{quantity}.w{w}")))
-                .collect::<Result<_, _>>()?;
-            quantities.push(
-                (0..n)
-                    .map(|i| {
-                        let bits = (0..4).fold(0u128, |acc, w| acc | (words[w][i] as u128) << (32 * w));
-                        bits as i128
-                    })
-                    .collect(),
-            );
-        }
-        let lum2 = quantities.pop().unwrap_or_default();
-        let rgb: Vec<[i128; 3]> = (0..n)
-            .map(|i| [quantities[0][i], quantities[1][i], quantities[2][i]])
-            .collect();
+        let (rgb, lum2) = read_sums(&layer.channel_data, w * h).map_err(error)?;
         let sums = PassSums::from_parts((w as u32, h as u32), rgb, lum2, passes, photons)
             .ok_or_else(|| error("its sums do not match its size".into()))?;
         Ok(Part {
@@ -329,6 +299,38 @@ impl Part {
             metadata,
         })
     }
+}
+
+/// The fixed-point sums in a part's `caustic.sum.*` channels, `n` pixels each: Σ RGB and
+/// Σ luminance²; the error names a missing or malformed channel.
+fn read_sums(
+    channels: &exr::prelude::AnyChannels<exr::prelude::FlatSamples>,
+    n: usize,
+) -> Result<(Vec<[i128; 3]>, Vec<i128>), String> {
+    let channel = |name: &str| -> Result<&Vec<u32>, String> {
+        let c = channels
+            .list
+            .iter()
+            .find(|c| c.name.to_string() == name)
+            .ok_or_else(|| format!("channel {name} is missing"))?;
+        match &c.sample_data {
+            exr::prelude::FlatSamples::U32(v) if v.len() == n => Ok(v),
+            _ => Err(format!("channel {name} is not {n} u32 samples")),
+        }
+    };
+    let mut quantities: Vec<Vec<i128>> = Vec::with_capacity(4);
+    for quantity in QUANTITIES {
+        let words: Vec<&Vec<u32>> = (0..4)
+            .map(|w| channel(&format!("caustic.sum.{quantity}.w{w}")))
+            .collect::<Result<_, _>>()?;
+        let word = |i: usize| (0..4).fold(0u128, |acc, w| acc | (words[w][i] as u128) << (32 * w)) as i128;
+        quantities.push((0..n).map(word).collect());
+    }
+    let lum2 = quantities.pop().unwrap_or_default();
+    let rgb = (0..n)
+        .map(|i| [quantities[0][i], quantities[1][i], quantities[2][i]])
+        .collect();
+    Ok((rgb, lum2))
 }
 
 /// What differs between two `[render]` tables: the first keys whose lines differ.
