@@ -6,13 +6,15 @@
 //!   eye pass traces the same eye rays as the previous epoch's last one (the random streams
 //!   continue, [`StreamOffset`]); a pixel whose points come out where they were (or moved by
 //!   at most [`NEAR`] of their radius, facing the same way) keeps its slots: radius, photon
-//!   count `N`, and its flux as a *prior* worth at most [`PRIOR_PASSES`] full passes of
-//!   photons ([`Slot::prior`]), and the light it saw directly, worth as many passes. The prior
+//!   count `N`, and its flux as a *prior* worth at most [`PRIOR_PASSES`] times the epoch's
+//!   first pass of photons ([`Slot::prior`]; with the viewer's photon ramp that first pass is
+//!   16,384 photons, so the prior is a fraction of a full pass), and the light it saw
+//!   directly, worth [`PRIOR_PASSES`] passes. The prior
 //!   is counted like photons emitted before the epoch, so the estimate
 //!   `τ/(πR²(N_emitted + prior))` starts at the previous image and the epoch's own photons take
 //!   over as they come: where the edit changed the light (a moved caustic or shadow), the old
-//!   light's share after `k` full passes is at most `PRIOR_PASSES/(PRIOR_PASSES + k)`, and the
-//!   converged image is the edited scene's.
+//!   light's share after the epoch has emitted `k` first passes' worth of photons is at most
+//!   `PRIOR_PASSES/(PRIOR_PASSES + k)`, and the converged image is the edited scene's.
 //! - **Estimates near a moved point.** A point that moved further (the edited surface, what is
 //!   seen through or in it) takes the previous estimate of the nearest point of any pixel
 //!   whose radius holds it and that faces the same way, the flux scaled by the ratio of the
@@ -38,9 +40,13 @@ use rayon::prelude::*;
 use crate::geometry::Aabb;
 use crate::scene::Scene;
 
-/// The most a kept pixel's previous estimate counts for, in full passes of photons: after `k`
-/// passes of the new epoch the old light's share is at most `PRIOR_PASSES/(PRIOR_PASSES + k)`.
-/// Chosen with `caustic bench edit` on `scenes/inline_patch.toml` (time to relative MSE 1e-2
+/// The most a kept pixel's previous estimate counts for, in passes of the epoch's first pass's
+/// photons (the photon ramp's first pass in the viewer, 16,384 photons: on
+/// `scenes/inline_patch.toml` at 480×360 the prior is then 131,072 photons, 0.19 of a full
+/// pass). Measured again on 2026-12-01 (release, medians of 5, a machine about 25 % slower
+/// than before): a prior of 32,768 photons 0.87 s, 65,536 0.86 s, 131,072 (this) 0.67–0.77 s,
+/// 700,000 0.87 s, 2,000,000 1.21 s, cold 0.80–0.93 s; a smaller cap only for the caustic
+/// (primary) estimate did not help (0.65–0.69 s). Chosen with `caustic bench edit` on `scenes/inline_patch.toml` (time to relative MSE 1e-2
 /// after the edit; development build, medians of 3 runs: 2 passes 0.71 s, 4 passes 0.63 s,
 /// 8 passes 0.55 s, cold 0.62–0.69 s; release, medians of 5: 8 passes 0.51–0.56 s, 12 passes
 /// 0.54 s, 16 passes 0.53 s, cold 0.62–0.67 s): a smaller prior lets the new photons' noise at
@@ -278,7 +284,7 @@ impl Ppm {
 
     /// After the first eye pass of an inheriting epoch: every pixel whose visible points are
     /// where they were (or moved by at most [`NEAR`] of their radius) keeps its slots'
-    /// statistics, the flux capped to a prior of [`PRIOR_PASSES`] full passes. Returns the
+    /// statistics, the flux capped to a prior of [`PRIOR_PASSES`] first passes. Returns the
     /// share of pixels kept.
     pub(super) fn keep_unmoved(&mut self) -> f64 {
         let Some(warm) = &self.inherited else {
