@@ -92,7 +92,8 @@ pub struct Frame {
     /// Search radius per pixel (largest of the pixel's slots), for the viewer's probe; zeros
     /// for renderers without one.
     pub radius: Arc<[f32]>,
-    /// Accumulated photon count `N` per pixel (summed over the pixel's slots), or samples.
+    /// Accumulated photon count `N` per pixel (summed over the pixel's slots; with the global
+    /// radius schedule, the photons its last pass gathered), or samples.
     pub gathered: Arc<[f32]>,
     /// A quick low-resolution preview of a new epoch (pass 0), enlarged to full size.
     pub preview: bool,

@@ -245,6 +245,31 @@ mod tests {
     }
 
     #[test]
+    fn with_the_global_schedule_alpha_and_photons_restart_too() {
+        let old = RenderParams {
+            radius_schedule: RadiusSchedule::Global,
+            ..Default::default()
+        };
+        for changed in [
+            RenderParams {
+                alpha: 0.5,
+                ..old.clone()
+            },
+            RenderParams {
+                photons_per_pass: 1000,
+                ..old.clone()
+            },
+            RenderParams {
+                radius_schedule: RadiusSchedule::PerPoint,
+                ..old.clone()
+            },
+        ] {
+            assert!(changed.restarts_from(&old), "{changed:?}");
+        }
+        assert!(!old.clone().restarts_from(&old));
+    }
+
+    #[test]
     fn stochastic_passes_trace_at_least_the_photons_per_pixel() {
         let p = RenderParams::default();
         assert_eq!(p.pass_photons(false, 1_000_000), 200_000, "classic PPM: as set");

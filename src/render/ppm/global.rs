@@ -105,6 +105,12 @@ impl Ppm {
         self.area_direct.iter_mut().for_each(|a| *a = DVec3::ZERO);
         self.sample_area_lights(scene);
         let values = self.pass_values(&gathered.phi);
+        // Each estimate's count is this pass's photons (what the probe and the photons layer
+        // show: nothing accumulates from pass to pass).
+        for (k, s) in self.slots.iter_mut().enumerate() {
+            s.primary.n = gathered.m[2 * k] as f64;
+            s.indirect.n = gathered.m[2 * k + 1] as f64;
+        }
         if let Some(g) = &mut self.global {
             g.sums.add_pass(pass as u32, &values, self.pass_photons);
             g.done += 1;
