@@ -282,7 +282,7 @@ impl Ppm {
     /// Runs one pass: eye pass if needed, photons in batches (calling `control(&mut α)`
     /// between batches; `Abort` drops the pass), then the radius/flux update.
     /// With the global radius schedule, the pass is the next of this process's shard, an
-    /// independent estimate ([`global`]).
+    /// independent estimate at the global schedule's radius ([`schedule_factor`]).
     pub fn run_pass(&mut self, scene: &Scene, control: &mut dyn FnMut(&mut f64) -> Control) -> PassOutcome {
         if self.global.is_some() {
             return self.run_global_pass(scene, control);
