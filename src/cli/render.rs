@@ -84,10 +84,10 @@ pub struct PpmArgs {
     /// Photon mapping: passes to run (default 16, or what --from records); with --shard,
     /// the passes of the whole render, of which the shard renders its own.
     #[arg(long)]
-    pub(super) passes: Option<u32>,
+    passes: Option<u32>,
     /// Photon mapping: stop after this many seconds even if passes remain.
     #[arg(long, allow_negative_numbers = true)]
-    pub(super) time_limit: Option<f64>,
+    time_limit: Option<f64>,
     /// Photon mapping: photons per pass (default: the scene's).
     #[arg(long)]
     photons: Option<u64>,
@@ -144,7 +144,7 @@ pub struct PpmArgs {
 impl PpmArgs {
     /// Lays the photon-mapping flags given over the scene's parameters and checks the result
     /// with [`RenderParams::validate`]; an error names the flag.
-    pub(super) fn overlay(&self, params: &mut RenderParams) -> Result<()> {
+    fn overlay(&self, params: &mut RenderParams) -> Result<()> {
         if let Some(p) = self.photons {
             params.photons_per_pass = p;
         }
@@ -205,12 +205,18 @@ pub fn render(args: RenderArgs) -> Result<()> {
         if args.reference.is_some() || args.tev.is_some() || args.json {
             bail!("--reference, --tev and --json report on a whole render: merge the parts, then compare or view the merged image");
         }
+        if args.ppm.time_limit.is_some() {
+            bail!(
+                "--time-limit cannot be used with --shard: a part holds whole passes, chosen by their number"
+            );
+        }
         let total = args
             .ppm
             .passes
             .or(recorded.as_ref().and_then(|r| r.passes))
             .unwrap_or(16);
-        return super::shard::render_shard(&mut scene, shard, total, &args.ppm, out, args.overwrite.force);
+        args.ppm.overlay(&mut scene.params)?;
+        return super::shard::render_shard(&mut scene, shard, total, out, args.overwrite.force);
     }
     let reference = match &args.reference {
         Some(path) => {

@@ -7,7 +7,6 @@ use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 
-use super::render::PpmArgs;
 use super::shared_args::Overwrite;
 use caustic::render::image_metadata;
 use caustic::render::ppm::{Control, PassOutcome, Ppm, PpmOptions};
@@ -15,44 +14,28 @@ use caustic::render::shard::{Part, Shard};
 use caustic::scene::{RendererKind, Scene};
 use caustic::settings::RadiusSchedule;
 
-/// Renders shard `shard` of a `total`-pass render of `scene` into the part file `out`.
-pub fn render_shard(
-    scene: &mut Scene,
-    shard: Shard,
-    total: u32,
-    args: &PpmArgs,
-    out: &Path,
-    force: bool,
-) -> Result<()> {
+/// Renders shard `shard` of a `total`-pass render of `scene` (its photon-mapping flags laid
+/// in) into the part file `out`, which `render` has checked may be written.
+pub fn render_shard(scene: &mut Scene, shard: Shard, total: u32, out: &Path, force: bool) -> Result<()> {
     if !out.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr")) {
         bail!(
             "{}: a shard is written as an EXR part file (use .exr)",
             out.display()
         );
     }
-    if args.time_limit.is_some() {
-        bail!("--time-limit cannot be used with --shard: a part holds whole passes, chosen by their number");
-    }
     if total == 0 {
         bail!("--passes must be at least 1");
     }
-    args.overlay(&mut scene.params)?;
-    if !force && out.exists() {
-        bail!(
-            "{}: the file exists; choose another name or pass --force to overwrite it",
-            out.display()
-        );
-    }
     let start = Instant::now();
     let count = shard.passes_of(total);
-    let bar = indicatif::ProgressBar::new(count as u64).with_style(
-        indicatif::ProgressStyle::with_template("{msg} [{bar:40}] pass {pos}/{len}, {elapsed} (eta {eta})")
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-    );
-    bar.set_message(format!(
-        "shard {shard} of {total} passes, {}x{}",
-        scene.camera.width, scene.camera.height
-    ));
+    let bar = super::progress_bar(
+        count as u64,
+        "{msg} [{bar:40}] pass {pos}/{len}, {elapsed} (eta {eta})",
+        format!(
+            "shard {shard} of {total} passes, {}x{}",
+            scene.camera.width, scene.camera.height
+        ),
+    )?;
     let (part, photons) = shard_part(scene, shard, total, || bar.inc(1))?;
     bar.finish_and_clear();
     part.write(out, force)?;
