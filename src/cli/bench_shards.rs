@@ -53,9 +53,7 @@ pub struct ShardsArgs {
 
 /// Peak resident memory since the last reset, in MiB (`/proc/self/status` VmHWM).
 fn peak_mib() -> Option<f64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    Some(line.split_whitespace().nth(1)?.parse::<f64>().ok()? / 1024.0)
+    super::memory::resident_mib().map(|(_, peak)| peak)
 }
 
 /// Starts a new peak-memory measurement (Linux: writing 5 to clear_refs resets VmHWM).

@@ -37,7 +37,7 @@ pub struct MemoryArgs {
 }
 
 /// Resident set size and its peak, in MiB, from `/proc/self/status` (Linux).
-fn resident_mib() -> Option<(f64, f64)> {
+pub(super) fn resident_mib() -> Option<(f64, f64)> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
     let field = |name: &str| -> Option<f64> {
         let line = status.lines().find(|l| l.starts_with(name))?;

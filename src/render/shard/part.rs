@@ -170,12 +170,7 @@ impl Part {
                 self.total_passes, other.total_passes
             )));
         }
-        if let Some(p) = other
-            .sums
-            .passes()
-            .iter()
-            .find(|p| self.sums.passes().binary_search(p).is_ok())
-        {
+        if let Some(p) = self.sums.first_shared_pass(&other.sums) {
             return Err(refuse(format!("the pass lists overlap: both hold pass {p}")));
         }
         Ok(())

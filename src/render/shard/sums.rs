@@ -116,7 +116,7 @@ impl PassSums {
                 theirs: (other.width, other.height),
             });
         }
-        if let Some(p) = first_common(&self.passes, &other.passes) {
+        if let Some(p) = self.first_shared_pass(other) {
             return Err(SumsClash::Overlap(p));
         }
         for (a, b) in self.rgb.iter_mut().zip(&other.rgb) {
@@ -131,6 +131,11 @@ impl PassSums {
         self.passes.sort_unstable();
         self.photons += other.photons;
         Ok(())
+    }
+
+    /// The first pass summed in both.
+    pub fn first_shared_pass(&self, other: &PassSums) -> Option<u32> {
+        first_common(&self.passes, &other.passes)
     }
 
     /// Image size.
