@@ -34,10 +34,8 @@ pub(super) struct Global {
     shard: Shard,
     /// α, fixed for the render.
     alpha: f64,
-    /// Per slot, the pilot's radii² `r_1²` (primary, indirect); empty before the pilot.
-    pilot: Vec<(f64, f64)>,
-    /// Classic PPM: per pixel, the light seen directly by the one eye pass.
-    classic_direct: Vec<DVec3>,
+    /// Per slot, the pilot's radii² `r_1²` (primary, indirect); `None` before the pilot.
+    pilot: Option<Vec<(f64, f64)>>,
     /// This shard's passes completed.
     done: u32,
     /// The stream position: 0 for the pilot, `i + 1` for pass `i`.
@@ -52,8 +50,7 @@ impl Global {
         Self {
             shard,
             alpha,
-            pilot: Vec::new(),
-            classic_direct: Vec::new(),
+            pilot: None,
             done: 0,
             stream: 0,
             sums: PassSums::new(width, height),
@@ -79,10 +76,8 @@ impl Ppm {
         scene: &Scene,
         control: &mut dyn FnMut(&mut f64) -> Control,
     ) -> PassOutcome {
-        if self.global.as_ref().is_some_and(|g| g.pilot.is_empty()) {
-            if let Some(g) = &mut self.global {
-                g.stream = 0;
-            }
+        if self.global.as_ref().is_some_and(|g| g.pilot.is_none()) {
+            // Stream position 0 until the pilot completes.
             if self.run_statistics_pass(scene, control) == PassOutcome::Aborted {
                 return PassOutcome::Aborted;
             }
@@ -122,9 +117,11 @@ impl Ppm {
 
     /// Every slot's estimates emptied and set to pass `pass`'s radii, `r_1² ·` [`schedule_factor`].
     fn schedule_radii(&mut self, pass: u64) {
-        let Some(g) = &self.global else { return };
+        let Some((g, pilot)) = self.global.as_ref().and_then(|g| Some((g, g.pilot.as_ref()?))) else {
+            return;
+        };
         let factor = schedule_factor(pass, g.alpha);
-        for (s, &(primary, indirect)) in self.slots.iter_mut().zip(&g.pilot) {
+        for (s, &(primary, indirect)) in self.slots.iter_mut().zip(pilot) {
             s.primary = Estimate {
                 radius2: primary * factor,
                 ..Default::default()
@@ -155,13 +152,15 @@ impl Ppm {
             };
             values[s.pixel as usize] += primary.radiance(emitted) + indirect.radiance(emitted);
         }
-        let seen = match (&self.global, self.stochastic) {
-            (_, true) => &self.pass_direct,
-            (Some(g), false) => &g.classic_direct,
-            (None, false) => &self.direct,
-        };
+        // Light seen directly: this pass's eye pass, or classic PPM's one eye pass (the pilot's).
+        let eye_passes = self.stats.eye_passes.max(1) as f64;
         for (i, v) in values.iter_mut().enumerate() {
-            *v += seen[i] + self.area_direct.get(i).copied().unwrap_or_default();
+            let seen = if self.stochastic {
+                self.pass_direct[i]
+            } else {
+                self.direct[i] / eye_passes
+            };
+            *v += seen + self.area_direct.get(i).copied().unwrap_or_default();
         }
         values
     }
@@ -186,9 +185,9 @@ impl Ppm {
     }
 
     /// After the pilot pass: each slot's `r_1` (the initial radius, narrowed where the pilot
-    /// found photons dense; the indirect estimate's chosen scale), the directly seen light of
-    /// a classic eye pass; the statistics start again at pass 0 (the pilot's time stays in
-    /// the elapsed time).
+    /// found photons dense; the indirect estimate's chosen scale); the statistics start again
+    /// at pass 0 (the pilot's time stays in the elapsed time; classic PPM keeps its one eye
+    /// pass and the light it saw directly).
     fn finish_pilot(&mut self) {
         let r0_2 = self.initial_radius2;
         let indirect = match self.indirect_scale {
@@ -210,15 +209,8 @@ impl Ppm {
         for s in &mut self.slots {
             s.restart = Restart::None;
         }
-        let classic_direct = if self.stochastic {
-            Vec::new()
-        } else {
-            let eye = self.stats.eye_passes.max(1) as f64;
-            self.direct.iter().map(|d| *d / eye).collect()
-        };
         if let Some(g) = &mut self.global {
-            g.pilot = pilot;
-            g.classic_direct = classic_direct;
+            g.pilot = Some(pilot);
         }
         let s = &mut self.stats;
         s.passes = 0;
