@@ -128,11 +128,7 @@ impl Viewer {
     fn load_watched_scene(&mut self, part: &Path) {
         match Recorded::read(part) {
             Ok(recorded) => {
-                let keep = self.watch.take();
-                let summary = self.watching.take();
                 self.replace_scene_paused(recorded.scene);
-                self.watch = keep;
-                self.watching = summary;
                 self.watch_epoch_base = 1 << 32;
             }
             Err(e) => self.status = Some(Status::Error(format!("The render's scene: {e}"))),
