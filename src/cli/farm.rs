@@ -228,7 +228,6 @@ fn kubernetes_manifest(job: &Job) -> Result<String> {
     let Some(image) = &job.image else {
         bail!("--image is required for Kubernetes: the container image the pods run");
     };
-    let q = |s: &str| serde_json::to_string(s).unwrap_or_default();
     let program = job.program.as_deref().unwrap_or("caustic");
     let scene = job.scene.display().to_string();
     let out = job.out.display().to_string();
@@ -248,69 +247,93 @@ fn kubernetes_manifest(job: &Job) -> Result<String> {
         out_q = sh(&out),
         n = job.shards,
     );
-    let volume = format!(
-        r#"          volumeMounts:
-            - name: data
-              mountPath: /data
-      volumes:
-        - name: data
-          persistentVolumeClaim:
-            claimName: {}
-"#,
-        q(&job.volume_claim)
-    );
-    Ok(format!(
+    let header = format!(
         r#"# Renders {scene} in {shards} shards of {passes} passes on Kubernetes, then merges them.
 # Written by `caustic farm kubernetes`; apply with `kubectl apply -f`. The scene and {out}
 # are paths on the PersistentVolumeClaim {claim}, mounted at /data in every pod. Parts are
 # written under a hidden name and renamed when complete, so the merge Job counts only whole
 # parts; it merges once all {shards} are there.
-apiVersion: batch/v1
-kind: Job
-metadata:
-  name: {shard_job}
-spec:
-  completions: {shards}
-  parallelism: {shards}
-  completionMode: Indexed
-  backoffLimit: {backoff}
-  template:
-    spec:
-      restartPolicy: Never
-      containers:
-        - name: shard
-          image: {image}
-          command: ["sh", "-c", {shard_command}]
-          resources:
-            requests:
-              cpu: "{threads}"
-{volume}---
-apiVersion: batch/v1
-kind: Job
-metadata:
-  name: {merge_job}
-spec:
-  backoffLimit: 3
-  template:
-    spec:
-      restartPolicy: OnFailure
-      containers:
-        - name: merge
-          image: {image}
-          command: ["sh", "-c", {merge_command}]
-          resources:
-            requests:
-              cpu: "1"
-{volume}"#,
+"#,
         shards = job.shards,
         passes = job.passes,
         claim = job.volume_claim,
-        shard_job = q(&format!("{}-shards", job.name)),
-        merge_job = q(&format!("{}-merge", job.name)),
-        backoff = 3 * job.shards,
-        image = q(image),
-        shard_command = q(&shard_command),
-        merge_command = q(&merge_command),
-        threads = job.threads,
+    );
+    let shards = PodJob {
+        name: format!("{}-shards", job.name),
+        spec: format!(
+            "  completions: {n}\n  parallelism: {n}\n  completionMode: Indexed\n  backoffLimit: {}\n",
+            3 * job.shards,
+            n = job.shards
+        ),
+        restart: "Never",
+        container: "shard",
+        command: shard_command,
+        cpu: job.threads.to_string(),
+    };
+    let merge = PodJob {
+        name: format!("{}-merge", job.name),
+        spec: "  backoffLimit: 3\n".into(),
+        restart: "OnFailure",
+        container: "merge",
+        command: merge_command,
+        cpu: "1".into(),
+    };
+    Ok(format!(
+        "{header}{}---\n{}",
+        shards.yaml(image, &job.volume_claim),
+        merge.yaml(image, &job.volume_claim)
     ))
+}
+
+/// One Job of the Kubernetes manifest: a pod of one container with the shared volume.
+struct PodJob {
+    name: String,
+    /// The Job's own `spec` lines (indented two spaces) before its template.
+    spec: String,
+    restart: &'static str,
+    container: &'static str,
+    /// The container's shell command.
+    command: String,
+    /// Its CPU request.
+    cpu: String,
+}
+
+impl PodJob {
+    /// The Job as YAML, running `image` with the PersistentVolumeClaim `claim` at /data.
+    fn yaml(&self, image: &str, claim: &str) -> String {
+        let q = |s: &str| serde_json::to_string(s).unwrap_or_default();
+        format!(
+            r#"apiVersion: batch/v1
+kind: Job
+metadata:
+  name: {name}
+spec:
+{spec}  template:
+    spec:
+      restartPolicy: {restart}
+      containers:
+        - name: {container}
+          image: {image}
+          command: ["sh", "-c", {command}]
+          resources:
+            requests:
+              cpu: "{cpu}"
+          volumeMounts:
+            - name: data
+              mountPath: /data
+      volumes:
+        - name: data
+          persistentVolumeClaim:
+            claimName: {claim}
+"#,
+            name = q(&self.name),
+            spec = self.spec,
+            restart = self.restart,
+            container = self.container,
+            image = q(image),
+            command = q(&self.command),
+            cpu = self.cpu,
+            claim = q(claim),
+        )
+    }
 }
