@@ -382,20 +382,26 @@ fn photon_mapping_section_ui(p: &mut PanelParams, ranges: Ranges, ui: &mut egui:
             .on_hover_text("Each light learns which of its photons reach what the camera sees and sends more there (weighted: the image converges to the same result). Off: lights emit as they shine. Restarts.");
         ui.checkbox(&mut p.render.stratified_eye_rays, "Stratified eye rays")
             .on_hover_text("When eye rays are jittered (anti-aliasing, depth of field), place each pixel's rays over passes by low-discrepancy sequences: the outlines of lights and the lens blur settle sooner. Off: independent random jitter. Restarts.");
-        ui.horizontal(|ui| {
-            ui.label("Radius").on_hover_text("How the search radius shrinks pass by pass. Restarts.");
-            ui.selectable_value(&mut p.render.radius_schedule, RadiusSchedule::PerPoint, "Per point")
-                .on_hover_text("Each point's photon count and flux carry from pass to pass and its radius shrinks with the photons it gathered (Hachisuka et al. 2008)");
-            ui.selectable_value(&mut p.render.radius_schedule, RadiusSchedule::Global, "Global schedule")
-                .on_hover_text("Every pass is an independent estimate at one shrinking radius (Knaus & Zwicker 2011): the passes of a render can be split across machines and merged (render --shard, caustic merge). α and the radii are fixed by a pilot pass; changing α restarts");
-        });
-        ui.horizontal(|ui| {
-            ui.label("Index").on_hover_text("Spatial index over visible points; the image is the same, the speed differs");
-            ui.selectable_value(&mut p.render.index, IndexKind::HashGrid, "Hash grid")
-                .on_hover_text("Hashed uniform grid (fastest here)");
-            ui.selectable_value(&mut p.render.index, IndexKind::KdTree, "kd-tree")
-                .on_hover_text("The seed report's kd-tree");
-        });
+        schedule_and_index_ui(p, ui);
+    });
+}
+
+/// How the radius shrinks and which index finds the visible points.
+fn schedule_and_index_ui(p: &mut PanelParams, ui: &mut egui::Ui) {
+    ui.horizontal(|ui| {
+        ui.label("Radius").on_hover_text("How the search radius shrinks pass by pass. Restarts.");
+        ui.selectable_value(&mut p.render.radius_schedule, RadiusSchedule::PerPoint, "Per point")
+            .on_hover_text("Each point's photon count and flux carry from pass to pass and its radius shrinks with the photons it gathered (Hachisuka et al. 2008)");
+        ui.selectable_value(&mut p.render.radius_schedule, RadiusSchedule::Global, "Global schedule")
+            .on_hover_text("Every pass is an independent estimate at one shrinking radius (Knaus & Zwicker 2011): the passes of a render can be split across machines and merged (render --shard, caustic merge). α and the radii are fixed by a pilot pass; changing α restarts");
+    });
+    ui.horizontal(|ui| {
+        ui.label("Index")
+            .on_hover_text("Spatial index over visible points; the image is the same, the speed differs");
+        ui.selectable_value(&mut p.render.index, IndexKind::HashGrid, "Hash grid")
+            .on_hover_text("Hashed uniform grid (fastest here)");
+        ui.selectable_value(&mut p.render.index, IndexKind::KdTree, "kd-tree")
+            .on_hover_text("The seed report's kd-tree");
     });
 }
 
