@@ -24,8 +24,9 @@ struct Seen {
 }
 
 impl Seen {
+    /// How the file at `path` looks now (`None`: not a file).
     fn of(path: &Path) -> Option<Seen> {
-        let meta = std::fs::metadata(path).ok()?;
+        let meta = std::fs::metadata(path).ok().filter(|m| m.is_file())?;
         Some(Seen {
             len: meta.len(),
             modified: meta.modified().ok(),
@@ -92,7 +93,8 @@ impl FolderMerge {
     /// Reads what is new or changed in `dir` and merges it.
     pub fn scan(&mut self, dir: &Path) -> Result<ScanReport, String> {
         let read = std::fs::read_dir(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-        let mut paths: Vec<PathBuf> = read
+        // Each file looked at once a scan.
+        let mut files: Vec<(PathBuf, Seen)> = read
             .flatten()
             .map(|e| e.path())
             .filter(|p| {
@@ -100,27 +102,26 @@ impl FolderMerge {
                     .file_name()
                     .map(|n| n.to_string_lossy().into_owned())
                     .unwrap_or_default();
-                !name.starts_with('.')
-                    && p.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"))
-                    && p.is_file()
+                !name.starts_with('.') && p.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"))
             })
+            .filter_map(|p| Some((p.clone(), Seen::of(&p)?)))
             .collect();
-        paths.sort();
+        files.sort_by(|a, b| a.0.cmp(&b.0));
         let mut report = ScanReport::default();
-        let rewritten = paths.iter().any(|p| {
-            matches!(self.files.get(p), Some((seen, Fate::Merged)) if Seen::of(p).is_some_and(|s| s != *seen))
-        }) || self
-            .files
+        let rewritten = files
             .iter()
-            .any(|(p, (_, f))| *f == Fate::Merged && !paths.contains(p));
+            .any(|(p, now)| matches!(self.files.get(p), Some((seen, Fate::Merged)) if now != seen))
+            || self
+                .files
+                .iter()
+                .any(|(p, (_, f))| *f == Fate::Merged && files.binary_search_by(|(q, _)| q.cmp(p)).is_err());
         if rewritten {
             // A merged part changed or went away: merge everything again.
             self.files.clear();
             self.merged = None;
             report.changed = true;
         }
-        for path in paths {
-            let Some(seen) = Seen::of(&path) else { continue };
+        for (path, seen) in files {
             if self.files.get(&path).is_some_and(|(s, _)| *s == seen) {
                 continue;
             }
