@@ -146,6 +146,30 @@ impl FileDialog {
     }
 }
 
+/// How a dialog ended ([`take_finished`]).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Finished {
+    /// A file (or folder) was chosen.
+    Chosen(PathBuf),
+    /// The person closed it without a choice.
+    Cancelled,
+    /// Its thread ended without an answer.
+    Lost,
+}
+
+/// The dialog in `slot` if it has ended, taken out of the slot: how it ended. `None` while it
+/// is open, or when there is none.
+pub fn take_finished(slot: &mut Option<FileDialog>) -> Option<Finished> {
+    let finished = match slot.as_ref()?.poll() {
+        Poll::Pending => return None,
+        Poll::Ready(Some(path)) => Finished::Chosen(path),
+        Poll::Ready(None) => Finished::Cancelled,
+        Poll::Lost => Finished::Lost,
+    };
+    *slot = None;
+    Some(finished)
+}
+
 /// One entry of the folder listing.
 #[derive(Clone, Debug, PartialEq)]
 struct Entry {

@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use super::file_dialog::{FileDialog, FileRequest};
+use super::file_dialog::{take_finished, FileDialog, FileRequest, Finished};
 use super::job::{Job, Poll};
 use super::state::Status;
 use super::viewer::Viewer;
@@ -59,20 +59,10 @@ impl Viewer {
 
     /// Takes a finished dialog or load; call once per UI frame.
     pub(super) fn poll_reference(&mut self) {
-        if let Some(job) = &self.reference.picking {
-            match job.poll() {
-                Poll::Pending => {}
-                Poll::Ready(choice) => {
-                    self.reference.picking = None;
-                    if let Some(path) = choice {
-                        self.open_reference(path);
-                    }
-                }
-                Poll::Lost => {
-                    self.reference.picking = None;
-                    self.status = Some(Status::Error("the file dialog failed".into()));
-                }
-            }
+        match take_finished(&mut self.reference.picking) {
+            Some(Finished::Chosen(path)) => self.open_reference(path),
+            Some(Finished::Lost) => self.status = Some(Status::Error("the file dialog failed".into())),
+            Some(Finished::Cancelled) | None => {}
         }
         let Some((job, path)) = &self.reference.loading else {
             return;

@@ -5,8 +5,7 @@
 use std::path::PathBuf;
 
 use super::action::AfterDiscard;
-use super::file_dialog::{FileDialog, FileRequest};
-use super::job::Poll;
+use super::file_dialog::{take_finished, FileDialog, FileRequest, Finished};
 use super::viewer::{Status, Viewer};
 use crate::scene::save::save_scene;
 
@@ -94,26 +93,17 @@ impl Viewer {
 
     /// Takes the answer of the "save scene as" dialog.
     pub(super) fn poll_scene_dialog(&mut self) {
-        let Some(job) = &self.scene_dialog else {
-            return;
-        };
-        match job.poll() {
-            Poll::Pending => {}
-            Poll::Ready(choice) => {
-                self.scene_dialog = None;
-                match choice {
-                    Some(path) => self.save_scene_to(path),
-                    None => {
-                        self.after_save = None;
-                        self.status = Some(Status::Info("Scene not saved".into()));
-                    }
-                }
+        match take_finished(&mut self.scene_dialog) {
+            Some(Finished::Chosen(path)) => self.save_scene_to(path),
+            Some(Finished::Cancelled) => {
+                self.after_save = None;
+                self.status = Some(Status::Info("Scene not saved".into()));
             }
-            Poll::Lost => {
-                self.scene_dialog = None;
+            Some(Finished::Lost) => {
                 self.after_save = None;
                 self.status = Some(Status::Error("the file dialog failed".into()));
             }
+            None => {}
         }
     }
 

@@ -9,7 +9,7 @@ use std::time::Instant;
 use super::action::Action;
 use super::controls;
 use super::editor::Editor;
-use super::file_dialog::{self, FileDialog, FileRequest, NativeDialog};
+use super::file_dialog::{self, FileDialog, FileRequest, Finished, NativeDialog};
 use super::image_view::{frame_image, Comparison, ImageView};
 use super::job::{Job, Poll};
 use super::keys;
@@ -352,20 +352,10 @@ impl Viewer {
         if self.render_failure.is_none() {
             self.render_failure = self.session.failure();
         }
-        if let Some(job) = &self.picking {
-            match job.poll() {
-                Poll::Pending => {}
-                Poll::Ready(choice) => {
-                    self.picking = None;
-                    if let Some(path) = choice {
-                        self.open_scene(path);
-                    }
-                }
-                Poll::Lost => {
-                    self.picking = None;
-                    self.status = Some(Status::Error("the file dialog failed".into()));
-                }
-            }
+        match file_dialog::take_finished(&mut self.picking) {
+            Some(Finished::Chosen(path)) => self.open_scene(path),
+            Some(Finished::Lost) => self.status = Some(Status::Error("the file dialog failed".into())),
+            Some(Finished::Cancelled) | None => {}
         }
         if let Some((job, path)) = &self.loading {
             let path = path.clone();

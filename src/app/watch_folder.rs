@@ -5,8 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::file_dialog::{FileDialog, FileRequest};
-use super::job::Poll;
+use super::file_dialog::{take_finished, FileDialog, FileRequest, Finished};
 use super::state::Status;
 use super::viewer::Viewer;
 use super::watch::FolderWatch;
@@ -82,20 +81,10 @@ impl Viewer {
 
     /// Takes the folder dialog's answer and the watch's updates; call once per UI frame.
     pub(super) fn poll_watch(&mut self) {
-        if let Some(job) = &self.watch_picking {
-            match job.poll() {
-                Poll::Pending => {}
-                Poll::Ready(choice) => {
-                    self.watch_picking = None;
-                    if let Some(dir) = choice {
-                        self.watch_folder(dir);
-                    }
-                }
-                Poll::Lost => {
-                    self.watch_picking = None;
-                    self.status = Some(Status::Error("the folder dialog failed".into()));
-                }
-            }
+        match take_finished(&mut self.watch_picking) {
+            Some(Finished::Chosen(dir)) => self.watch_folder(dir),
+            Some(Finished::Lost) => self.status = Some(Status::Error("the folder dialog failed".into())),
+            Some(Finished::Cancelled) | None => {}
         }
         let Some(watch) = &self.watch else { return };
         for update in watch.updates() {
