@@ -14,7 +14,7 @@ use glam::{DVec2, DVec3};
 use rand::Rng;
 use rayon::prelude::*;
 
-use super::visible::VisiblePoint;
+use super::points::VisiblePoints;
 use crate::render::rng::stream_rng;
 use crate::render::sequence;
 use crate::scene::Scene;
@@ -32,7 +32,7 @@ pub fn has_area_lights(scene: &Scene) -> bool {
 /// stably across passes (its statistics slot), for the stratification.
 pub fn area_light_pass(
     scene: &Scene,
-    points: &[VisiblePoint],
+    points: &VisiblePoints,
     key: impl Fn(usize) -> u64 + Sync,
     pass: u64,
     seed: u64,
@@ -41,23 +41,26 @@ pub fn area_light_pass(
         (0u64..).zip(&scene.lights).filter(|(_, l)| l.is_area()).collect();
     let count = scene.lights.len() as u64;
     points
+        .reach
         .par_iter()
+        .zip(&points.shade)
         .enumerate()
-        .map(|(k, vp)| {
+        .map(|(k, (reach, shade))| {
+            let (position, normal) = (reach.position, shade.normal.as_dvec3());
             let mut sum = DVec3::ZERO;
             for &(l, light) in &lights {
                 let mut rng = stream_rng(seed, OFFSET_STREAM, key(k) * count + l);
                 let offset = DVec2::new(rng.random(), rng.random());
                 let u = sequence::rotated(sequence::r4(pass)[1], offset);
-                let Some(ls) = light.sample(vp.position, u) else {
+                let Some(ls) = light.sample(position, u) else {
                     continue;
                 };
-                let cos = vp.normal.dot(ls.wi);
+                let cos = normal.dot(ls.wi);
                 if cos <= 0.0 {
                     continue;
                 }
-                if !scene.occluded_from(vp.position, vp.normal, l as usize, &ls) {
-                    sum += vp.weight * ls.incident * cos;
+                if !scene.occluded_from(position, normal, l as usize, &ls) {
+                    sum += shade.weight.as_dvec3() * ls.incident * cos;
                 }
             }
             sum

@@ -108,11 +108,6 @@ impl Slot {
             prior: 0.0,
         }
     }
-
-    /// The larger search radius², which the spatial index must reach.
-    pub(super) fn reach2(&self) -> f64 {
-        self.primary.radius2.max(self.indirect.radius2)
-    }
 }
 
 impl Ppm {

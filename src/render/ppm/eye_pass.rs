@@ -8,6 +8,7 @@ use glam::{DVec2, DVec3};
 use rand::Rng;
 use rayon::prelude::*;
 
+use super::points::{self, Shade, VisiblePoints};
 use super::visible::{trace_eye, Branching, VisiblePoint};
 
 use super::radius::IndirectScale;
@@ -16,16 +17,6 @@ use crate::render::rng::stream_rng;
 use crate::render::sequence;
 use crate::scene::camera::concentric_disk;
 use crate::scene::Scene;
-
-/// The empty visible point (no slot): a stochastic eye pass's placeholder for a pixel whose
-/// path found no diffuse surface.
-pub(super) const NO_POINT: VisiblePoint = VisiblePoint {
-    slot: u32::MAX,
-    position: DVec3::ZERO,
-    normal: DVec3::ZERO,
-    weight: DVec3::ZERO,
-    radius2: 0.0,
-};
 
 impl Ppm {
     /// Stochastic PPM's eye pass: one eye ray per pixel (jittered, through the lens), in
@@ -44,16 +35,17 @@ impl Ppm {
         let interrupt = self.interrupt.as_deref();
         let skipped = std::sync::atomic::AtomicBool::new(false);
         let pixels = (w * h) as usize;
-        self.points.clear();
-        self.points.resize(pixels, NO_POINT);
+        self.points.reset(pixels);
         self.pass_direct.clear();
         self.pass_direct.resize(pixels, DVec3::ZERO);
         let rays = scene.camera.eye_rays();
-        self.points
+        let VisiblePoints { reach, shade } = &mut self.points;
+        reach
             .par_iter_mut()
+            .zip(shade.par_iter_mut())
             .zip(self.pass_direct.par_iter_mut())
             .enumerate()
-            .for_each(|(i, (point, direct))| {
+            .for_each(|(i, ((reach, shade), direct))| {
                 if interrupt.is_some_and(|f| f()) {
                     skipped.store(true, std::sync::atomic::Ordering::Relaxed);
                     return;
@@ -80,8 +72,8 @@ impl Ppm {
                 let px = DVec2::new(x as f64, y as f64) + jitter;
                 let lens = concentric_disk(lens);
                 let mut sink = |vp: VisiblePoint| {
-                    debug_assert!(point.slot == NO_POINT.slot, "a chosen path ends once");
-                    *point = vp;
+                    debug_assert!(shade.slot == Shade::NONE, "a chosen path ends once");
+                    (*reach, *shade) = points::split(&vp);
                 };
                 *direct = trace_eye(
                     scene,
@@ -96,7 +88,7 @@ impl Ppm {
         if skipped.into_inner() {
             return false;
         }
-        self.points.retain(|p| p.slot != NO_POINT.slot);
+        self.points.drop_empty();
         true
     }
 
@@ -166,10 +158,10 @@ impl Ppm {
             for (d, p) in self.direct.iter_mut().zip(direct) {
                 *d += p;
             }
-            self.points = points;
-            for vp in &mut self.points {
-                let pixel = vp.slot;
-                vp.slot = self.slots.len() as u32;
+            self.points = points.into_iter().collect();
+            for shade in &mut self.points.shade {
+                let pixel = shade.slot;
+                shade.slot = self.slots.len() as u32;
                 self.slots.push(Slot::new(pixel));
             }
         }
@@ -192,9 +184,6 @@ impl Ppm {
         if self.stats.passes == 0 && self.inherited.is_some() {
             self.stats.kept_share = self.keep_unmoved();
         }
-        for vp in &mut self.points {
-            vp.radius2 = self.slots[vp.slot as usize].reach2();
-        }
         true
     }
 
@@ -209,12 +198,12 @@ impl Ppm {
         let light = direct::area_light_pass(
             scene,
             &self.points,
-            |k| self.points[k].slot as u64,
+            |k| self.points.shade[k].slot as u64,
             self.stream_pass(),
             self.seed,
         );
-        for (vp, l) in self.points.iter().zip(light) {
-            self.area_direct[slots[vp.slot as usize].pixel as usize] += l;
+        for (shade, l) in self.points.shade.iter().zip(light) {
+            self.area_direct[slots[shade.slot as usize].pixel as usize] += l;
         }
         self.stats.direct_secs += start.elapsed().as_secs_f64();
     }

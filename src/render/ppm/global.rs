@@ -131,9 +131,6 @@ impl Ppm {
                 ..Default::default()
             };
         }
-        for vp in &mut self.points {
-            vp.radius2 = self.slots[vp.slot as usize].reach2();
-        }
     }
 
     /// This pass's estimate per pixel: the flux `phi` each slot's estimates gathered over

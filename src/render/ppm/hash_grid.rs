@@ -6,6 +6,8 @@
 use glam::{DVec3, IVec3};
 use rayon::prelude::*;
 
+use super::points::SearchSphere;
+#[cfg(test)]
 use super::visible::VisiblePoint;
 
 /// The grid: bucket `b` holds `entries[starts[b]..starts[b + 1]]`.
@@ -30,15 +32,15 @@ fn hash(c: IVec3) -> u64 {
 
 impl HashGrid {
     /// Builds the grid over `points`, with cells as wide as the largest search diameter.
-    pub fn build(points: &[VisiblePoint]) -> Self {
+    pub fn build<P: SearchSphere + Sync>(points: &[P]) -> Self {
         if points.is_empty() {
             return Self::default();
         }
-        let max_r = points.iter().map(|p| p.radius2).fold(0.0f64, f64::max).sqrt();
+        let max_r = points.iter().map(|p| p.reach2()).fold(0.0f64, f64::max).sqrt();
         let cell = (2.0 * max_r).max(1e-12);
         let origin = points
             .iter()
-            .fold(DVec3::splat(f64::INFINITY), |m, p| m.min(p.position))
+            .fold(DVec3::splat(f64::INFINITY), |m, p| m.min(p.centre()))
             - DVec3::splat(max_r);
         let inv_cell = 1.0 / cell;
         let cell_of = |p: DVec3| ((p - origin) * inv_cell).floor().as_ivec3();
@@ -50,9 +52,9 @@ impl HashGrid {
         // bucket, and a point listed twice there would be handed a photon twice. A sphere spans
         // 2 cells per axis, 3 when rounding puts its edge a hair past a cell boundary (seen in
         // the Cornell box), so at most 27.
-        let buckets_of = |p: &VisiblePoint| -> ([u32; 27], usize) {
-            let r = p.radius2.sqrt();
-            let (lo, hi) = (cell_of(p.position - r), cell_of(p.position + r));
+        let buckets_of = |p: &P| -> ([u32; 27], usize) {
+            let (c, r) = (p.centre(), p.reach2().sqrt());
+            let (lo, hi) = (cell_of(c - r), cell_of(c + r));
             let mut b = [0u32; 27];
             let mut n = 0;
             for z in lo.z..=hi.z {

@@ -3,7 +3,7 @@
 
 use glam::DVec3;
 
-use super::visible::VisiblePoint;
+use super::points::SearchSphere;
 use super::{HashGrid, KdTree};
 
 /// A built spatial index.
@@ -17,7 +17,7 @@ pub enum SpatialIndex {
 impl SpatialIndex {
     /// Calls `f` with candidate points near `p` (the caller checks the radius).
     #[inline]
-    pub fn for_candidates(&self, points: &[VisiblePoint], p: DVec3, f: &mut impl FnMut(u32)) {
+    pub fn for_candidates<P: SearchSphere>(&self, points: &[P], p: DVec3, f: &mut impl FnMut(u32)) {
         match self {
             SpatialIndex::Grid(g) => g.candidates(p).iter().for_each(|&k| f(k)),
             SpatialIndex::Kd(t) => t.for_candidates(points, p, f),

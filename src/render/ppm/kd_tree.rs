@@ -4,7 +4,7 @@
 
 use glam::DVec3;
 
-use super::visible::VisiblePoint;
+use super::points::SearchSphere;
 
 #[derive(Clone, Copy, Debug)]
 struct Node {
@@ -22,7 +22,7 @@ pub struct KdTree {
 
 impl KdTree {
     /// Builds the tree over `points`.
-    pub fn build(points: &[VisiblePoint]) -> Self {
+    pub fn build<P: SearchSphere>(points: &[P]) -> Self {
         let mut order: Vec<u32> = (0..points.len() as u32).collect();
         let mut nodes = vec![
             Node {
@@ -38,11 +38,11 @@ impl KdTree {
 
     /// Calls `f` with every point whose search sphere's subtree bound reaches `p` (a superset:
     /// the caller checks distances).
-    pub fn for_candidates(&self, points: &[VisiblePoint], p: DVec3, f: &mut impl FnMut(u32)) {
+    pub fn for_candidates<P: SearchSphere>(&self, points: &[P], p: DVec3, f: &mut impl FnMut(u32)) {
         self.visit(points, 0, self.nodes.len(), p, f);
     }
 
-    fn visit(&self, points: &[VisiblePoint], lo: usize, hi: usize, p: DVec3, f: &mut impl FnMut(u32)) {
+    fn visit<P: SearchSphere>(&self, points: &[P], lo: usize, hi: usize, p: DVec3, f: &mut impl FnMut(u32)) {
         if lo >= hi {
             return;
         }
@@ -51,7 +51,7 @@ impl KdTree {
         if node.max_radius2 <= 0.0 {
             return;
         }
-        let split = points[node.point as usize].position[node.axis as usize];
+        let split = points[node.point as usize].centre()[node.axis as usize];
         let d = p[node.axis as usize] - split;
         let (near, far) = if d < 0.0 {
             ((lo, mid), (mid + 1, hi))
@@ -71,14 +71,14 @@ impl KdTree {
     }
 }
 
-fn build(points: &[VisiblePoint], order: &mut [u32], nodes: &mut [Node], offset: usize) -> f64 {
+fn build<P: SearchSphere>(points: &[P], order: &mut [u32], nodes: &mut [Node], offset: usize) -> f64 {
     if order.is_empty() {
         return 0.0;
     }
     let bounds = order
         .iter()
         .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &i| {
-            let p = points[i as usize].position;
+            let p = points[i as usize].centre();
             (lo.min(p), hi.max(p))
         });
     let extent = bounds.1 - bounds.0;
@@ -91,14 +91,14 @@ fn build(points: &[VisiblePoint], order: &mut [u32], nodes: &mut [Node], offset:
     };
     let mid = order.len() / 2;
     order.select_nth_unstable_by(mid, |&a, &b| {
-        points[a as usize].position[axis].total_cmp(&points[b as usize].position[axis])
+        points[a as usize].centre()[axis].total_cmp(&points[b as usize].centre()[axis])
     });
     let point = order[mid];
     let (left, rest) = order.split_at_mut(mid);
     let right = &mut rest[1..];
     let left_max = build(points, left, nodes, offset);
     let right_max = build(points, right, nodes, offset + mid + 1);
-    let max_radius2 = points[point as usize].radius2.max(left_max).max(right_max);
+    let max_radius2 = points[point as usize].reach2().max(left_max).max(right_max);
     nodes[offset + mid] = Node {
         point,
         axis: axis as u8,

@@ -26,6 +26,7 @@ mod eye_pass;
 mod global;
 mod index;
 mod photon_pass;
+mod points;
 mod radius;
 mod stats;
 
@@ -45,7 +46,7 @@ use glam::DVec3;
 use guide::EmissionGuide;
 pub use hash_grid::HashGrid;
 pub use kd_tree::KdTree;
-use visible::VisiblePoint;
+use points::VisiblePoints;
 
 use crate::render::shard::{PassSums, Shard};
 use crate::scene::Scene;
@@ -141,7 +142,8 @@ pub struct Ppm {
     pub photons_per_pass: u64,
     initial_radius: Option<f64>,
     slots: Vec<Slot>,
-    points: Vec<VisiblePoint>,
+    /// This pass's visible points (classic PPM: the one eye pass's).
+    points: VisiblePoints,
     direct: Vec<DVec3>,
     /// This stochastic pass's directly seen light, added to `direct` when the pass completes.
     pass_direct: Vec<DVec3>,
@@ -225,7 +227,7 @@ impl Ppm {
                 .pass_photons(stochastic, cam.width as u64 * cam.height as u64),
             initial_radius: scene.params.initial_radius,
             slots: Vec::new(),
-            points: Vec::new(),
+            points: VisiblePoints::default(),
             direct: vec![DVec3::ZERO; pixels],
             pass_direct: Vec::new(),
             area_direct: if scene.params.direct_light && direct::has_area_lights(scene) {
@@ -304,10 +306,6 @@ impl Ppm {
             if !self.eye_pass(scene) {
                 return PassOutcome::Aborted;
             }
-        } else {
-            for vp in &mut self.points {
-                vp.radius2 = self.slots[vp.slot as usize].reach2();
-            }
         }
         self.stats.eye_secs += start.elapsed().as_secs_f64();
         let Some(gathered) = self.gather(scene, control) else {
@@ -336,12 +334,14 @@ impl Ppm {
         Some(gathered)
     }
 
-    /// The spatial index over this pass's visible points.
+    /// The spatial index over this pass's visible points, their radii first copied from
+    /// their slots.
     fn build_index(&mut self) -> SpatialIndex {
         let start = Instant::now();
+        self.points.set_radii(&self.slots);
         let index = match self.index {
-            IndexKind::HashGrid => SpatialIndex::Grid(HashGrid::build(&self.points)),
-            IndexKind::KdTree => SpatialIndex::Kd(KdTree::build(&self.points)),
+            IndexKind::HashGrid => SpatialIndex::Grid(HashGrid::build(&self.points.reach)),
+            IndexKind::KdTree => SpatialIndex::Kd(KdTree::build(&self.points.reach)),
         };
         self.stats.index_secs += start.elapsed().as_secs_f64();
         index

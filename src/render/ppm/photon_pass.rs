@@ -27,9 +27,6 @@ pub(super) const MAX_CHUNK_DEPOSITS: usize = 1 << 20;
 /// Flux handed to a statistics slot: `(slot, flux × point weight, photon count)`.
 pub(super) type Deposit = (u32, DVec3, u32);
 
-/// A visible point's position and its estimates' radii², packed for the candidate test.
-pub(super) type Reach = [f64; 5];
-
 /// What one chunk of photons left: its deposits, counts and guide tally.
 pub(super) type ChunkResult = (Vec<Deposit>, PhotonCounts, Option<GuideTally>);
 
@@ -72,16 +69,6 @@ impl Ppm {
         control: &mut dyn FnMut(&mut f64) -> Control,
     ) -> Option<Gathered> {
         let source = PhotonSource::new(scene, self.direct_light).with_guide(self.guide.as_ref());
-        // Positions and both radii packed tightly: the candidate test reads nothing else.
-        let reach: Vec<Reach> = self
-            .points
-            .iter()
-            .map(|v| {
-                let s = &self.slots[v.slot as usize];
-                let p = v.position;
-                [p.x, p.y, p.z, s.primary.radius2, s.indirect.radius2]
-            })
-            .collect();
         let mut out = Gathered {
             phi: vec![Vec3::ZERO; 2 * self.slots.len()],
             m: vec![0u32; 2 * self.slots.len()],
@@ -99,7 +86,7 @@ impl Ppm {
             let end = (chunk + chunks_per_batch).min(chunks);
             let results: Vec<ChunkResult> = (chunk..end)
                 .into_par_iter()
-                .map(|c| self.trace_chunk(c, &source, index, &reach))
+                .map(|c| self.trace_chunk(c, &source, index))
                 .collect();
             // Fold in chunk order: the same sums whatever the thread count.
             for (deposits, c, tally) in results {
@@ -133,18 +120,12 @@ impl Ppm {
     }
 
     /// Traces photon chunk `c` of this pass: the deposits it makes and its counts.
-    pub(super) fn trace_chunk(
-        &self,
-        c: u64,
-        source: &PhotonSource,
-        index: &SpatialIndex,
-        reach: &[Reach],
-    ) -> ChunkResult {
+    pub(super) fn trace_chunk(&self, c: u64, source: &PhotonSource, index: &SpatialIndex) -> ChunkResult {
         let mut deposits: Vec<Deposit> = Vec::new();
         let mut counts = PhotonCounts::default();
         let mut tally = self.guide.as_ref().map(EmissionGuide::tally);
         let (photons, first_photon) = (self.pass_photons, self.first_photon());
-        let points = &self.points;
+        let (reach, shade) = (&self.points.reach, &self.points.shade);
         let split = self.indirect_scale != IndirectScale::Off;
         for i in c * CHUNK..((c + 1) * CHUNK).min(photons) {
             let mut rng = stream_rng(self.seed, streams::PHOTON, first_photon + i);
@@ -153,12 +134,12 @@ impl Ppm {
                 // Hand the flux to every visible point on this side of the surface whose
                 // search sphere (of the photon's estimate) holds the photon.
                 let estimate = usize::from(indirect && split);
-                index.for_candidates(points, p, &mut |k| {
+                index.for_candidates(reach, p, &mut |k| {
                     let r = &reach[k as usize];
-                    if (DVec3::new(r[0], r[1], r[2]) - p).length_squared() <= r[3 + estimate] {
-                        let vp = &points[k as usize];
-                        if vp.normal.dot(n) > 1e-3 {
-                            deposits.push((2 * vp.slot + estimate as u32, vp.weight * flux, 1));
+                    if (r.position - p).length_squared() <= r.radius2[estimate] {
+                        let s = &shade[k as usize];
+                        if s.normal.as_dvec3().dot(n) > 1e-3 {
+                            deposits.push((2 * s.slot + estimate as u32, s.weight.as_dvec3() * flux, 1));
                             useful = true;
                         }
                     }

@@ -53,6 +53,7 @@ impl Ppm {
         let cam = &scene.camera;
         let mut distances: Vec<f64> = self
             .points
+            .reach
             .iter()
             .map(|p| (p.position - cam.position).dot(cam.forward).abs())
             .collect();

@@ -31,6 +31,7 @@
 
 use super::estimate::{Restart, Slot};
 use super::guide::EmissionGuide;
+use super::points::VisiblePoints;
 use super::radius::IndirectScale;
 use super::visible::VisiblePoint;
 use super::Ppm;
@@ -128,13 +129,13 @@ pub(super) struct PointRecord {
 }
 
 /// Each of `slots` slots' visible point among `points` (each point names its slot).
-pub(super) fn records(slots: usize, points: &[VisiblePoint]) -> Vec<PointRecord> {
+pub(super) fn records(slots: usize, points: &VisiblePoints) -> Vec<PointRecord> {
     let mut out = vec![PointRecord::default(); slots];
-    for p in points {
-        out[p.slot as usize] = PointRecord {
-            position: p.position.as_vec3(),
-            normal: p.normal.as_vec3(),
-            weight: p.weight.as_vec3(),
+    for (r, s) in points.reach.iter().zip(&points.shade) {
+        out[s.slot as usize] = PointRecord {
+            position: r.position.as_vec3(),
+            normal: s.normal,
+            weight: s.weight,
         };
     }
     out
