@@ -302,10 +302,8 @@ impl Ppm {
         if self.interrupted() {
             return PassOutcome::Aborted;
         }
-        if self.stochastic || self.stats.eye_passes == 0 {
-            if !self.eye_pass(scene) {
-                return PassOutcome::Aborted;
-            }
+        if (self.stochastic || self.stats.eye_passes == 0) && !self.eye_pass(scene) {
+            return PassOutcome::Aborted;
         }
         self.stats.eye_secs += start.elapsed().as_secs_f64();
         let Some(gathered) = self.gather(scene, control) else {
