@@ -847,7 +847,16 @@ fn an_adaptive_radius_restarts_dense_points_narrower_and_keeps_the_image() {
         adaptive_stats.narrowed_share
     );
     assert!(adaptive_stats.mean_radius < 0.8 * fixed_stats.mean_radius);
-    assert_eq!(adaptive_one, fixed_one, "the first pass's image does not change");
+    // Unchanged up to the rounding of the narrowed estimate's radius² and flux, which are
+    // stored in f32.
+    for (a, f) in adaptive_one.iter().zip(&fixed_one) {
+        for c in 0..3 {
+            assert!(
+                (a[c] - f[c]).abs() <= 1e-6 * f[c].abs().max(1e-3),
+                "the first pass's image does not change: {a:?} vs {f:?}"
+            );
+        }
+    }
     assert!((adaptive_mean - 1.0).abs() < 0.02, "adaptive: {adaptive_mean}");
     assert!((adaptive_mean / fixed_mean - 1.0).abs() < 0.02);
 }

@@ -96,8 +96,8 @@ fn pixel_statistics(ppm: &Ppm) -> (Arc<[f32]>, Arc<[f32]>) {
     let mut gathered = vec![0.0f32; w as usize * h as usize];
     for s in ppm.slots() {
         let px = &mut radius[s.pixel as usize];
-        *px = px.max(s.primary.radius2.sqrt() as f32);
-        gathered[s.pixel as usize] += (s.primary.n + s.indirect.n) as f32;
+        *px = px.max(s.primary.radius2().sqrt() as f32);
+        gathered[s.pixel as usize] += (s.primary.n() + s.indirect.n()) as f32;
     }
     (radius.into(), gathered.into())
 }

@@ -7,30 +7,69 @@ use std::f64::consts::PI;
 use super::photon_pass::Gathered;
 use super::radius::IndirectScale;
 use super::Ppm;
-use glam::DVec3;
+use glam::{DVec3, Vec3};
 
 /// One progressive density estimate (Hachisuka et al. 2008 §4): search radius², photon
-/// count `N` and flux `τ`, updated after every pass.
+/// count `N` and flux `τ`, updated after every pass. Stored in f32 (20 bytes instead of 40:
+/// at 1920×1080 a stochastic render holds two per pixel) and computed in f64: each update
+/// rounds once, a relative 6·10⁻⁸, so after 10,000 passes an estimate is off by about
+/// 10⁻⁵ of itself at most for rounding that happens to go one way, far below its noise.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Estimate {
-    /// Search radius².
-    pub radius2: f64,
-    /// Accumulated photon count `N`.
-    pub n: f64,
-    /// Accumulated flux `τ`.
-    pub tau: DVec3,
+    radius2: f32,
+    n: f32,
+    tau: Vec3,
 }
 
 impl Estimate {
+    /// An estimate of radius² `radius2`, photon count `n` and flux `tau`.
+    pub fn new(radius2: f64, n: f64, tau: DVec3) -> Self {
+        Self {
+            radius2: radius2 as f32,
+            n: n as f32,
+            tau: tau.as_vec3(),
+        }
+    }
+
+    /// An empty estimate of radius² `radius2`.
+    pub fn empty(radius2: f64) -> Self {
+        Self::new(radius2, 0.0, DVec3::ZERO)
+    }
+
+    /// Search radius².
+    #[inline]
+    pub fn radius2(&self) -> f64 {
+        self.radius2 as f64
+    }
+
+    /// Accumulated photon count `N`.
+    pub fn n(&self) -> f64 {
+        self.n as f64
+    }
+
+    /// Accumulated flux `τ`.
+    pub fn tau(&self) -> DVec3 {
+        self.tau.as_dvec3()
+    }
+
+    /// Sets the photon count `N` (the global schedule shows each pass's own).
+    pub(super) fn set_n(&mut self, n: f64) {
+        self.n = n as f32;
+    }
+
+    /// Multiplies the flux by `factor`, per channel.
+    pub(super) fn scale_tau(&mut self, factor: DVec3) {
+        self.tau = (self.tau() * factor).as_vec3();
+    }
+
     /// Folds in a pass that brought `m` photons of flux `phi` within the radius (eqs. 6–11):
     /// the radius shrinks so that a share α of the new photons is kept.
     pub(super) fn update(&mut self, phi: DVec3, m: u32, alpha: f64) {
         let m = m as f64;
         if m > 0.0 {
-            let g = (self.n + alpha * m) / (self.n + m);
-            self.radius2 *= g;
-            self.tau = (self.tau + phi) * g;
-            self.n += alpha * m;
+            let n = self.n();
+            let g = (n + alpha * m) / (n + m);
+            *self = Self::new(self.radius2() * g, n + alpha * m, (self.tau() + phi) * g);
         }
     }
 
@@ -39,21 +78,17 @@ impl Estimate {
     /// holds nothing to scale).
     pub(super) fn resized(self, radius2: f64) -> Self {
         let share = if self.radius2 > 0.0 {
-            radius2 / self.radius2
+            radius2 / self.radius2()
         } else {
             0.0
         };
-        Self {
-            radius2,
-            n: self.n * share,
-            tau: self.tau * share,
-        }
+        Self::new(radius2, self.n() * share, self.tau() * share)
     }
 
     /// Reflected radiance `τ/(π R² N_emitted)`.
     pub(super) fn radiance(&self, emitted: f64) -> DVec3 {
         if self.radius2 > 0.0 {
-            self.tau / (PI * self.radius2 * emitted)
+            self.tau() / (PI * self.radius2() * emitted)
         } else {
             DVec3::ZERO
         }
@@ -128,8 +163,7 @@ impl Ppm {
             if s.restart == Restart::Pending {
                 // The first pass's flux only stood in until this pass: it was gathered over
                 // the wide radius.
-                s.primary.n = 0.0;
-                s.primary.tau = DVec3::ZERO;
+                s.primary = Estimate::empty(s.primary.radius2());
                 s.restart = Restart::Restarted;
             }
             s.primary.update(phi[2 * k].as_dvec3(), m[2 * k], alpha);
@@ -166,7 +200,7 @@ impl Ppm {
             .slots
             .iter()
             .filter(|s| s.primary.n > 0.0)
-            .map(|s| s.primary.radius2.sqrt())
+            .map(|s| s.primary.radius2().sqrt())
             .collect();
         self.stats.mean_radius = gathered.iter().sum::<f64>() / gathered.len().max(1) as f64;
     }

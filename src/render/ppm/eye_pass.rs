@@ -12,7 +12,7 @@ use super::points::{self, Shade, VisiblePoints};
 use super::visible::{trace_eye, Branching, VisiblePoint};
 
 use super::radius::IndirectScale;
-use super::{direct, streams, Ppm, Slot};
+use super::{direct, streams, Estimate, Ppm, Slot};
 use crate::render::rng::stream_rng;
 use crate::render::sequence;
 use crate::scene::camera::concentric_disk;
@@ -165,7 +165,7 @@ impl Ppm {
                 self.slots.push(Slot::new(pixel));
             }
         }
-        if self.stats.passes == 0 && self.slots.iter().all(|s| s.primary.radius2 == 0.0) {
+        if self.stats.passes == 0 && self.slots.iter().all(|s| s.primary.radius2() == 0.0) {
             let r0 = self
                 .initial_radius
                 .unwrap_or_else(|| self.automatic_radius(scene));
@@ -176,8 +176,8 @@ impl Ppm {
                 IndirectScale::Fixed(k) => k * r0,
             };
             for s in &mut self.slots {
-                s.primary.radius2 = r0 * r0;
-                s.indirect.radius2 = indirect * indirect;
+                s.primary = Estimate::empty(r0 * r0);
+                s.indirect = Estimate::empty(indirect * indirect);
             }
             self.initial_radius2 = r0 * r0;
         }

@@ -103,8 +103,8 @@ impl Ppm {
         // Each estimate's count is this pass's photons (what the probe and the photons layer
         // show: nothing accumulates from pass to pass).
         for (k, s) in self.slots.iter_mut().enumerate() {
-            s.primary.n = gathered.m[2 * k] as f64;
-            s.indirect.n = gathered.m[2 * k + 1] as f64;
+            s.primary.set_n(gathered.m[2 * k] as f64);
+            s.indirect.set_n(gathered.m[2 * k + 1] as f64);
         }
         if let Some(g) = &mut self.global {
             g.sums.add_pass(pass as u32, &values, self.pass_photons);
@@ -122,14 +122,8 @@ impl Ppm {
         };
         let factor = schedule_factor(pass, g.alpha);
         for (s, &(primary, indirect)) in self.slots.iter_mut().zip(pilot) {
-            s.primary = Estimate {
-                radius2: primary * factor,
-                ..Default::default()
-            };
-            s.indirect = Estimate {
-                radius2: indirect * factor,
-                ..Default::default()
-            };
+            s.primary = Estimate::empty(primary * factor);
+            s.indirect = Estimate::empty(indirect * factor);
         }
     }
 
@@ -139,14 +133,8 @@ impl Ppm {
         let emitted = self.pass_photons as f64;
         let mut values = vec![DVec3::ZERO; self.direct.len()];
         for (k, s) in self.slots.iter().enumerate() {
-            let primary = Estimate {
-                tau: phi[2 * k].as_dvec3(),
-                ..s.primary
-            };
-            let indirect = Estimate {
-                tau: phi[2 * k + 1].as_dvec3(),
-                ..s.indirect
-            };
+            let primary = Estimate::new(s.primary.radius2(), 0.0, phi[2 * k].as_dvec3());
+            let indirect = Estimate::new(s.indirect.radius2(), 0.0, phi[2 * k + 1].as_dvec3());
             values[s.pixel as usize] += primary.radiance(emitted) + indirect.radiance(emitted);
         }
         // Light seen directly: this pass's eye pass, or classic PPM's one eye pass (the pilot's).
@@ -174,9 +162,9 @@ impl Ppm {
         s.deposits += counts.deposits;
         s.useful_paths += counts.useful;
         s.visible_points = self.points.len();
-        let radii = self.slots.iter().filter(|s| s.primary.radius2 > 0.0);
+        let radii = self.slots.iter().filter(|s| s.primary.radius2() > 0.0);
         let (sum, n) = radii.fold((0.0, 0usize), |(sum, n), s| {
-            (sum + s.primary.radius2.sqrt(), n + 1)
+            (sum + s.primary.radius2().sqrt(), n + 1)
         });
         s.mean_radius = sum / n.max(1) as f64;
     }
@@ -196,7 +184,7 @@ impl Ppm {
             .iter()
             .map(|s| {
                 let primary = if s.restart == Restart::Pending {
-                    s.primary.radius2
+                    s.primary.radius2()
                 } else {
                     r0_2
                 };

@@ -7,6 +7,8 @@
 
 use glam::{DVec3, Vec3};
 
+#[cfg(test)]
+use super::estimate::Estimate;
 use super::estimate::Slot;
 use super::visible::VisiblePoint;
 
@@ -135,7 +137,7 @@ impl VisiblePoints {
     pub fn set_radii(&mut self, slots: &[Slot]) {
         for (r, s) in self.reach.iter_mut().zip(&self.shade) {
             let slot = &slots[s.slot as usize];
-            r.radius2 = [slot.primary.radius2, slot.indirect.radius2];
+            r.radius2 = [slot.primary.radius2(), slot.indirect.radius2()];
         }
     }
 }
@@ -170,8 +172,8 @@ mod tests {
         assert_eq!(points.shade[0].slot, 1);
         assert_eq!(points.reach[1].position.x, 3.0);
         let mut slots: Vec<Slot> = (0..4).map(Slot::new).collect();
-        slots[3].primary.radius2 = 4.0;
-        slots[3].indirect.radius2 = 9.0;
+        slots[3].primary = Estimate::empty(4.0);
+        slots[3].indirect = Estimate::empty(9.0);
         points.set_radii(&slots);
         assert_eq!(points.reach[1].radius2, [4.0, 9.0]);
         assert_eq!(points.reach[1].reach2(), 9.0);

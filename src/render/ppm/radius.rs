@@ -43,7 +43,7 @@ impl Ppm {
         if !ppm.eye_pass(&scene) {
             return 1e-3;
         }
-        ppm.slots.first().map_or(1e-3, |s| s.primary.radius2.sqrt())
+        ppm.slots.first().map_or(1e-3, |s| s.primary.radius2().sqrt())
     }
 
     /// The automatic initial radius: twice the footprint of one pixel at the median distance
@@ -82,13 +82,9 @@ impl Ppm {
             // (the second only costs memory and time). Each is brought to the smaller of the
             // two radii — N and τ scaled by the area, as PPM's update does — and summed.
             for s in &mut self.slots {
-                let r2 = s.primary.radius2.min(s.indirect.radius2);
+                let r2 = s.primary.radius2().min(s.indirect.radius2());
                 let (p, i) = (s.primary.resized(r2), s.indirect.resized(r2));
-                s.primary = Estimate {
-                    radius2: r2,
-                    n: p.n + i.n,
-                    tau: p.tau + i.tau,
-                };
+                s.primary = Estimate::new(r2, p.n() + i.n(), p.tau() + i.tau());
                 s.indirect = Estimate::default();
             }
             self.indirect_scale = IndirectScale::Off;
@@ -96,7 +92,7 @@ impl Ppm {
         }
         let area = k * k;
         for s in &mut self.slots {
-            s.indirect = s.indirect.resized(s.indirect.radius2 * area);
+            s.indirect = s.indirect.resized(s.indirect.radius2() * area);
         }
         self.indirect_scale = IndirectScale::Fixed(k);
     }
@@ -119,7 +115,7 @@ impl Ppm {
         for (k, s) in self.slots.iter_mut().enumerate() {
             let count = m[2 * k] as f64 + if merged { m[2 * k + 1] as f64 } else { 0.0 };
             // A slot a warm restart kept has its radius already.
-            if count <= DENSE_PHOTONS || s.primary.radius2 <= 0.0 || s.prior > 0.0 {
+            if count <= DENSE_PHOTONS || s.primary.radius2() <= 0.0 || s.prior > 0.0 {
                 continue;
             }
             let radius2 = r0_2 * (DENSE_PHOTONS / count).max(MAX_NARROWING.powi(-2));

@@ -228,7 +228,7 @@ impl Ppm {
                     _ => all,
                 };
                 let mut kept = *s;
-                kept.primary.tau *= all / primary.max(1.0);
+                kept.primary.scale_tau(DVec3::splat(all / primary.max(1.0)));
                 kept.prior = all;
                 kept.restart = Restart::None;
                 kept
@@ -322,7 +322,7 @@ impl Ppm {
                 (old_range.len() == range.len()).then_some(())?;
                 let mut first = None;
                 for (from, to) in old_range.clone().zip(range.clone()) {
-                    let f = carry(&warm.points[from], &now[to], warm.slots[from].primary.radius2)?;
+                    let f = carry(&warm.points[from], &now[to], warm.slots[from].primary.radius2())?;
                     first.get_or_insert((o?, f));
                 }
                 first
@@ -336,12 +336,12 @@ impl Ppm {
             let old_range = &old[o].1;
             light[*pixel as usize] = warm.light[*pixel as usize].capped(PRIOR_PASSES, first);
             for (from, to) in old_range.clone().zip(range.clone()) {
-                let factor = carry(&warm.points[from], &now[to], warm.slots[from].primary.radius2)
+                let factor = carry(&warm.points[from], &now[to], warm.slots[from].primary.radius2())
                     .unwrap_or(DVec3::ONE);
                 let mut slot = warm.slots[from];
                 let scale = if slot.prior > cap { cap / slot.prior } else { 1.0 };
-                slot.primary.tau *= scale * factor;
-                slot.indirect.tau *= scale * factor;
+                slot.primary.scale_tau(scale * factor);
+                slot.indirect.scale_tau(scale * factor);
                 slot.prior *= scale;
                 self.slots[to] = slot;
             }
@@ -383,7 +383,7 @@ impl Ppm {
                 position: r.position.as_dvec3(),
                 normal: r.normal.as_dvec3(),
                 weight: r.weight.as_dvec3(),
-                radius2: warm.slots[k].primary.radius2,
+                radius2: warm.slots[k].primary.radius2(),
             })
             .collect();
         let grid = super::HashGrid::build(&old);
@@ -413,8 +413,8 @@ impl Ppm {
         for (to, from, factor) in found {
             let mut slot = warm.slots[from as usize];
             let scale = if slot.prior > cap { cap / slot.prior } else { 1.0 };
-            slot.primary.tau *= scale * factor;
-            slot.indirect.tau *= scale * factor;
+            slot.primary.scale_tau(scale * factor);
+            slot.indirect.scale_tau(scale * factor);
             slot.prior *= scale;
             slot.pixel = self.slots[to].pixel;
             self.slots[to] = slot;
