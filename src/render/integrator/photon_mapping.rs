@@ -5,7 +5,7 @@ use std::sync::Arc;
 
 use super::{Integrator, PassPlan, Setup};
 use crate::render::frame::{Frame, FrameStats, StatRow};
-use crate::render::ppm::{Control, PassOutcome, Ppm, PpmStats};
+use crate::render::ppm::{Control, PassOutcome, Ppm, PpmStats, Slot};
 use crate::render::provenance;
 use crate::scene::Scene;
 use crate::settings::RendererKind;
@@ -81,7 +81,7 @@ impl Frame {
             stats: FrameStats::from(stats),
             width,
             height,
-            radiance: ppm.radiance().into(),
+            radiance: ppm.radiance_shared(),
             radius,
             gathered,
             preview: false,
@@ -89,17 +89,30 @@ impl Frame {
     }
 }
 
-/// Per-pixel search radius (largest of the pixel's slots) and photon count (sum of them).
+/// Per-pixel search radius (largest of the pixel's slots) and photon count (sum of them),
+/// each made in one allocation (the slots lie together, in pixel order).
 fn pixel_statistics(ppm: &Ppm) -> (Arc<[f32]>, Arc<[f32]>) {
     let (w, h) = ppm.size();
-    let mut radius = vec![0.0f32; w as usize * h as usize];
-    let mut gathered = vec![0.0f32; w as usize * h as usize];
-    for s in ppm.slots() {
-        let px = &mut radius[s.pixel as usize];
-        *px = px.max(s.primary.radius2().sqrt() as f32);
-        gathered[s.pixel as usize] += (s.primary.n() + s.indirect.n()) as f32;
-    }
-    (radius.into(), gathered.into())
+    let pixels = w as usize * h as usize;
+    let per_pixel = |f: &dyn Fn(&[Slot]) -> f32| -> Arc<[f32]> {
+        let mut runs = ppm.slots().chunk_by(|a, b| a.pixel == b.pixel).peekable();
+        (0..pixels)
+            .map(|i| {
+                let mut v = 0.0;
+                while let Some(run) = runs.next_if(|run| run[0].pixel as usize == i) {
+                    v += f(run);
+                }
+                v
+            })
+            .collect()
+    };
+    let radius = per_pixel(&|run| {
+        run.iter()
+            .map(|s| s.primary.radius2().sqrt() as f32)
+            .fold(0.0, f32::max)
+    });
+    let gathered = per_pixel(&|run| run.iter().map(|s| (s.primary.n() + s.indirect.n()) as f32).sum());
+    (radius, gathered)
 }
 
 /// A number with thousands separators.

@@ -148,13 +148,7 @@ impl Slot {
 impl Ppm {
     /// Folds a completed pass into the slots and the statistics.
     pub(super) fn update(&mut self, gathered: Gathered) {
-        let Gathered {
-            phi,
-            m,
-            counts,
-            tally,
-        } = gathered;
-        if let (Some(guide), Some(tally)) = (&mut self.guide, &tally) {
+        if let (Some(guide), Some(tally)) = (&mut self.guide, &gathered.tally) {
             guide.learn(tally);
         }
         // Compute new photon counts, radii and flux (Hachisuka et al. 2008, eqs. 6–11).
@@ -166,22 +160,23 @@ impl Ppm {
                 s.primary = Estimate::empty(s.primary.radius2());
                 s.restart = Restart::Restarted;
             }
-            s.primary.update(phi[2 * k].as_dvec3(), m[2 * k], alpha);
-            s.indirect.update(phi[2 * k + 1].as_dvec3(), m[2 * k + 1], alpha);
+            s.primary.update(gathered.flux(k, 0), gathered.count(k, 0), alpha);
+            s.indirect
+                .update(gathered.flux(k, 1), gathered.count(k, 1), alpha);
         }
         if self.indirect_scale == IndirectScale::Automatic && self.stats.passes == 0 {
-            self.widen_indirect(&m);
+            self.widen_indirect(&gathered);
         }
         if self.adaptive_radius && self.stats.passes == 0 {
             self.first_pass_photons = self.pass_photons;
-            self.narrow_dense(&m);
+            self.narrow_dense(&gathered);
         }
         if self.stochastic && self.options.warm_restarts {
             self.last_points = self.point_records();
         }
         if self.stochastic {
             for (d, p) in self.direct.iter_mut().zip(self.pass_direct.drain(..)) {
-                *d += p;
+                *d += p.as_dvec3();
             }
             self.stats.eye_passes += 1;
         }
@@ -192,16 +187,17 @@ impl Ppm {
             _ => 1.0,
         };
         self.stats.photons += self.pass_photons;
-        self.stats.bounces += counts.bounces;
-        self.stats.deposits += counts.deposits;
-        self.stats.useful_paths += counts.useful;
+        self.stats.bounces += gathered.counts.bounces;
+        self.stats.deposits += gathered.counts.deposits;
+        self.stats.useful_paths += gathered.counts.useful;
         self.stats.visible_points = self.points.len();
-        let gathered: Vec<f64> = self
+        let (sum, count) = self
             .slots
             .iter()
             .filter(|s| s.primary.n > 0.0)
-            .map(|s| s.primary.radius2().sqrt())
-            .collect();
-        self.stats.mean_radius = gathered.iter().sum::<f64>() / gathered.len().max(1) as f64;
+            .fold((0.0, 0usize), |(sum, count), s| {
+                (sum + s.primary.radius2().sqrt(), count + 1)
+            });
+        self.stats.mean_radius = sum / count.max(1) as f64;
     }
 }

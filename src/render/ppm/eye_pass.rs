@@ -4,7 +4,7 @@
 
 use std::time::Instant;
 
-use glam::{DVec2, DVec3};
+use glam::{DVec2, DVec3, Vec3};
 use rand::Rng;
 use rayon::prelude::*;
 
@@ -37,7 +37,7 @@ impl Ppm {
         let pixels = (w * h) as usize;
         self.points.reset(pixels);
         self.pass_direct.clear();
-        self.pass_direct.resize(pixels, DVec3::ZERO);
+        self.pass_direct.resize(pixels, Vec3::ZERO);
         let rays = scene.camera.eye_rays();
         let VisiblePoints { reach, shade } = &mut self.points;
         reach
@@ -83,7 +83,8 @@ impl Ppm {
                     direct_light,
                     &mut rng,
                     &mut sink,
-                );
+                )
+                .as_vec3();
             });
         if skipped.into_inner() {
             return false;
@@ -190,7 +191,7 @@ impl Ppm {
     /// Adds one light sample of every area light at each visible point of this pass to the
     /// per-pixel sums (when direct light is on; see [`direct`]).
     pub(super) fn sample_area_lights(&mut self, scene: &Scene) {
-        if self.area_direct.is_empty() {
+        if !self.direct_light || !direct::has_area_lights(scene) {
             return;
         }
         let start = Instant::now();
@@ -203,7 +204,12 @@ impl Ppm {
             self.seed,
         );
         for (shade, l) in self.points.shade.iter().zip(light) {
-            self.area_direct[slots[shade.slot as usize].pixel as usize] += l;
+            let pixel = slots[shade.slot as usize].pixel as usize;
+            if self.stochastic {
+                self.pass_direct[pixel] += l.as_vec3();
+            } else {
+                self.area_direct[pixel] += l;
+            }
         }
         self.stats.direct_secs += start.elapsed().as_secs_f64();
     }

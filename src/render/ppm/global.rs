@@ -18,6 +18,7 @@ use std::time::Instant;
 
 use glam::DVec3;
 
+use super::photon_pass::Gathered;
 use super::radius::IndirectScale;
 use super::{Control, Estimate, PassOutcome, Ppm, Restart};
 use crate::render::shard::{PassSums, Shard};
@@ -99,12 +100,12 @@ impl Ppm {
         };
         self.area_direct.iter_mut().for_each(|a| *a = DVec3::ZERO);
         self.sample_area_lights(scene);
-        let values = self.pass_values(&gathered.phi);
+        let values = self.pass_values(&gathered);
         // Each estimate's count is this pass's photons (what the probe and the photons layer
         // show: nothing accumulates from pass to pass).
         for (k, s) in self.slots.iter_mut().enumerate() {
-            s.primary.set_n(gathered.m[2 * k] as f64);
-            s.indirect.set_n(gathered.m[2 * k + 1] as f64);
+            s.primary.set_n(gathered.count(k, 0) as f64);
+            s.indirect.set_n(gathered.count(k, 1) as f64);
         }
         if let Some(g) = &mut self.global {
             g.sums.add_pass(pass as u32, &values, self.pass_photons);
@@ -129,19 +130,19 @@ impl Ppm {
 
     /// This pass's estimate per pixel: the flux `phi` each slot's estimates gathered over
     /// `π r² N_emitted`, plus the light the pass saw directly.
-    fn pass_values(&self, phi: &[glam::Vec3]) -> Vec<DVec3> {
+    fn pass_values(&self, gathered: &Gathered) -> Vec<DVec3> {
         let emitted = self.pass_photons as f64;
         let mut values = vec![DVec3::ZERO; self.direct.len()];
         for (k, s) in self.slots.iter().enumerate() {
-            let primary = Estimate::new(s.primary.radius2(), 0.0, phi[2 * k].as_dvec3());
-            let indirect = Estimate::new(s.indirect.radius2(), 0.0, phi[2 * k + 1].as_dvec3());
+            let primary = Estimate::new(s.primary.radius2(), 0.0, gathered.flux(k, 0));
+            let indirect = Estimate::new(s.indirect.radius2(), 0.0, gathered.flux(k, 1));
             values[s.pixel as usize] += primary.radiance(emitted) + indirect.radiance(emitted);
         }
         // Light seen directly: this pass's eye pass, or classic PPM's one eye pass (the pilot's).
         let eye_passes = self.stats.eye_passes.max(1) as f64;
         for (i, v) in values.iter_mut().enumerate() {
             let seen = if self.stochastic {
-                self.pass_direct[i]
+                self.pass_direct[i].as_dvec3()
             } else {
                 self.direct[i] / eye_passes
             };

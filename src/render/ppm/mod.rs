@@ -41,7 +41,7 @@ pub mod warm;
 use std::sync::Arc;
 use std::time::Instant;
 
-use glam::DVec3;
+use glam::{DVec3, Vec3};
 
 use guide::EmissionGuide;
 pub use hash_grid::HashGrid;
@@ -145,10 +145,13 @@ pub struct Ppm {
     /// This pass's visible points (classic PPM: the one eye pass's).
     points: VisiblePoints,
     direct: Vec<DVec3>,
-    /// This stochastic pass's directly seen light, added to `direct` when the pass completes.
-    pass_direct: Vec<DVec3>,
+    /// This stochastic pass's directly seen light, added to `direct` when the pass completes
+    /// (f32: one pass's value, summed in f64).
+    pass_direct: Vec<Vec3>,
     /// Area light sampled at the visible points, summed over completed passes, per pixel
-    /// (empty unless direct light is on and the scene has area lights).
+    /// (empty unless direct light is on, the scene has area lights and the eye pass is
+    /// classic: a stochastic pass adds its samples to `pass_direct`, which counts the same
+    /// passes; at 1920×1080 that is 48 MiB less).
     area_direct: Vec<DVec3>,
     /// Where photons are sent, learned from completed passes (`None`: uniformly, as the
     /// lights emit).
@@ -230,7 +233,7 @@ impl Ppm {
             points: VisiblePoints::default(),
             direct: vec![DVec3::ZERO; pixels],
             pass_direct: Vec::new(),
-            area_direct: if scene.params.direct_light && direct::has_area_lights(scene) {
+            area_direct: if scene.params.direct_light && direct::has_area_lights(scene) && !stochastic {
                 vec![DVec3::ZERO; pixels]
             } else {
                 Vec::new()
@@ -369,28 +372,46 @@ impl Ppm {
     /// Linear RGB radiance per pixel: `τ/(π R² N_emitted)` of every slot of the pixel plus the
     /// mean of the light seen directly (with the global schedule, the mean of the passes).
     pub fn radiance(&self) -> Vec<[f32; 3]> {
-        if let Some(g) = &self.global {
-            return g.sums.mean();
+        match &self.global {
+            Some(g) => g.sums.mean(),
+            None => self.pixel_radiance().collect(),
         }
-        let mut out = vec![DVec3::ZERO; self.direct.len()];
-        if self.stats.photons > 0 {
-            let emitted = self.stats.photons as f64;
-            let restarted = (self.stats.photons - self.first_pass_photons) as f64;
-            for s in &self.slots {
-                let primary = match s.restart {
-                    Restart::Restarted => s.primary.radiance(restarted + s.prior),
-                    _ => s.primary.radiance(emitted + s.prior),
-                };
-                out[s.pixel as usize] += primary + s.indirect.radiance(emitted + s.prior);
+    }
+
+    /// [`Ppm::radiance`] in the form a frame holds, made in one allocation.
+    pub fn radiance_shared(&self) -> Arc<[[f32; 3]]> {
+        match &self.global {
+            Some(g) => g.sums.mean().into(),
+            None => self.pixel_radiance().collect(),
+        }
+    }
+
+    /// Each pixel's radiance with per-point statistics, in pixel order, summed in f64 over the
+    /// pixel's slots (which lie together, in pixel order) without an image-sized buffer.
+    fn pixel_radiance(&self) -> impl Iterator<Item = [f32; 3]> + '_ {
+        let emitted = self.stats.photons as f64;
+        let restarted = (self.stats.photons - self.first_pass_photons) as f64;
+        let slots = if self.stats.photons > 0 {
+            &self.slots[..]
+        } else {
+            &[]
+        };
+        debug_assert!(slots.is_sorted_by_key(|s| s.pixel), "slots lie in pixel order");
+        let mut runs = slots.chunk_by(|a, b| a.pixel == b.pixel).peekable();
+        (0..self.direct.len()).map(move |i| {
+            let mut c = DVec3::ZERO;
+            while let Some(run) = runs.next_if(|run| run[0].pixel as usize == i) {
+                for s in run {
+                    let primary = match s.restart {
+                        Restart::Restarted => s.primary.radiance(restarted + s.prior),
+                        _ => s.primary.radiance(emitted + s.prior),
+                    };
+                    c += primary + s.indirect.radiance(emitted + s.prior);
+                }
             }
-        }
-        out.iter()
-            .enumerate()
-            .map(|(i, l)| {
-                let c = *l + self.light_seen(i);
-                [c.x as f32, c.y as f32, c.z as f32]
-            })
-            .collect()
+            let c = c + self.light_seen(i);
+            [c.x as f32, c.y as f32, c.z as f32]
+        })
     }
 
     /// Pixel `i`'s mean light seen directly (emission, and lights sampled at its visible

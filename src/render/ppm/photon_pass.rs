@@ -47,16 +47,50 @@ pub(super) fn compact(deposits: &mut Vec<Deposit>) {
     *deposits = merged;
 }
 
-/// What one pass's photons left: flux `Φ` and photon count `M` per slot and estimate (index
-/// `2 × slot + estimate`, 0 primary, 1 indirect), and counts. A pass's flux is summed in f32
-/// (12 bytes instead of 24 per estimate: at 1920×1080 this keeps the peak under 1 GiB with
-/// two estimates per slot); τ accumulates the passes in f64.
+/// What one pass's photons left: flux `Φ` and photon count `M` per slot and estimate (0
+/// primary, 1 indirect; only the primary when the indirect estimate is off, which halves
+/// them), and counts. A pass's flux is summed in f32 (12 bytes instead of 24 per estimate);
+/// τ accumulates the passes.
 pub(super) struct Gathered {
-    pub(super) phi: Vec<Vec3>,
-    pub(super) m: Vec<u32>,
+    phi: Vec<Vec3>,
+    m: Vec<u32>,
+    /// Estimates per slot held: 2, or 1 when the indirect estimate is off.
+    estimates: usize,
     pub(super) counts: PhotonCounts,
     /// Emitted and useful photons per light and bin, when emission is guided.
     pub(super) tally: Option<GuideTally>,
+}
+
+impl Gathered {
+    /// Where slot `slot`'s estimate `estimate` is held.
+    #[inline]
+    fn at(estimates: usize, slot: u32, estimate: usize) -> u32 {
+        slot * estimates as u32 + estimate as u32
+    }
+
+    /// The flux slot `k`'s estimate `estimate` gathered.
+    pub(super) fn flux(&self, k: usize, estimate: usize) -> DVec3 {
+        if estimate < self.estimates {
+            self.phi[k * self.estimates + estimate].as_dvec3()
+        } else {
+            DVec3::ZERO
+        }
+    }
+
+    /// The photons slot `k`'s estimate `estimate` gathered.
+    pub(super) fn count(&self, k: usize, estimate: usize) -> u32 {
+        if estimate < self.estimates {
+            self.m[k * self.estimates + estimate]
+        } else {
+            0
+        }
+    }
+
+    /// The indirect estimates' photon counts, slot by slot (none when it is off).
+    pub(super) fn indirect_counts(&self) -> impl Iterator<Item = u32> + '_ {
+        let both: &[u32] = if self.estimates == 2 { &self.m } else { &[] };
+        both.iter().skip(1).step_by(2).copied()
+    }
 }
 
 impl Ppm {
@@ -69,9 +103,11 @@ impl Ppm {
         control: &mut dyn FnMut(&mut f64) -> Control,
     ) -> Option<Gathered> {
         let source = PhotonSource::new(scene, self.direct_light).with_guide(self.guide.as_ref());
+        let estimates = self.estimates();
         let mut out = Gathered {
-            phi: vec![Vec3::ZERO; 2 * self.slots.len()],
-            m: vec![0u32; 2 * self.slots.len()],
+            phi: vec![Vec3::ZERO; estimates * self.slots.len()],
+            m: vec![0u32; estimates * self.slots.len()],
+            estimates,
             counts: PhotonCounts::default(),
             tally: self.guide.as_ref().map(EmissionGuide::tally),
         };
@@ -107,6 +143,15 @@ impl Ppm {
         Some(out)
     }
 
+    /// Estimates each slot gathers into this pass: 2, or 1 when the indirect one is off.
+    fn estimates(&self) -> usize {
+        if self.indirect_scale == IndirectScale::Off {
+            1
+        } else {
+            2
+        }
+    }
+
     /// This pass's photons: `photons_per_pass` divided by the guide's gain (as many useful
     /// photons, fewer lost ones; see [`guide`]), but not below one chunk (or all of them).
     pub(super) fn guided_pass_photons(&self) -> u64 {
@@ -126,7 +171,8 @@ impl Ppm {
         let mut tally = self.guide.as_ref().map(EmissionGuide::tally);
         let (photons, first_photon) = (self.pass_photons, self.first_photon());
         let (reach, shade) = (&self.points.reach, &self.points.shade);
-        let split = self.indirect_scale != IndirectScale::Off;
+        let estimates = self.estimates();
+        let split = estimates == 2;
         for i in c * CHUNK..((c + 1) * CHUNK).min(photons) {
             let mut rng = stream_rng(self.seed, streams::PHOTON, first_photon + i);
             let mut useful = false;
@@ -136,10 +182,14 @@ impl Ppm {
                 let estimate = usize::from(indirect && split);
                 index.for_candidates(reach, p, &mut |k| {
                     let r = &reach[k as usize];
-                    if (r.position - p).length_squared() <= r.radius2[estimate] {
+                    if (r.position - p).length_squared() <= r.radius2[estimate] as f64 {
                         let s = &shade[k as usize];
                         if s.normal.as_dvec3().dot(n) > 1e-3 {
-                            deposits.push((2 * s.slot + estimate as u32, s.weight.as_dvec3() * flux, 1));
+                            deposits.push((
+                                Gathered::at(estimates, s.slot, estimate),
+                                s.weight.as_dvec3() * flux,
+                                1,
+                            ));
                             useful = true;
                         }
                     }

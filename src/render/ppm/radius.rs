@@ -4,6 +4,7 @@
 //! mapping's k-nearest-neighbour radius, Jensen 2001, chosen once and then shrunk by the
 //! paper's rule).
 
+use super::photon_pass::Gathered;
 use super::{Estimate, Ppm, PpmOptions, Restart};
 use crate::scene::Scene;
 
@@ -73,9 +74,9 @@ impl Ppm {
     /// where they are dense (small closed rooms) `k` is 1 and the two estimates merge into
     /// one. The estimate is scaled as PPM's update assumes, for a density uniform within the
     /// radius: N and τ by the area. Counts are deterministic, so is `k`.
-    pub(super) fn widen_indirect(&mut self, m: &[u32]) {
+    pub(super) fn widen_indirect(&mut self, gathered: &Gathered) {
         let slots = self.slots.len().max(1) as f64;
-        let mean = m.iter().skip(1).step_by(2).map(|&c| c as f64).sum::<f64>() / slots;
+        let mean = gathered.indirect_counts().map(|c| c as f64).sum::<f64>() / slots;
         let k = (INDIRECT_PHOTONS / mean).sqrt().clamp(1.0, MAX_INDIRECT_SCALE);
         if k == 1.0 {
             // Dense photons: the two estimates would share one radius, so they become one
@@ -108,12 +109,12 @@ impl Ppm {
     /// second pass (kept until then, scaled by the area, so the image does not go dark), so
     /// that no blur of it stays in the estimate; the radius is chosen from photons the
     /// estimate then never uses. Counts are deterministic, so are the radii.
-    pub(super) fn narrow_dense(&mut self, m: &[u32]) {
+    pub(super) fn narrow_dense(&mut self, gathered: &Gathered) {
         let merged = self.indirect_scale == IndirectScale::Off;
         let r0_2 = self.initial_radius2;
         let mut narrowed = 0usize;
         for (k, s) in self.slots.iter_mut().enumerate() {
-            let count = m[2 * k] as f64 + if merged { m[2 * k + 1] as f64 } else { 0.0 };
+            let count = gathered.count(k, 0) as f64 + if merged { gathered.count(k, 1) as f64 } else { 0.0 };
             // A slot a warm restart kept has its radius already.
             if count <= DENSE_PHOTONS || s.primary.radius2() <= 0.0 || s.prior > 0.0 {
                 continue;
