@@ -116,7 +116,7 @@ pub struct Slot {
     /// Photons emitted before this epoch that both estimates' flux already counts: a slot a
     /// warm restart kept ([`super::warm`]) carries its previous estimate as a prior worth
     /// this many photons, which fades as the epoch's own photons come (0: a cold slot).
-    pub prior: f64,
+    pub prior: f32,
 }
 
 /// A primary estimate's restart with a narrower radius ([`Ppm::narrow_dense`]).

@@ -403,10 +403,10 @@ impl Ppm {
             while let Some(run) = runs.next_if(|run| run[0].pixel as usize == i) {
                 for s in run {
                     let primary = match s.restart {
-                        Restart::Restarted => s.primary.radiance(restarted + s.prior),
-                        _ => s.primary.radiance(emitted + s.prior),
+                        Restart::Restarted => s.primary.radiance(restarted + s.prior as f64),
+                        _ => s.primary.radiance(emitted + s.prior as f64),
                     };
-                    c += primary + s.indirect.radiance(emitted + s.prior);
+                    c += primary + s.indirect.radiance(emitted + s.prior as f64);
                 }
             }
             let c = c + self.light_seen(i);

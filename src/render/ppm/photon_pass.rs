@@ -24,8 +24,9 @@ pub const DEFAULT_BATCH_PHOTONS: u64 = 16 * CHUNK;
 /// large (every photon then reaches thousands of points).
 pub(super) const MAX_CHUNK_DEPOSITS: usize = 1 << 20;
 
-/// Flux handed to a statistics slot: `(slot, flux × point weight, photon count)`.
-pub(super) type Deposit = (u32, DVec3, u32);
+/// Flux handed to a statistics slot: `(slot, flux × point weight, photon count)`, the flux
+/// in f32 as the pass sums it (20 bytes a deposit, not 32).
+pub(super) type Deposit = (u32, Vec3, u32);
 
 /// What one chunk of photons left: its deposits, counts and guide tally.
 pub(super) type ChunkResult = (Vec<Deposit>, PhotonCounts, Option<GuideTally>);
@@ -130,7 +131,7 @@ impl Ppm {
                     all.add(t);
                 }
                 for (slot, flux, count) in deposits {
-                    out.phi[slot as usize] += flux.as_vec3();
+                    out.phi[slot as usize] += flux;
                     out.m[slot as usize] += count;
                     out.counts.deposits += count as u64;
                 }
@@ -187,7 +188,7 @@ impl Ppm {
                         if s.normal.as_dvec3().dot(n) > 1e-3 {
                             deposits.push((
                                 Gathered::at(estimates, s.slot, estimate),
-                                s.weight.as_dvec3() * flux,
+                                (s.weight.as_dvec3() * flux).as_vec3(),
                                 1,
                             ));
                             useful = true;

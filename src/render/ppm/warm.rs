@@ -163,6 +163,16 @@ fn carry(old: &PointRecord, new: &PointRecord, radius2: f64) -> Option<DVec3> {
     (plausible(ratio.x) && plausible(ratio.y) && plausible(ratio.z)).then_some(ratio)
 }
 
+/// The factor that brings a prior worth `prior` photons down to at most `cap`.
+fn prior_scale(prior: f32, cap: f64) -> f64 {
+    let prior = prior as f64;
+    if prior > cap {
+        cap / prior
+    } else {
+        1.0
+    }
+}
+
 /// A visible point that moved by at most this share of its previous estimate's radius keeps
 /// the estimate (as a prior, with the flux scaled by the new weight): the photons it gathered
 /// lie about as near the new point, as PPM's own radius assumes.
@@ -222,14 +232,14 @@ impl Ppm {
             .iter()
             .map(|s| {
                 // Both estimates brought to one count of photons: the indirect one's.
-                let all = emitted + s.prior;
+                let all = emitted + s.prior as f64;
                 let primary = match s.restart {
-                    Restart::Restarted => restarted + s.prior,
+                    Restart::Restarted => restarted + s.prior as f64,
                     _ => all,
                 };
                 let mut kept = *s;
                 kept.primary.scale_tau(DVec3::splat(all / primary.max(1.0)));
-                kept.prior = all;
+                kept.prior = all as f32;
                 kept.restart = Restart::None;
                 kept
             })
@@ -339,10 +349,10 @@ impl Ppm {
                 let factor = carry(&warm.points[from], &now[to], warm.slots[from].primary.radius2())
                     .unwrap_or(DVec3::ONE);
                 let mut slot = warm.slots[from];
-                let scale = if slot.prior > cap { cap / slot.prior } else { 1.0 };
+                let scale = prior_scale(slot.prior, cap);
                 slot.primary.scale_tau(scale * factor);
                 slot.indirect.scale_tau(scale * factor);
-                slot.prior *= scale;
+                slot.prior = (slot.prior as f64 * scale) as f32;
                 self.slots[to] = slot;
             }
             kept += 1;
@@ -412,10 +422,10 @@ impl Ppm {
         let mut warmed = std::collections::BTreeSet::new();
         for (to, from, factor) in found {
             let mut slot = warm.slots[from as usize];
-            let scale = if slot.prior > cap { cap / slot.prior } else { 1.0 };
+            let scale = prior_scale(slot.prior, cap);
             slot.primary.scale_tau(scale * factor);
             slot.indirect.scale_tau(scale * factor);
-            slot.prior *= scale;
+            slot.prior = (slot.prior as f64 * scale) as f32;
             slot.pixel = self.slots[to].pixel;
             self.slots[to] = slot;
             warmed.insert(slot.pixel);
