@@ -1,7 +1,11 @@
-//! A hashed uniform grid over visible points, rebuilt every pass (Hachisuka & Jensen 2009 §4;
-//! pbrt-v4 `SPPMIntegrator`): each point is entered in every cell its search sphere's box
-//! overlaps, so a photon looks in the one cell it falls into. Cells are hashed into a table of
-//! about twice as many buckets as entries and stored compactly (counting sort, no per-cell vectors).
+//! A hashed uniform grid over visible points, rebuilt every pass (Hachisuka & Jensen 2009 §4
+//! hash the points into the cells their search sphere overlaps; so does pbrt-v4's
+//! `SPPMIntegrator`). Here each point is entered once, in the cell of its centre, with cells
+//! as wide as the largest search diameter: a photon looks in the cells within that radius of
+//! it (2 per axis, 8 in all), and the points themselves are stored sorted by bucket (counting
+//! sort), so each bucket's points lie together — what a photon reads is contiguous, and the
+//! grid is only its bucket starts (at 1920×1080: 17 MiB, where eight entries per point in
+//! the cells their sphere overlaps took 83 MiB and sent every candidate to a random place).
 
 use glam::{DVec3, IVec3};
 use rayon::prelude::*;
@@ -10,18 +14,17 @@ use super::points::SearchSphere;
 #[cfg(test)]
 use super::visible::VisiblePoint;
 
-/// The grid: bucket `b` holds `entries[starts[b]..starts[b + 1]]`.
+/// The grid: bucket `b` holds the points at places `starts[b]..starts[b + 1]` of the order
+/// [`HashGrid::build`] returned.
 #[derive(Clone, Debug, Default)]
 pub struct HashGrid {
     origin: DVec3,
     inv_cell: f64,
+    /// The largest search radius: how far from a photon the points' centres are looked for.
+    reach: f64,
     mask: u64,
     starts: Vec<u32>,
-    entries: Vec<u32>,
 }
-
-/// Points whose buckets are computed together while the grid is built.
-const BLOCK: usize = 1 << 16;
 
 #[inline]
 fn hash(c: IVec3) -> u64 {
@@ -34,97 +37,113 @@ fn hash(c: IVec3) -> u64 {
 }
 
 impl HashGrid {
-    /// Builds the grid over `points`, with cells as wide as the largest search diameter.
-    pub fn build<P: SearchSphere + Sync>(points: &[P]) -> Self {
+    /// Builds the grid over `points` and returns with it the order the points must be stored
+    /// in for it: place `i` holds point `order[i]` (within a bucket the points keep their
+    /// order, so the order depends on the points only).
+    pub fn build<P: SearchSphere + Sync>(points: &[P]) -> (Self, Vec<u32>) {
         if points.is_empty() {
-            return Self::default();
+            return (Self::default(), Vec::new());
         }
-        let max_r = points.iter().map(|p| p.reach2()).fold(0.0f64, f64::max).sqrt();
-        let cell = (2.0 * max_r).max(1e-12);
+        let reach = points.iter().map(|p| p.reach2()).fold(0.0f64, f64::max).sqrt();
+        let inv_cell = 1.0 / (2.0 * reach).max(1e-12);
         let origin = points
             .iter()
             .fold(DVec3::splat(f64::INFINITY), |m, p| m.min(p.centre()))
-            - DVec3::splat(max_r);
-        let inv_cell = 1.0 / cell;
-        let cell_of = |p: DVec3| ((p - origin) * inv_cell).floor().as_ivec3();
-        // Two buckets per point (about four entries a bucket): a cell holds the entries of many
-        // points, so cells are far fewer than buckets and rarely share one. Eight per point
-        // (67 MiB of bucket starts at 1920×1080) measured no faster in `bench ppm`, and 4 %
-        // faster at most in 1920×1080 passes of 2M photons.
+            - DVec3::splat(reach);
+        // Two buckets per point: a cell holds several points, so occupied cells are far fewer
+        // than buckets and rarely share one.
         let buckets = (2 * points.len()).next_power_of_two().max(2);
         let mask = buckets as u64 - 1;
-        // The distinct buckets of a point's cells: two of its cells may hash to the same
-        // bucket, and a point listed twice there would be handed a photon twice. A sphere spans
-        // 2 cells per axis, 3 when rounding puts its edge a hair past a cell boundary (seen in
-        // the Cornell box), so at most 27.
-        let buckets_of = |p: &P| -> ([u32; 27], usize) {
-            let (c, r) = (p.centre(), p.reach2().sqrt());
-            let (lo, hi) = (cell_of(c - r), cell_of(c + r));
-            let mut b = [0u32; 27];
-            let mut n = 0;
-            for z in lo.z..=hi.z {
-                for y in lo.y..=hi.y {
-                    for x in lo.x..=hi.x {
-                        let h = (hash(IVec3::new(x, y, z)) & mask) as u32;
-                        if n < b.len() && !b[..n].contains(&h) {
-                            b[n] = h;
-                            n += 1;
-                        }
-                    }
-                }
-            }
-            (b, n)
+        let mut grid = Self {
+            origin,
+            inv_cell,
+            reach,
+            mask,
+            starts: vec![0u32; buckets + 1],
         };
-        // Counting sort by bucket, a block of points at a time (the blocks' buckets are
-        // computed in parallel, twice, rather than held for all points: at 1920×1080 that list
-        // would be 66 MiB): bucket sizes, running ends, then entries filled from the back so
-        // that each `starts[b]` comes down to its bucket's beginning and points stay in index
-        // order.
-        let block_ids =
-            |block: &[P]| -> Vec<([u32; 27], usize)> { block.par_iter().map(buckets_of).collect() };
-        let mut starts = vec![0u32; buckets + 1];
-        let mut total = 0usize;
-        for block in points.chunks(BLOCK) {
-            for (b, n) in block_ids(block) {
-                for &b in &b[..n] {
-                    starts[b as usize] += 1;
-                }
-                total += n;
-            }
+        let bucket: Vec<u32> = points
+            .par_iter()
+            .map(|p| grid.bucket(grid.cell_of(p.centre())))
+            .collect();
+        // Counting sort: bucket sizes, running ends, then places filled from the back so that
+        // each `starts[b]` comes down to its bucket's beginning.
+        for &b in &bucket {
+            grid.starts[b as usize] += 1;
         }
         let mut end = 0;
-        for s in starts.iter_mut() {
+        for s in grid.starts.iter_mut() {
             end += *s;
             *s = end;
         }
-        let mut entries = vec![0u32; total];
-        for (k0, block) in points.chunks(BLOCK).enumerate().rev() {
-            for (k, (b, n)) in block_ids(block).into_iter().enumerate().rev() {
-                for &b in b[..n].iter().rev() {
-                    starts[b as usize] -= 1;
-                    entries[starts[b as usize] as usize] = (k0 * BLOCK + k) as u32;
+        let mut order = vec![0u32; points.len()];
+        for (k, &b) in bucket.iter().enumerate().rev() {
+            grid.starts[b as usize] -= 1;
+            order[grid.starts[b as usize] as usize] = k as u32;
+        }
+        (grid, order)
+    }
+
+    #[inline]
+    fn cell_of(&self, p: DVec3) -> IVec3 {
+        ((p - self.origin) * self.inv_cell).floor().as_ivec3()
+    }
+
+    #[inline]
+    fn bucket(&self, c: IVec3) -> u32 {
+        (hash(c) & self.mask) as u32
+    }
+
+    /// Calls `f` with the place of every point whose centre lies in a cell within the largest
+    /// search radius of `p`: every point whose search sphere holds `p`, among others (the
+    /// caller checks distances), each once. A sphere that holds `p` has its centre within its
+    /// radius of `p`, so in a cell between those of `p` minus and plus the largest radius.
+    #[inline]
+    pub fn for_candidates(&self, p: DVec3, f: &mut impl FnMut(u32)) {
+        if self.starts.is_empty() {
+            return;
+        }
+        let (lo, hi) = (self.cell_of(p - self.reach), self.cell_of(p + self.reach));
+        // Two of these cells may hash to one bucket: it is read once. Rounding can make the
+        // range 3 cells long on an axis, so at most 27.
+        let mut seen = [0u32; 27];
+        let mut n = 0;
+        for z in lo.z..=hi.z {
+            for y in lo.y..=hi.y {
+                for x in lo.x..=hi.x {
+                    let b = self.bucket(IVec3::new(x, y, z));
+                    if n == seen.len() || seen[..n].contains(&b) {
+                        continue;
+                    }
+                    seen[n] = b;
+                    n += 1;
+                    let b = b as usize;
+                    (self.starts[b]..self.starts[b + 1]).for_each(&mut *f);
                 }
             }
         }
-        Self {
-            origin,
-            inv_cell,
-            mask,
-            starts,
-            entries,
-        }
     }
+}
 
-    /// Indices of the points whose search sphere may contain `p` (a superset: the caller
-    /// checks distances).
-    #[inline]
-    pub fn candidates(&self, p: DVec3) -> &[u32] {
-        if self.entries.is_empty() {
-            return &[];
+/// Puts `a` and `b` in `order` (place `i` gets element `order[i]`), in place, following the
+/// permutation's cycles: no copy of either array is made. `order` is used up.
+pub fn permute<A: Copy, B: Copy>(a: &mut [A], b: &mut [B], order: &mut [u32]) {
+    const DONE: u32 = u32::MAX;
+    for i in 0..order.len() {
+        if order[i] == DONE {
+            continue;
         }
-        let c = ((p - self.origin) * self.inv_cell).floor().as_ivec3();
-        let b = (hash(c) & self.mask) as usize;
-        &self.entries[self.starts[b] as usize..self.starts[b + 1] as usize]
+        let (first_a, first_b) = (a[i], b[i]);
+        let mut j = i;
+        loop {
+            let k = order[j] as usize;
+            order[j] = DONE;
+            if k == i {
+                (a[j], b[j]) = (first_a, first_b);
+                break;
+            }
+            (a[j], b[j]) = (a[k], b[k]);
+            j = k;
+        }
     }
 }
 
@@ -132,6 +151,17 @@ impl HashGrid {
 mod tests {
     use super::*;
     use crate::render::ppm::kd_tree::KdTree;
+
+    /// The grid over `points` and the slots (`VisiblePoint::slot`) of the candidates it gives
+    /// for `p`.
+    fn grid_slots(points: &[VisiblePoint]) -> impl Fn(DVec3) -> Vec<u32> + '_ {
+        let (grid, order) = HashGrid::build(points);
+        move |p| {
+            let mut out = Vec::new();
+            grid.for_candidates(p, &mut |k| out.push(points[order[k as usize] as usize].slot));
+            out
+        }
+    }
 
     /// Rounding can make a sphere whose radius is the largest touch 3 cells along an axis (seen
     /// in the Cornell box, where many eye-pass points share one wall coordinate and radius):
@@ -169,22 +199,22 @@ mod tests {
             p.radius2 = 1e-4;
             points.push(p);
         }
-        let grid = HashGrid::build(&points);
+        let candidates = grid_slots(&points);
         for i in 0..=40 {
             for j in 0..=40 {
                 let (theta, phi) = (i as f64 / 40.0 * std::f64::consts::PI, j as f64 / 40.0 * 6.3);
                 let d = DVec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
                 let p = centre + d * r * 0.999;
-                assert!(grid.candidates(p).contains(&1), "missed at {p}");
+                assert!(candidates(p).contains(&1), "missed at {p}");
             }
         }
     }
 
-    /// The grid is built a block of points at a time: points of every block, the last one
-    /// partial, are each found once, and every bucket lists its points in index order.
+    /// Points are stored in the grid's order: each bucket's points together, in their own
+    /// order; every point is found once, from its own position.
     #[test]
-    fn points_of_every_block_are_found_once_in_index_order() {
-        let n = 2 * BLOCK + 7;
+    fn points_sorted_by_bucket_are_each_found_once() {
+        let n = 100_003;
         let points: Vec<VisiblePoint> = (0..n as u32)
             .map(|k| VisiblePoint {
                 slot: k,
@@ -194,17 +224,29 @@ mod tests {
                 radius2: 0.004 * 0.004,
             })
             .collect();
-        let grid = HashGrid::build(&points);
+        let (grid, order) = HashGrid::build(&points);
+        let mut sorted = order.clone();
+        sorted.sort_unstable();
+        assert!(
+            sorted.iter().copied().eq(0..n as u32),
+            "the order is a permutation"
+        );
         for (k, p) in points.iter().enumerate() {
-            let candidates = grid.candidates(p.position);
-            assert!(candidates.windows(2).all(|w| w[0] < w[1]), "bucket out of order");
-            let inside: Vec<u32> = candidates
-                .iter()
-                .copied()
-                .filter(|&j| (points[j as usize].position - p.position).length_squared() <= p.radius2)
-                .collect();
+            let mut inside = Vec::new();
+            grid.for_candidates(p.position, &mut |place| {
+                let q = &points[order[place as usize] as usize];
+                if (q.position - p.position).length_squared() <= p.radius2 {
+                    inside.push(q.slot);
+                }
+            });
             assert_eq!(inside, [k as u32]);
         }
+        // Putting two arrays in that order moves each element where the order says.
+        let mut a: Vec<u32> = (0..n as u32).collect();
+        let mut b: Vec<u64> = (0..n as u64).map(|k| k * 3).collect();
+        permute(&mut a, &mut b, &mut order.clone());
+        assert_eq!(a, order);
+        assert!(b.iter().zip(&order).all(|(&b, &o)| b == o as u64 * 3));
     }
 
     #[test]
@@ -240,7 +282,7 @@ mod tests {
                 radius2: WALL_RADIUS.powi(2),
             });
         }
-        let grid = HashGrid::build(&points);
+        let candidates = grid_slots(&points);
         let kd = KdTree::build(&points);
         for q in 0..6000 {
             let mut p = DVec3::new(next(), next(), next()) * 10.0;
@@ -250,7 +292,7 @@ mod tests {
             let inside =
                 |k: &u32| (points[*k as usize].position - p).length_squared() <= points[*k as usize].radius2;
             let mut brute: Vec<u32> = (0..points.len() as u32).filter(inside).collect();
-            let mut from_grid: Vec<u32> = grid.candidates(p).iter().copied().filter(inside).collect();
+            let mut from_grid: Vec<u32> = candidates(p).into_iter().filter(inside).collect();
             let mut from_kd = Vec::new();
             kd.for_candidates(&points, p, &mut |k| {
                 if inside(&k) {

@@ -19,7 +19,7 @@ impl SpatialIndex {
     #[inline]
     pub fn for_candidates<P: SearchSphere>(&self, points: &[P], p: DVec3, f: &mut impl FnMut(u32)) {
         match self {
-            SpatialIndex::Grid(g) => g.candidates(p).iter().for_each(|&k| f(k)),
+            SpatialIndex::Grid(g) => g.for_candidates(p, f),
             SpatialIndex::Kd(t) => t.for_candidates(points, p, f),
         }
     }

@@ -336,12 +336,16 @@ impl Ppm {
     }
 
     /// The spatial index over this pass's visible points, their radii first copied from
-    /// their slots.
+    /// their slots (the hash grid puts the points in its order).
     fn build_index(&mut self) -> SpatialIndex {
         let start = Instant::now();
         self.points.set_radii(&self.slots);
         let index = match self.index {
-            IndexKind::HashGrid => SpatialIndex::Grid(HashGrid::build(&self.points.reach)),
+            IndexKind::HashGrid => {
+                let (grid, mut order) = HashGrid::build(&self.points.reach);
+                self.points.permute(&mut order);
+                SpatialIndex::Grid(grid)
+            }
             IndexKind::KdTree => SpatialIndex::Kd(KdTree::build(&self.points.reach)),
         };
         self.stats.index_secs += start.elapsed().as_secs_f64();

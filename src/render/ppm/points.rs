@@ -134,6 +134,11 @@ impl VisiblePoints {
         self.shade.truncate(kept);
     }
 
+    /// Puts the points in `order` (place `i` gets point `order[i]`; used up), in place.
+    pub fn permute(&mut self, order: &mut [u32]) {
+        super::hash_grid::permute(&mut self.reach, &mut self.shade, order);
+    }
+
     /// Copies each point's slot's radii² into its reach.
     pub fn set_radii(&mut self, slots: &[Slot]) {
         for (r, s) in self.reach.iter_mut().zip(&self.shade) {

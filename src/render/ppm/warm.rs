@@ -396,22 +396,26 @@ impl Ppm {
                 radius2: warm.slots[k].primary.radius2(),
             })
             .collect();
-        let grid = super::HashGrid::build(&old);
+        let (grid, order) = super::HashGrid::build(&old);
+        let old: Vec<VisiblePoint> = order.iter().map(|&k| old[k as usize]).collect();
         // Each slot left: the nearest previous point whose radius holds it, found in parallel.
         let found: Vec<(usize, u32, DVec3)> = now
             .par_iter()
             .enumerate()
             .filter(|(to, new)| !carried[*to] && new.weight != Vec3::ZERO)
             .filter_map(|(to, new)| {
-                let p = new.position.as_dvec3();
-                let (o, _) = grid
-                    .candidates(p)
-                    .iter()
-                    .map(|&k| &old[k as usize])
-                    .filter(|o| o.normal.dot(new.normal.as_dvec3()) >= 0.9)
-                    .map(|o| (o, (o.position - p).length_squared()))
-                    .filter(|(o, d2)| *d2 <= o.radius2)
-                    .min_by(|a, b| a.1.total_cmp(&b.1))?;
+                let (p, normal) = (new.position.as_dvec3(), new.normal.as_dvec3());
+                // The nearest; of equally near ones, the first pixel's.
+                let mut nearest: Option<(&VisiblePoint, f64)> = None;
+                grid.for_candidates(p, &mut |k| {
+                    let o = &old[k as usize];
+                    let d2 = (o.position - p).length_squared();
+                    let nearer = nearest.is_none_or(|(n, nd2)| (d2, o.slot) < (nd2, n.slot));
+                    if o.normal.dot(normal) >= 0.9 && d2 <= o.radius2 && nearer {
+                        nearest = Some((o, d2));
+                    }
+                });
+                let (o, _) = nearest?;
                 Some((
                     to,
                     o.slot,
