@@ -15,11 +15,18 @@ pub enum SpatialIndex {
 }
 
 impl SpatialIndex {
-    /// Calls `f` with candidate points near `p` (the caller checks the radius).
+    /// Calls `f` with candidate points near `p` (the caller checks the radius), among them
+    /// every point whose sphere, of a radius at most `radius`, holds `p`.
     #[inline]
-    pub fn for_candidates<P: SearchSphere>(&self, points: &[P], p: DVec3, f: &mut impl FnMut(u32)) {
+    pub fn for_candidates<P: SearchSphere>(
+        &self,
+        points: &[P],
+        p: DVec3,
+        radius: f64,
+        f: &mut impl FnMut(u32),
+    ) {
         match self {
-            SpatialIndex::Grid(g) => g.for_candidates(p, f),
+            SpatialIndex::Grid(g) => g.for_candidates(p, radius, f),
             SpatialIndex::Kd(t) => t.for_candidates(points, p, f),
         }
     }

@@ -112,6 +112,16 @@ impl Ppm {
             counts: PhotonCounts::default(),
             tally: self.guide.as_ref().map(EmissionGuide::tally),
         };
+        // Each estimate's largest radius: how far from a photon its points are looked for.
+        let radius = [0, 1].map(|e| {
+            let max2 = self
+                .points
+                .reach
+                .iter()
+                .map(|r| r.radius2[e])
+                .fold(0.0f32, f32::max);
+            (max2 as f64).sqrt()
+        });
         self.pass_photons = self.guided_pass_photons();
         let chunks = self.pass_photons.div_ceil(CHUNK);
         let chunks_per_batch = self.options.batch_photons.div_ceil(CHUNK).max(1);
@@ -123,7 +133,7 @@ impl Ppm {
             let end = (chunk + chunks_per_batch).min(chunks);
             let results: Vec<ChunkResult> = (chunk..end)
                 .into_par_iter()
-                .map(|c| self.trace_chunk(c, &source, index))
+                .map(|c| self.trace_chunk(c, &source, index, radius))
                 .collect();
             // Fold in chunk order: the same sums whatever the thread count.
             for (deposits, c, tally) in results {
@@ -166,7 +176,13 @@ impl Ppm {
     }
 
     /// Traces photon chunk `c` of this pass: the deposits it makes and its counts.
-    pub(super) fn trace_chunk(&self, c: u64, source: &PhotonSource, index: &SpatialIndex) -> ChunkResult {
+    pub(super) fn trace_chunk(
+        &self,
+        c: u64,
+        source: &PhotonSource,
+        index: &SpatialIndex,
+        radius: [f64; 2],
+    ) -> ChunkResult {
         let mut deposits: Vec<Deposit> = Vec::new();
         let mut counts = PhotonCounts::default();
         let mut tally = self.guide.as_ref().map(EmissionGuide::tally);
@@ -181,7 +197,7 @@ impl Ppm {
                 // Hand the flux to every visible point on this side of the surface whose
                 // search sphere (of the photon's estimate) holds the photon.
                 let estimate = usize::from(indirect && split);
-                index.for_candidates(reach, p, &mut |k| {
+                index.for_candidates(reach, p, radius[estimate], &mut |k| {
                     let r = &reach[k as usize];
                     if (r.position - p).length_squared() <= r.radius2[estimate] as f64 {
                         let s = &shade[k as usize];

@@ -407,7 +407,7 @@ impl Ppm {
                 let (p, normal) = (new.position.as_dvec3(), new.normal.as_dvec3());
                 // The nearest; of equally near ones, the first pixel's.
                 let mut nearest: Option<(&VisiblePoint, f64)> = None;
-                grid.for_candidates(p, &mut |k| {
+                grid.for_candidates(p, f64::INFINITY, &mut |k| {
                     let o = &old[k as usize];
                     let d2 = (o.position - p).length_squared();
                     let nearer = nearest.is_none_or(|(n, nd2)| (d2, o.slot) < (nd2, n.slot));
