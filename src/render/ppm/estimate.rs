@@ -4,7 +4,7 @@
 
 use std::f64::consts::PI;
 
-use super::photon_pass::Gathered;
+use super::gathered::Gathered;
 use super::radius::IndirectScale;
 use super::Ppm;
 use glam::{DVec3, Vec3};

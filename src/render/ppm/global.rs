@@ -18,7 +18,7 @@ use std::time::Instant;
 
 use glam::DVec3;
 
-use super::photon_pass::Gathered;
+use super::gathered::Gathered;
 use super::radius::IndirectScale;
 use super::{Control, Estimate, PassOutcome, Ppm, Restart};
 use crate::render::shard::{PassSums, Shard};

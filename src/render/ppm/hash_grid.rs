@@ -137,29 +137,6 @@ impl HashGrid {
     }
 }
 
-/// Puts `a` and `b` in `order` (place `i` gets element `order[i]`), in place, following the
-/// permutation's cycles: no copy of either array is made. `order` is used up.
-pub fn permute<A: Copy, B: Copy>(a: &mut [A], b: &mut [B], order: &mut [u32]) {
-    const DONE: u32 = u32::MAX;
-    for i in 0..order.len() {
-        if order[i] == DONE {
-            continue;
-        }
-        let (first_a, first_b) = (a[i], b[i]);
-        let mut j = i;
-        loop {
-            let k = order[j] as usize;
-            order[j] = DONE;
-            if k == i {
-                (a[j], b[j]) = (first_a, first_b);
-                break;
-            }
-            (a[j], b[j]) = (a[k], b[k]);
-            j = k;
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -230,8 +207,8 @@ mod tests {
         }
     }
 
-    /// Points are stored in the grid's order: each bucket's points together, in their own
-    /// order; every point is found once, from its own position.
+    /// The grid's order is a permutation (the points are stored in it: each bucket's points
+    /// together, in their own order); every point is found once, from its own position.
     #[test]
     fn points_sorted_by_bucket_are_each_found_once() {
         let n = 100_003;
@@ -261,12 +238,6 @@ mod tests {
             });
             assert_eq!(inside, [k as u32]);
         }
-        // Putting two arrays in that order moves each element where the order says.
-        let mut a: Vec<u32> = (0..n as u32).collect();
-        let mut b: Vec<u64> = (0..n as u64).map(|k| k * 3).collect();
-        permute(&mut a, &mut b, &mut order.clone());
-        assert_eq!(a, order);
-        assert!(b.iter().zip(&order).all(|(&b, &o)| b == o as u64 * 3));
     }
 
     #[test]

@@ -23,6 +23,7 @@
 
 mod estimate;
 mod eye_pass;
+mod gathered;
 mod global;
 mod index;
 mod photon_pass;
@@ -324,7 +325,7 @@ impl Ppm {
         &mut self,
         scene: &Scene,
         control: &mut dyn FnMut(&mut f64) -> Control,
-    ) -> Option<photon_pass::Gathered> {
+    ) -> Option<gathered::Gathered> {
         let index = self.build_index();
         if self.interrupted() {
             return None;

@@ -2,9 +2,10 @@
 //! chunk order (so the image is the same for any thread count), batch by batch with the
 //! caller asked between batches.
 
-use glam::{DVec3, Vec3};
+use glam::Vec3;
 use rayon::prelude::*;
 
+use super::gathered::Gathered;
 use super::guide::{EmissionGuide, GuideTally};
 use super::photon::{PhotonCounts, PhotonSource};
 
@@ -48,52 +49,6 @@ pub(super) fn compact(deposits: &mut Vec<Deposit>) {
     *deposits = merged;
 }
 
-/// What one pass's photons left: flux `Φ` and photon count `M` per slot and estimate (0
-/// primary, 1 indirect; only the primary when the indirect estimate is off, which halves
-/// them), and counts. A pass's flux is summed in f32 (12 bytes instead of 24 per estimate);
-/// τ accumulates the passes.
-pub(super) struct Gathered {
-    phi: Vec<Vec3>,
-    m: Vec<u32>,
-    /// Estimates per slot held: 2, or 1 when the indirect estimate is off.
-    estimates: usize,
-    pub(super) counts: PhotonCounts,
-    /// Emitted and useful photons per light and bin, when emission is guided.
-    pub(super) tally: Option<GuideTally>,
-}
-
-impl Gathered {
-    /// Where slot `slot`'s estimate `estimate` is held.
-    #[inline]
-    fn at(estimates: usize, slot: u32, estimate: usize) -> u32 {
-        slot * estimates as u32 + estimate as u32
-    }
-
-    /// The flux slot `k`'s estimate `estimate` gathered.
-    pub(super) fn flux(&self, k: usize, estimate: usize) -> DVec3 {
-        if estimate < self.estimates {
-            self.phi[k * self.estimates + estimate].as_dvec3()
-        } else {
-            DVec3::ZERO
-        }
-    }
-
-    /// The photons slot `k`'s estimate `estimate` gathered.
-    pub(super) fn count(&self, k: usize, estimate: usize) -> u32 {
-        if estimate < self.estimates {
-            self.m[k * self.estimates + estimate]
-        } else {
-            0
-        }
-    }
-
-    /// The indirect estimates' photon counts, slot by slot (none when it is off).
-    pub(super) fn indirect_counts(&self) -> impl Iterator<Item = u32> + '_ {
-        let both: &[u32] = if self.estimates == 2 { &self.m } else { &[] };
-        both.iter().skip(1).step_by(2).copied()
-    }
-}
-
 impl Ppm {
     /// Traces this pass's photons in batches and gathers their flux at the visible points;
     /// `None` when `control` aborts the pass.
@@ -105,13 +60,11 @@ impl Ppm {
     ) -> Option<Gathered> {
         let source = PhotonSource::new(scene, self.direct_light).with_guide(self.guide.as_ref());
         let estimates = self.estimates();
-        let mut out = Gathered {
-            phi: vec![Vec3::ZERO; estimates * self.slots.len()],
-            m: vec![0u32; estimates * self.slots.len()],
+        let mut out = Gathered::new(
+            self.slots.len(),
             estimates,
-            counts: PhotonCounts::default(),
-            tally: self.guide.as_ref().map(EmissionGuide::tally),
-        };
+            self.guide.as_ref().map(EmissionGuide::tally),
+        );
         // Each estimate's largest radius: how far from a photon its points are looked for.
         let radius = [0, 1].map(|e| {
             let max2 = self
@@ -140,10 +93,8 @@ impl Ppm {
                 if let (Some(all), Some(t)) = (&mut out.tally, &tally) {
                     all.add(t);
                 }
-                for (slot, flux, count) in deposits {
-                    out.phi[slot as usize] += flux;
-                    out.m[slot as usize] += count;
-                    out.counts.deposits += count as u64;
+                for (at, flux, count) in deposits {
+                    out.add(at, flux, count);
                 }
                 out.counts.paths += c.paths;
                 out.counts.bounces += c.bounces;

@@ -134,9 +134,29 @@ impl VisiblePoints {
         self.shade.truncate(kept);
     }
 
-    /// Puts the points in `order` (place `i` gets point `order[i]`; used up), in place.
+    /// Puts the points in `order` (place `i` gets point `order[i]`; used up, as the grid's
+    /// build returns it), in place, following the permutation's cycles: neither array is
+    /// copied.
     pub fn permute(&mut self, order: &mut [u32]) {
-        super::hash_grid::permute(&mut self.reach, &mut self.shade, order);
+        const DONE: u32 = u32::MAX;
+        let (reach, shade) = (&mut self.reach, &mut self.shade);
+        for i in 0..order.len() {
+            if order[i] == DONE {
+                continue;
+            }
+            let first = (reach[i], shade[i]);
+            let mut j = i;
+            loop {
+                let k = order[j] as usize;
+                order[j] = DONE;
+                if k == i {
+                    (reach[j], shade[j]) = first;
+                    break;
+                }
+                (reach[j], shade[j]) = (reach[k], shade[k]);
+                j = k;
+            }
+        }
     }
 
     /// Copies each point's slot's radii² into its reach.
@@ -184,5 +204,29 @@ mod tests {
         assert_eq!(points.reach[1].radius2, [4.0, 9.0]);
         assert_eq!(points.reach[1].reach2(), 9.0);
         assert_eq!(points.reach[0].reach2(), 0.0);
+    }
+
+    /// Putting the points in an order of several cycles moves each point where the order says.
+    #[test]
+    fn permuting_moves_each_point_where_the_order_says() {
+        let n = 1000u32;
+        let mut points: VisiblePoints = (0..n)
+            .map(|k| VisiblePoint {
+                slot: k,
+                position: DVec3::new(k as f64, 0.0, 0.0),
+                normal: DVec3::Z,
+                weight: DVec3::ONE,
+                radius2: 0.0,
+            })
+            .collect();
+        // Cycles of several lengths: k ↦ 7k mod 1000 on the units, fixed points elsewhere.
+        let order: Vec<u32> = (0..n)
+            .map(|k| if k % 2 == 1 && k % 5 != 0 { k * 7 % n } else { k })
+            .collect();
+        points.permute(&mut order.clone());
+        for (place, &from) in order.iter().enumerate() {
+            assert_eq!(points.shade[place].slot, from);
+            assert_eq!(points.reach[place].position.x, from as f64);
+        }
     }
 }

@@ -4,7 +4,7 @@
 //! mapping's k-nearest-neighbour radius, Jensen 2001, chosen once and then shrunk by the
 //! paper's rule).
 
-use super::photon_pass::Gathered;
+use super::gathered::Gathered;
 use super::{Estimate, Ppm, PpmOptions, Restart};
 use crate::scene::Scene;
 
