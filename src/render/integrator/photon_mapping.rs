@@ -5,7 +5,7 @@ use std::sync::Arc;
 
 use super::{Integrator, PassPlan, Setup};
 use crate::render::frame::{Frame, FrameStats, StatRow};
-use crate::render::ppm::{Control, PassOutcome, Ppm, PpmStats, Slot};
+use crate::render::ppm::{Control, PassOutcome, Ppm, PpmStats};
 use crate::render::provenance;
 use crate::scene::Scene;
 use crate::settings::RendererKind;
@@ -90,28 +90,25 @@ impl Frame {
 }
 
 /// Per-pixel search radius (largest of the pixel's slots) and photon count (sum of them),
-/// each made in one allocation (the slots lie together, in pixel order).
+/// each made in one allocation.
 fn pixel_statistics(ppm: &Ppm) -> (Arc<[f32]>, Arc<[f32]>) {
-    let (w, h) = ppm.size();
-    let pixels = w as usize * h as usize;
-    let per_pixel = |f: &dyn Fn(&[Slot]) -> f32| -> Arc<[f32]> {
-        let mut runs = ppm.slots().chunk_by(|a, b| a.pixel == b.pixel).peekable();
-        (0..pixels)
-            .map(|i| {
-                let mut v = 0.0;
-                while let Some(run) = runs.next_if(|run| run[0].pixel as usize == i) {
-                    v += f(run);
-                }
-                v
-            })
-            .collect()
-    };
-    let radius = per_pixel(&|run| {
-        run.iter()
-            .map(|s| s.primary.radius2().sqrt() as f32)
-            .fold(0.0, f32::max)
-    });
-    let gathered = per_pixel(&|run| run.iter().map(|s| (s.primary.n() + s.indirect.n()) as f32).sum());
+    let radius = ppm
+        .slots_by_pixel()
+        .map(|slots| {
+            slots
+                .iter()
+                .map(|s| s.primary.radius2().sqrt() as f32)
+                .fold(0.0, f32::max)
+        })
+        .collect();
+    let gathered = ppm
+        .slots_by_pixel()
+        .map(|slots| {
+            slots
+                .iter()
+                .fold(0.0, |sum, s| sum + (s.primary.n() + s.indirect.n()) as f32)
+        })
+        .collect();
     (radius, gathered)
 }
 

@@ -392,21 +392,14 @@ impl Ppm {
     }
 
     /// Each pixel's radiance with per-point statistics, in pixel order, summed in f64 over the
-    /// pixel's slots (which lie together, in pixel order) without an image-sized buffer.
+    /// pixel's slots without an image-sized buffer.
     fn pixel_radiance(&self) -> impl Iterator<Item = [f32; 3]> + '_ {
         let emitted = self.stats.photons as f64;
         let restarted = (self.stats.photons - self.first_pass_photons) as f64;
-        let slots = if self.stats.photons > 0 {
-            &self.slots[..]
-        } else {
-            &[]
-        };
-        debug_assert!(slots.is_sorted_by_key(|s| s.pixel), "slots lie in pixel order");
-        let mut runs = slots.chunk_by(|a, b| a.pixel == b.pixel).peekable();
-        (0..self.direct.len()).map(move |i| {
+        self.slots_by_pixel().enumerate().map(move |(i, slots)| {
             let mut c = DVec3::ZERO;
-            while let Some(run) = runs.next_if(|run| run[0].pixel as usize == i) {
-                for s in run {
+            if emitted > 0.0 {
+                for s in slots {
                     let primary = match s.restart {
                         Restart::Restarted => s.primary.radiance(restarted + s.prior as f64),
                         _ => s.primary.radiance(emitted + s.prior as f64),
@@ -430,6 +423,18 @@ impl Ppm {
             light += (*a + prior.area) / passes.max(1.0);
         }
         light
+    }
+
+    /// Each pixel's statistics slots, in pixel order (none for a pixel without a visible
+    /// point): a pixel's slots lie together, and pixels in order, however the eye pass made
+    /// them.
+    pub fn slots_by_pixel(&self) -> impl Iterator<Item = &[Slot]> + '_ {
+        debug_assert!(
+            self.slots.is_sorted_by_key(|s| s.pixel),
+            "slots lie in pixel order"
+        );
+        let mut runs = self.slots.chunk_by(|a, b| a.pixel == b.pixel).peekable();
+        (0..self.direct.len()).map(move |i| runs.next_if(|run| run[0].pixel as usize == i).unwrap_or(&[]))
     }
 
     /// The statistics slots (for the viewer's probe).

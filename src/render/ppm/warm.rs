@@ -163,14 +163,15 @@ fn carry(old: &PointRecord, new: &PointRecord, radius2: f64) -> Option<DVec3> {
     (plausible(ratio.x) && plausible(ratio.y) && plausible(ratio.z)).then_some(ratio)
 }
 
-/// The factor that brings a prior worth `prior` photons down to at most `cap`.
-fn prior_scale(prior: f32, cap: f64) -> f64 {
-    let prior = prior as f64;
-    if prior > cap {
-        cap / prior
-    } else {
-        1.0
-    }
+/// A previous slot as a prior for a new point: worth at most `cap` photons (its flux scaled
+/// down with its count), its flux scaled by `factor` for the new point's weight.
+fn as_prior(mut slot: Slot, cap: f64, factor: DVec3) -> Slot {
+    let prior = slot.prior as f64;
+    let scale = if prior > cap { cap / prior } else { 1.0 };
+    slot.primary.scale_tau(scale * factor);
+    slot.indirect.scale_tau(scale * factor);
+    slot.prior = (prior * scale) as f32;
+    slot
 }
 
 /// A visible point that moved by at most this share of its previous estimate's radius keeps
@@ -348,12 +349,7 @@ impl Ppm {
             for (from, to) in old_range.clone().zip(range.clone()) {
                 let factor = carry(&warm.points[from], &now[to], warm.slots[from].primary.radius2())
                     .unwrap_or(DVec3::ONE);
-                let mut slot = warm.slots[from];
-                let scale = prior_scale(slot.prior, cap);
-                slot.primary.scale_tau(scale * factor);
-                slot.indirect.scale_tau(scale * factor);
-                slot.prior = (slot.prior as f64 * scale) as f32;
-                self.slots[to] = slot;
+                self.slots[to] = as_prior(warm.slots[from], cap, factor);
             }
             kept += 1;
             carried[range.clone()].iter_mut().for_each(|c| *c = true);
@@ -425,11 +421,7 @@ impl Ppm {
             .collect();
         let mut warmed = std::collections::BTreeSet::new();
         for (to, from, factor) in found {
-            let mut slot = warm.slots[from as usize];
-            let scale = prior_scale(slot.prior, cap);
-            slot.primary.scale_tau(scale * factor);
-            slot.indirect.scale_tau(scale * factor);
-            slot.prior = (slot.prior as f64 * scale) as f32;
+            let mut slot = as_prior(warm.slots[from as usize], cap, factor);
             slot.pixel = self.slots[to].pixel;
             self.slots[to] = slot;
             warmed.insert(slot.pixel);
