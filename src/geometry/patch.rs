@@ -21,7 +21,9 @@
 //! coordinate at the root is the ray distance. Because Bézier patches are affine invariant the
 //! ray-space patch is just the patch with transformed control points, so the convex hull
 //! property gives a cheap exact rejection: if the projected control points do not surround the
-//! origin the ray misses.
+//! origin the ray misses. A tighter test follows it (`beside`): the bilinear patch through the
+//! corners, widened by the sub-patch's largest deviation from it, bounds the surface too, so a
+//! ray outside that quadrilateral needs no Newton solve.
 //!
 //! Near-singular Jacobians (the collapsed rows at the teapot's poles, folds at grazing angles)
 //! take a Levenberg–Marquardt step instead of a Newton step. When Newton does not converge to a
@@ -275,11 +277,73 @@ fn bilinear_start(p: &BezierPatch) -> (f64, f64) {
     best
 }
 
+/// Whether the ray passes farther than `tolerance` from the ray-space sub-patch `p`, judged by
+/// the bilinear patch `L` through its four corners.
+///
+/// `p − L` is itself a Bézier patch whose control points are `P_ij − L(i/3, j/3)` (a bilinear
+/// patch degree-elevated to bicubic has the control points `L(i/3, j/3)`), so by the convex
+/// hull property every point of `p` lies within `δ = max |P_ij − L(i/3, j/3)|` of `L`. Where
+/// the corners form a strictly convex quadrilateral, `L` maps the unit square onto it, and a
+/// ray farther than `δ + tolerance` outside one of its edge lines meets no point of `p`. For a
+/// nearly flat sub-patch the quadrilateral is much tighter than the box of the control
+/// points: this one test replaces the Newton solves and splits that find no root where the
+/// ray passes beside a sub-patch (its root lies in a neighbour, or it misses).
+fn beside(p: &BezierPatch, tolerance: f64) -> bool {
+    let corner = |k: usize| p.points[k].truncate();
+    // Counter-clockwise or clockwise; the orientation comes from the first corner's turn.
+    let quad = [corner(0), corner(12), corner(15), corner(3)];
+    let cross = |a: DVec2, b: DVec2| a.x * b.y - a.y * b.x;
+    let edges = [
+        quad[1] - quad[0],
+        quad[2] - quad[1],
+        quad[3] - quad[2],
+        quad[0] - quad[3],
+    ];
+    let turns = [
+        cross(edges[3], edges[0]),
+        cross(edges[0], edges[1]),
+        cross(edges[1], edges[2]),
+        cross(edges[2], edges[3]),
+    ];
+    let orientation = turns[0].signum();
+    if !turns.iter().all(|&turn| turn * orientation > 0.0) {
+        return false;
+    }
+    // Distance of the ray (the origin) outside each edge line; the largest one.
+    let mut outside = f64::NEG_INFINITY;
+    for (edge, start) in edges.iter().zip(quad) {
+        let length = edge.length();
+        // The origin relative to the edge's start, against the interior's side.
+        let side = -orientation * cross(*edge, -start) / length;
+        outside = outside.max(side);
+    }
+    // (No NaN reaches here: a NaN corner fails the convexity test above.)
+    if outside <= tolerance {
+        return false;
+    }
+    let (p00, e, f, g) = (
+        quad[0],
+        edges[0],
+        quad[3] - quad[0],
+        quad[0] - quad[1] + quad[2] - quad[3],
+    );
+    let mut deviation2: f64 = 0.0;
+    for i in 0..4 {
+        let s = i as f64 / 3.0;
+        for j in 0..4 {
+            let t = j as f64 / 3.0;
+            let bilinear = p00 + e * s + f * t + g * (s * t);
+            deviation2 = deviation2.max((corner(4 * i + j) - bilinear).length_squared());
+        }
+    }
+    let margin = outside - tolerance;
+    margin * margin > deviation2
+}
+
 /// Newton (or Levenberg–Marquardt where the Jacobian is near singular) on the first two
 /// ray-space coordinates, from [`bilinear_start`] and, should that fail (its corners can
 /// coincide at a pole), from the middle. Returns the root `(s, t)` and its ray distance.
-fn newton(p: &BezierPatch, tolerance: f64) -> Option<(f64, f64, f64)> {
-    let start = bilinear_start(p);
+fn newton(p: &BezierPatch, tolerance: f64, start: (f64, f64)) -> Option<(f64, f64, f64)> {
     let clamped = !(0.0..=1.0).contains(&start.0) || !(0.0..=1.0).contains(&start.1);
     newton_from(p, tolerance, start)
         .or_else(|| clamped.then(|| newton_from(p, tolerance, (0.5, 0.5))).flatten())
@@ -399,7 +463,10 @@ impl Problem {
     /// fails or a second, nearer root cannot be ruled out.
     fn solve(&mut self, p: &BezierPatch, window: Window, depth: u32, t_max: f64) {
         let t_max = self.t_max(t_max);
-        let root = newton(p, self.tolerance);
+        if beside(p, self.tolerance) {
+            return;
+        }
+        let root = newton(p, self.tolerance, bilinear_start(p));
         self.budget = self.budget.saturating_sub(1);
         if let Some((s, t, dist)) = root {
             let inside = |x: f64| (-WINDOW_MARGIN..=1.0 + WINDOW_MARGIN).contains(&x);
