@@ -11,7 +11,7 @@
 //! [`BezierPatch::sub_patch`] needs to cut out an arbitrary `(u,v)` window exactly.
 //! Intersection with rays lives apart, in [`crate::geometry::patch`].
 
-use glam::{DAffine3, DVec3};
+use glam::{DAffine3, DVec2, DVec3};
 
 use super::aabb::Aabb;
 
@@ -115,6 +115,30 @@ impl BezierPatch {
             dp_du,
             dp_dv,
         }
+    }
+
+    /// The first two coordinates of `P(u,v)`, `∂P/∂u` and `∂P/∂v`: what a root finder in ray
+    /// space needs (the third coordinate is the distance along the ray, wanted only at the
+    /// root). The same arithmetic as [`BezierPatch::eval_with_derivs`] on those coordinates,
+    /// so the same bits.
+    #[inline]
+    pub fn eval_xy_with_derivs(&self, u: f64, v: f64) -> [DVec2; 3] {
+        let bu = bernstein(u);
+        let bv = bernstein(v);
+        let du = bernstein_deriv(u);
+        let dv = bernstein_deriv(v);
+        let mut position = DVec2::ZERO;
+        let mut dp_du = DVec2::ZERO;
+        let mut dp_dv = DVec2::ZERO;
+        for i in 0..4 {
+            let r = |j: usize| self.points[4 * i + j].truncate();
+            let row = bv[0] * r(0) + bv[1] * r(1) + bv[2] * r(2) + bv[3] * r(3);
+            let row_dv = dv[0] * r(0) + dv[1] * r(1) + dv[2] * r(2) + dv[3] * r(3);
+            position += bu[i] * row;
+            dp_du += du[i] * row;
+            dp_dv += bu[i] * row_dv;
+        }
+        [position, dp_du, dp_dv]
     }
 
     /// The unit normal `∂P/∂u × ∂P/∂v` at `(u,v)`.

@@ -353,11 +353,10 @@ fn newton(p: &BezierPatch, tolerance: f64, start: (f64, f64)) -> Option<(f64, f6
 fn newton_from(p: &BezierPatch, tolerance: f64, (mut s, mut t): (f64, f64)) -> Option<(f64, f64, f64)> {
     let mut previous = f64::INFINITY;
     for iteration in 0..MAX_NEWTON_ITERATIONS {
-        let sp = p.eval_with_derivs(s, t);
-        let (f, fs, ft) = (sp.position, sp.dp_du, sp.dp_dv);
+        let [f, fs, ft] = p.eval_xy_with_derivs(s, t);
         let residual = f.x.abs().max(f.y.abs());
         if residual <= tolerance {
-            return Some((s, t, f.z));
+            return Some((s, t, p.eval(s, t).z));
         }
         // Converging Newton shrinks the residual far faster than this; give the split
         // fallback the sub-patch instead of iterating on.
