@@ -112,24 +112,28 @@ impl Aabb {
     /// clipped to `[0, t_max]`, or `None`. `inv_dir` is [`safe_inverse`]`(dir)`.
     #[inline]
     pub fn hit_interval(&self, origin: DVec3, inv_dir: DVec3, t_max: f64) -> Option<(f64, f64)> {
+        // Plain comparisons rather than `f64::min`/`max`: no NaN reaches here (see
+        // `safe_inverse`), and these compile to single min/max instructions.
+        let min = |a: f64, b: f64| if a < b { a } else { b };
+        let max = |a: f64, b: f64| if a > b { a } else { b };
         let a = (self.min - origin) * inv_dir;
         let b = (self.max - origin) * inv_dir;
-        let near = a.min(b);
-        let far = a.max(b) * (1.0 + 2.0 * GAMMA3);
-        let t0 = near.max_element().max(0.0);
-        let t1 = far.min_element().min(t_max);
+        let near = DVec3::new(min(a.x, b.x), min(a.y, b.y), min(a.z, b.z));
+        let far = DVec3::new(max(a.x, b.x), max(a.y, b.y), max(a.z, b.z)) * (1.0 + 2.0 * GAMMA3);
+        let t0 = max(max(max(near.x, near.y), near.z), 0.0);
+        let t1 = min(min(min(far.x, far.y), far.z), t_max);
         (t0 <= t1).then_some((t0, t1))
     }
 }
 
-/// `1 / dir` component-wise, with zero components replaced by `±f64::MAX` (sign kept) instead
-/// of infinity: `(bound - origin) · inv` is then never `0 · ∞ = NaN` for a ray lying in a slab's
-/// plane, and overflow to `±∞` still orders correctly, so [`Aabb::hit_interval`] needs no
-/// special cases.
+/// `1 / dir` component-wise, with zero and subnormal components (whose reciprocal would be
+/// infinite) replaced by `±f64::MAX` (sign kept): `(bound - origin) · inv` is then never
+/// `0 · ∞ = NaN` for a ray lying in a slab's plane, and overflow to `±∞` still orders
+/// correctly, so [`Aabb::hit_interval`] needs no special cases.
 #[inline]
 pub fn safe_inverse(dir: DVec3) -> DVec3 {
     let inv = |d: f64| {
-        if d == 0.0 {
+        if d.abs() < f64::MIN_POSITIVE {
             f64::MAX.copysign(d)
         } else {
             1.0 / d
@@ -160,6 +164,11 @@ mod tests {
         assert!(b
             .hit_interval(DVec3::new(2.0, 0.5, 0.5), inv(DVec3::X), f64::INFINITY)
             .is_none());
+        // A subnormal component in the plane of a face: finite reciprocal, no NaN, a hit.
+        let tiny = DVec3::new(1.0, 1e-310, 0.0);
+        assert!(safe_inverse(tiny).is_finite());
+        let grazing = b.hit_interval(DVec3::new(-1.0, 0.0, 0.5), inv(tiny), f64::INFINITY);
+        assert!(grazing.is_some_and(|(t0, t1)| t0 == 1.0 && t1 >= 2.0));
     }
 
     #[test]

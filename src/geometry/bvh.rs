@@ -166,8 +166,10 @@ impl Bvh {
         if root.bounds.hit_interval(ray.origin, inv_dir, t_max).is_none() {
             return t_max;
         }
-        // Entries are nodes whose box the ray enters at the stored distance.
-        let mut stack = [(0u32, 0.0f64); 64];
+        // Entries are nodes whose box the ray enters at the stored distance. Two plain arrays
+        // (not an array of pairs, whose padding makes the start-up zeroing a scalar loop).
+        let mut stack_node = [0u32; 64];
+        let mut stack_enter = [0.0f64; 64];
         let mut top = 0usize;
         let mut node = 0usize;
         loop {
@@ -187,7 +189,8 @@ impl Bvh {
                 match (ha, hb) {
                     (Some((ta, _)), Some((tb, _))) => {
                         let (near, far, t_far) = if ta <= tb { (a, b, tb) } else { (b, a, ta) };
-                        stack[top] = (far as u32, t_far);
+                        stack_node[top] = far as u32;
+                        stack_enter[top] = t_far;
                         top += 1;
                         node = near;
                         continue;
@@ -209,9 +212,8 @@ impl Bvh {
                     return t_max;
                 }
                 top -= 1;
-                let (next, t_enter) = stack[top];
-                if t_enter <= t_max {
-                    node = next as usize;
+                if stack_enter[top] <= t_max {
+                    node = stack_node[top] as usize;
                     break;
                 }
             }
