@@ -226,6 +226,9 @@ struct Problem {
     t_min: f64,
     tolerance: f64,
     best: Option<PatchHit>,
+    /// Whether any root in range will do (shadow rays): the search ends at the first one
+    /// instead of ruling out nearer ones.
+    any: bool,
 }
 
 /// Where the ray meets the bilinear patch through the four corners of the ray-space patch `p`
@@ -472,6 +475,9 @@ impl Problem {
             if inside(s) && inside(t) && dist > self.t_min && dist < t_max {
                 let uv = window.map(s.clamp(0.0, 1.0), t.clamp(0.0, 1.0));
                 self.best = Some(PatchHit { t: dist, uv });
+                if self.any {
+                    return;
+                }
             }
             // With n·d of one sign over the sub-patch the ray crosses it at most once: the
             // root Newton found (inside or outside the window) is the only one there is.
@@ -523,6 +529,9 @@ impl Problem {
             // Only a root nearer by more than the tolerance is worth finding: without this
             // slack every sub-patch touching a pole (which all contain the root) would be
             // searched, doubling at each level.
+            if self.any && self.best.is_some() {
+                return;
+            }
             if near < self.t_max(t_max) - self.tolerance {
                 self.solve(&children[k], windows[k], depth - 1, t_max);
             }
@@ -555,14 +564,27 @@ fn tolerance(scale: f64, p: &BezierPatch) -> f64 {
     (RELATIVE_TOLERANCE * scale).max(16.0 * f64::EPSILON * far)
 }
 
-/// Intersects `ray` with a prepared leaf, for hits in `(t_min, t_max)`.
+/// Intersects `ray` with a prepared leaf: the nearest hit in `(t_min, t_max)`.
 pub fn intersect_leaf(leaf: &PatchLeaf, frame: &RayFrame, t_min: f64, t_max: f64) -> Option<PatchHit> {
+    search_leaf(leaf, frame, t_min, t_max, false)
+}
+
+/// Whether `ray` meets a prepared leaf anywhere in `(t_min, t_max)` (shadow rays): the same
+/// search as [`intersect_leaf`], ended at the first root found. Where the ray's sub-patch may
+/// hold two roots (the ray nearly tangent to it, as shadow rays often are) the nearest-hit
+/// search splits it to rule out a nearer one; this has no need to.
+pub fn leaf_occludes(leaf: &PatchLeaf, frame: &RayFrame, t_min: f64, t_max: f64) -> bool {
+    search_leaf(leaf, frame, t_min, t_max, true).is_some()
+}
+
+fn search_leaf(leaf: &PatchLeaf, frame: &RayFrame, t_min: f64, t_max: f64, any: bool) -> Option<PatchHit> {
     let p = frame.project(&leaf.sub_patch);
     let mut problem = Problem {
         budget: SPLIT_BUDGET,
         t_min,
         tolerance: tolerance(leaf.scale, &p),
         best: None,
+        any,
     };
     problem.run(&p, leaf.window, LEAF_FALLBACK_DEPTH, t_max);
     problem.best
@@ -612,6 +634,7 @@ pub fn intersect_per_ray(
             t_min,
             tolerance: tolerance(scale, &p),
             best: None,
+            any: false,
         };
         problem.run(&p, window, LEAF_FALLBACK_DEPTH, best.map_or(t_max, |h| h.t));
         if let Some(hit) = problem.best {

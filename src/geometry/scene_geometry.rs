@@ -20,7 +20,8 @@ use super::bezier::BezierPatch;
 use super::bvh::Bvh;
 use super::mesh::TriangleMesh;
 use super::patch::{
-    intersect_leaf, intersect_per_ray, subdivide, PatchLeaf, RayFrame, SubdivisionParams, Window,
+    intersect_leaf, intersect_per_ray, leaf_occludes, subdivide, PatchLeaf, RayFrame, SubdivisionParams,
+    Window,
 };
 use super::quad::{Plane, Quad};
 use super::ray::{spawn_ray, Ray};
@@ -603,7 +604,13 @@ impl SceneGeometry {
         let frame = self.has_patches().then(|| RayFrame::new(ray));
         self.bvh.any(ray, t_max, |k| {
             let primitive = self.primitives[k as usize];
-            counts(self.object_of(primitive)) && self.test(primitive, ray, &frame, t_max).is_some()
+            counts(self.object_of(primitive))
+                && match (primitive, &frame) {
+                    (Primitive::PatchLeaf(i), Some(frame)) => {
+                        leaf_occludes(&self.leaves[i as usize], frame, 0.0, t_max)
+                    }
+                    _ => self.test(primitive, ray, &frame, t_max).is_some(),
+                }
         })
     }
 
