@@ -462,13 +462,23 @@ impl Problem {
 
     /// Finds the nearest root of the ray-space patch `p` over `window` (whose hull the caller
     /// has checked with [`Problem::may_hit`]), splitting up to `depth` more times where Newton
-    /// fails or a second, nearer root cannot be ruled out.
-    fn solve(&mut self, p: &BezierPatch, window: Window, depth: u32, t_max: f64) {
+    /// fails or a second, nearer root cannot be ruled out. `known` is a root `(s, t, distance)`
+    /// of `p` already found in the sub-patch this one was split from: it stands for the
+    /// Newton solve, which would only find it again.
+    fn solve(
+        &mut self,
+        p: &BezierPatch,
+        window: Window,
+        depth: u32,
+        t_max: f64,
+        known: Option<(f64, f64, f64)>,
+    ) {
         let t_max = self.t_max(t_max);
-        if beside(p, self.tolerance) {
-            return;
-        }
-        let root = newton(p, self.tolerance, bilinear_start(p));
+        let root = match known {
+            Some(root) => Some(root),
+            None if beside(p, self.tolerance) => return,
+            None => newton(p, self.tolerance, bilinear_start(p)),
+        };
         self.budget = self.budget.saturating_sub(1);
         if let Some((s, t, dist)) = root {
             let inside = |x: f64| (-WINDOW_MARGIN..=1.0 + WINDOW_MARGIN).contains(&x);
@@ -533,7 +543,13 @@ impl Problem {
                 return;
             }
             if near < self.t_max(t_max) - self.tolerance {
-                self.solve(&children[k], windows[k], depth - 1, t_max);
+                // The root found here, in the quarter's own parameters, if it lies there.
+                let (ds, dt) = QUARTER_OFFSETS[k];
+                let inherited = root.and_then(|(s, t, dist)| {
+                    let (s, t) = (2.0 * s - ds, 2.0 * t - dt);
+                    ((0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&t)).then_some((s, t, dist))
+                });
+                self.solve(&children[k], windows[k], depth - 1, t_max, inherited);
             }
         }
     }
@@ -541,10 +557,13 @@ impl Problem {
     /// Culls, then solves the ray-space patch `p`.
     fn run(&mut self, p: &BezierPatch, window: Window, depth: u32, t_max: f64) {
         if self.may_hit(hull(p), self.t_max(t_max)) {
-            self.solve(p, window, depth, t_max);
+            self.solve(p, window, depth, t_max, None);
         }
     }
 }
+
+/// Where each quarter of [`BezierPatch::split_quad`] starts in its parent's `(s, t)`, doubled.
+const QUARTER_OFFSETS: [(f64, f64); 4] = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)];
 
 /// Sub-patches one search may solve before it settles for the nearest root found so far.
 /// Ordinary rays use one to a few; rays through a pole or tangent to the surface can use many.
