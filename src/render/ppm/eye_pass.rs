@@ -11,7 +11,6 @@ use rayon::prelude::*;
 use super::points::{self, Shade, VisiblePoints};
 use super::visible::{trace_eye, Branching, VisiblePoint};
 
-use super::radius::IndirectScale;
 use super::{direct, streams, Estimate, Ppm, Slot};
 use crate::render::rng::stream_rng;
 use crate::render::sequence;
@@ -170,12 +169,7 @@ impl Ppm {
             let r0 = self
                 .initial_radius
                 .unwrap_or_else(|| self.automatic_radius(scene));
-            let indirect = match self.indirect_scale {
-                IndirectScale::Off => 0.0,
-                // The first pass measures the photon density; `update` widens it after.
-                IndirectScale::Automatic => r0,
-                IndirectScale::Fixed(k) => k * r0,
-            };
+            let indirect = self.indirect_scale.initial_radius(r0);
             for s in &mut self.slots {
                 s.primary = Estimate::empty(r0 * r0);
                 s.indirect = Estimate::empty(indirect * indirect);

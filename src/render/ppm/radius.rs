@@ -21,6 +21,19 @@ pub(super) enum IndirectScale {
     Fixed(f64),
 }
 
+impl IndirectScale {
+    /// The radius a cold slot's indirect estimate starts at, for the initial radius `r0`: none
+    /// when it is off; `r0` while automatic (the first pass measures the photon density, and
+    /// [`Ppm::widen_indirect`] widens it after).
+    pub(super) fn initial_radius(self, r0: f64) -> f64 {
+        match self {
+            IndirectScale::Off => 0.0,
+            IndirectScale::Automatic => r0,
+            IndirectScale::Fixed(k) => k * r0,
+        }
+    }
+}
+
 /// Indirect photons an automatic indirect radius aims to hand each point per pass.
 pub(super) const INDIRECT_PHOTONS: f64 = 32.0;
 

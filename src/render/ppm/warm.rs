@@ -357,16 +357,12 @@ impl Ppm {
     /// when the initial radius is set.
     fn reopen(&self) -> Reopen {
         let r0_2 = self.initial_radius2;
-        let indirect = match self.indirect_scale {
-            IndirectScale::Off => 0.0,
-            IndirectScale::Automatic => r0_2,
-            IndirectScale::Fixed(k) => k * k * r0_2,
-        };
+        let indirect = self.indirect_scale.initial_radius(r0_2.sqrt());
         Reopen {
             cap: PRIOR_PASSES * self.photons_per_pass as f64,
             first_pass: self.photons_per_pass as f64,
             alpha: self.alpha,
-            ceiling2: [r0_2, indirect],
+            ceiling2: [r0_2, indirect * indirect],
         }
     }
 
