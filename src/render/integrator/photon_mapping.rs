@@ -39,7 +39,7 @@ impl Integrator for PhotonMapping {
         ppm.photons_per_pass = if ppm.pass_sums().is_some() {
             full
         } else {
-            plan.pass_photons(ppm.stats().passes, full)
+            plan.pass_photons(ppm.stats().passes, full, ppm.is_warm())
         };
         ppm.run_pass(scene, control) == PassOutcome::Completed
     }

@@ -251,6 +251,11 @@ fn runs(slots: &[Slot]) -> Vec<(u32, std::ops::Range<usize>)> {
 }
 
 impl Ppm {
+    /// Whether this epoch continues an earlier one's estimates (it inherited a warm start).
+    pub fn is_warm(&self) -> bool {
+        self.offset != StreamOffset::default()
+    }
+
     /// Each slot's visible point of the last eye pass (see [`records`]).
     pub(super) fn point_records(&self) -> Vec<PointRecord> {
         records(self.slots.len(), &self.points)
