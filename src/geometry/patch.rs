@@ -501,25 +501,46 @@ impl Problem {
             return;
         }
         if depth == 0 {
-            // The sub-patch is tiny and still surrounds the ray: accept the corner nearest the
-            // ray. Corners lie exactly on the surface, and at a pole one of them is the pole.
-            if self.best.is_none() {
-                let corners = [(0, 0.0, 0.0), (3, 0.0, 1.0), (12, 1.0, 0.0), (15, 1.0, 1.0)];
-                let off = |k: usize| p.points[k].truncate().length();
-                let (k, s, t) = corners
-                    .into_iter()
-                    .min_by(|a, b| off(a.0).total_cmp(&off(b.0)))
-                    .unwrap_or((0, 0.0, 0.0));
-                let dist = p.points[k].z;
-                if dist > self.t_min && dist < t_max {
-                    self.best = Some(PatchHit {
-                        t: dist,
-                        uv: window.map(s, t),
-                    });
-                }
-            }
+            self.settle_at_corner(p, window, t_max);
             return;
         }
+        self.solve_quarters(p, window, depth, t_max, root);
+    }
+
+    /// At the depth limit, a tiny sub-patch that still surrounds the ray: accepts the corner
+    /// nearest the ray when nothing was found. Corners lie exactly on the surface, and at a
+    /// pole one of them is the pole.
+    fn settle_at_corner(&mut self, p: &BezierPatch, window: Window, t_max: f64) {
+        if self.best.is_some() {
+            return;
+        }
+        let corners = [(0, 0.0, 0.0), (3, 0.0, 1.0), (12, 1.0, 0.0), (15, 1.0, 1.0)];
+        let off = |k: usize| p.points[k].truncate().length();
+        let (k, s, t) = corners
+            .into_iter()
+            .min_by(|a, b| off(a.0).total_cmp(&off(b.0)))
+            .unwrap_or((0, 0.0, 0.0));
+        let dist = p.points[k].z;
+        if dist > self.t_min && dist < t_max {
+            self.best = Some(PatchHit {
+                t: dist,
+                uv: window.map(s, t),
+            });
+        }
+    }
+
+    /// Splits `p` (over `window`) into quarters and solves those that may hold a root,
+    /// nearest first so that later ones are pruned by the nearer root found. `root`, the root
+    /// Newton found in `p` (if any), goes to the quarter that holds it ([`Problem::solve`]'s
+    /// `known`).
+    fn solve_quarters(
+        &mut self,
+        p: &BezierPatch,
+        window: Window,
+        depth: u32,
+        t_max: f64,
+        root: Option<(f64, f64, f64)>,
+    ) {
         let t_max = self.t_max(t_max);
         let children = p.split_quad();
         let windows = window.quarters();
