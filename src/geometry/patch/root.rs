@@ -1,0 +1,222 @@
+//! The solve in one ray-space sub-patch ([`super`]'s root finder): where Newton starts (the
+//! ray's crossing of the corners' bilinear patch), the quadrilateral test that rules a
+//! sub-patch out before any Newton step, Newton itself (Levenberg–Marquardt where the
+//! Jacobian is near singular), and the test that proves a root unique (the Jacobian's sign
+//! fixed over the sub-patch).
+
+use glam::DVec2;
+
+use crate::geometry::bezier::BezierPatch;
+
+/// Newton iterations before giving up on a sub-patch and splitting it.
+const MAX_NEWTON_ITERATIONS: usize = 10;
+
+/// Where the ray meets the bilinear patch through the four corners of the ray-space patch `p`
+/// (inverse bilinear interpolation, solved as a quadratic), clamped near `[0,1]²`; the middle
+/// `(0.5, 0.5)` when the quadratic has no usable root. A start this close to the root lets
+/// Newton converge in two or three steps to the root in this window rather than another.
+pub(super) fn bilinear_start(p: &BezierPatch) -> (f64, f64) {
+    let cross = |a: DVec2, b: DVec2| a.x * b.y - a.y * b.x;
+    let p00 = p.points[0].truncate();
+    let e = p.points[12].truncate() - p00; // along s
+    let f = p.points[3].truncate() - p00; // along t
+    let g = p00 - p.points[12].truncate() - p.points[3].truncate() + p.points[15].truncate();
+    let h = -p00;
+    let k2 = cross(g, f);
+    let k1 = cross(e, f) + cross(h, g);
+    let k0 = cross(h, e);
+    let t_candidates = if k2.abs() <= 1e-12 * k1.abs() {
+        [-k0 / k1, f64::NAN]
+    } else {
+        let disc = k1 * k1 - 4.0 * k0 * k2;
+        if disc < 0.0 {
+            return (0.5, 0.5);
+        }
+        let q = -0.5 * (k1 + k1.signum() * disc.sqrt());
+        [q / k2, k0 / q]
+    };
+    let mut best = (0.5, 0.5);
+    let mut best_outside = f64::INFINITY;
+    for t in t_candidates {
+        if !t.is_finite() {
+            continue;
+        }
+        let den = e + g * t;
+        let s = if den.x.abs() >= den.y.abs() {
+            (h.x - f.x * t) / den.x
+        } else {
+            (h.y - f.y * t) / den.y
+        };
+        if !s.is_finite() {
+            continue;
+        }
+        // Prefer the candidate nearest the unit square.
+        let outside = (s - s.clamp(0.0, 1.0)).abs().max((t - t.clamp(0.0, 1.0)).abs());
+        if outside < best_outside {
+            best_outside = outside;
+            best = (s.clamp(-0.25, 1.25), t.clamp(-0.25, 1.25));
+        }
+    }
+    best
+}
+
+/// Whether the ray passes farther than `tolerance` from the ray-space sub-patch `p`, judged by
+/// the bilinear patch `L` through its four corners.
+///
+/// `p − L` is itself a Bézier patch whose control points are `P_ij − L(i/3, j/3)` (a bilinear
+/// patch degree-elevated to bicubic has the control points `L(i/3, j/3)`), so by the convex
+/// hull property every point of `p` lies within `δ = max |P_ij − L(i/3, j/3)|` of `L`. Where
+/// the corners form a strictly convex quadrilateral, `L` maps the unit square onto it, and a
+/// ray farther than `δ + tolerance` outside one of its edge lines meets no point of `p`. For a
+/// nearly flat sub-patch the quadrilateral is much tighter than the box of the control
+/// points: this one test replaces the Newton solves and splits that find no root where the
+/// ray passes beside a sub-patch (its root lies in a neighbour, or it misses).
+pub(super) fn beside(p: &BezierPatch, tolerance: f64) -> bool {
+    let corner = |k: usize| p.points[k].truncate();
+    // Counter-clockwise or clockwise; the orientation comes from the first corner's turn.
+    let quad = [corner(0), corner(12), corner(15), corner(3)];
+    let cross = |a: DVec2, b: DVec2| a.x * b.y - a.y * b.x;
+    let edges = [
+        quad[1] - quad[0],
+        quad[2] - quad[1],
+        quad[3] - quad[2],
+        quad[0] - quad[3],
+    ];
+    let turns = [
+        cross(edges[3], edges[0]),
+        cross(edges[0], edges[1]),
+        cross(edges[1], edges[2]),
+        cross(edges[2], edges[3]),
+    ];
+    let orientation = turns[0].signum();
+    if !turns.iter().all(|&turn| turn * orientation > 0.0) {
+        return false;
+    }
+    // Distance of the ray (the origin) outside each edge line; the largest one.
+    let mut outside = f64::NEG_INFINITY;
+    for (edge, start) in edges.iter().zip(quad) {
+        let length = edge.length();
+        // The origin relative to the edge's start, against the interior's side.
+        let side = -orientation * cross(*edge, -start) / length;
+        outside = outside.max(side);
+    }
+    // (No NaN reaches here: a NaN corner fails the convexity test above.)
+    if outside <= tolerance {
+        return false;
+    }
+    let (p00, e, f, g) = (
+        quad[0],
+        edges[0],
+        quad[3] - quad[0],
+        quad[0] - quad[1] + quad[2] - quad[3],
+    );
+    let mut deviation2: f64 = 0.0;
+    for i in 0..4 {
+        let s = i as f64 / 3.0;
+        for j in 0..4 {
+            let t = j as f64 / 3.0;
+            let bilinear = p00 + e * s + f * t + g * (s * t);
+            deviation2 = deviation2.max((corner(4 * i + j) - bilinear).length_squared());
+        }
+    }
+    let margin = outside - tolerance;
+    margin * margin > deviation2
+}
+
+/// Newton (or Levenberg–Marquardt where the Jacobian is near singular) on the first two
+/// ray-space coordinates, from [`bilinear_start`] and, should that fail (its corners can
+/// coincide at a pole), from the middle. Returns the root `(s, t)` and its ray distance.
+pub(super) fn newton(p: &BezierPatch, tolerance: f64, start: (f64, f64)) -> Option<(f64, f64, f64)> {
+    let clamped = !(0.0..=1.0).contains(&start.0) || !(0.0..=1.0).contains(&start.1);
+    newton_from(p, tolerance, start)
+        .or_else(|| clamped.then(|| newton_from(p, tolerance, (0.5, 0.5))).flatten())
+}
+
+/// Newton from `(s, t)`, with steps limited to half the sub-patch.
+fn newton_from(p: &BezierPatch, tolerance: f64, (mut s, mut t): (f64, f64)) -> Option<(f64, f64, f64)> {
+    let mut previous = f64::INFINITY;
+    for iteration in 0..MAX_NEWTON_ITERATIONS {
+        let [f, fs, ft] = p.eval_xy_with_derivs(s, t);
+        let residual = f.x.abs().max(f.y.abs());
+        if residual <= tolerance {
+            return Some((s, t, p.eval(s, t).z));
+        }
+        // Converging Newton shrinks the residual far faster than this; give the split
+        // fallback the sub-patch instead of iterating on.
+        if iteration >= 3 && residual > 0.5 * previous {
+            return None;
+        }
+        previous = residual;
+        // Solve [fs ft] (ds, dt) = f for the first two coordinates.
+        let det = fs.x * ft.y - fs.y * ft.x;
+        let norm2 = fs.x * fs.x + fs.y * fs.y + ft.x * ft.x + ft.y * ft.y;
+        let (mut ds, mut dt) = if det.abs() > 1e-9 * norm2 {
+            ((f.x * ft.y - f.y * ft.x) / det, (fs.x * f.y - fs.y * f.x) / det)
+        } else {
+            // Minimum-norm damped least squares: Δ = Jᵀ (J Jᵀ + λI)⁻¹ f.
+            let lambda = 1e-12 * norm2 + f64::MIN_POSITIVE;
+            let a = fs.x * fs.x + ft.x * ft.x + lambda;
+            let b = fs.x * fs.y + ft.x * ft.y;
+            let d = fs.y * fs.y + ft.y * ft.y + lambda;
+            let det2 = a * d - b * b;
+            if det2 == 0.0 || !det2.is_finite() {
+                return None;
+            }
+            let y0 = (d * f.x - b * f.y) / det2;
+            let y1 = (a * f.y - b * f.x) / det2;
+            (fs.x * y0 + fs.y * y1, ft.x * y0 + ft.y * y1)
+        };
+        // Trust region: never jump more than half the sub-patch in one step.
+        let step = ds.abs().max(dt.abs());
+        if step > MAX_STEP {
+            ds *= MAX_STEP / step;
+            dt *= MAX_STEP / step;
+        }
+        s -= ds;
+        t -= dt;
+        // Well outside the sub-patch: the root (if any) is not this one's.
+        if !(-0.5..=1.5).contains(&s) || !(-0.5..=1.5).contains(&t) {
+            return None;
+        }
+    }
+    None
+}
+
+/// Largest Newton step in sub-patch parameters.
+const MAX_STEP: f64 = 0.5;
+
+/// Whether `det [∂(x,y)/∂s ∂(x,y)/∂t]` — which in ray space is `(Ps × Pt)·d`, the normal
+/// against the ray direction — provably keeps one sign over the sub-patch. The derivative
+/// patches' control points are differences of `p`'s; interval products of their bounds bound
+/// the determinant. Between two crossings of a smooth surface piece the ray would have to be
+/// tangent to it somewhere, where the determinant is zero, so a fixed sign means at most one
+/// root.
+pub(super) fn jacobian_sign_is_fixed(p: &BezierPatch) -> bool {
+    let (mut su_lo, mut su_hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+    let (mut sv_lo, mut sv_hi) = (su_lo, su_hi);
+    for i in 0..4 {
+        for j in 0..4 {
+            if i < 3 {
+                let d = (p.points[4 * (i + 1) + j] - p.points[4 * i + j]).truncate();
+                su_lo = su_lo.min(d);
+                su_hi = su_hi.max(d);
+            }
+            if j < 3 {
+                let d = (p.points[4 * i + j + 1] - p.points[4 * i + j]).truncate();
+                sv_lo = sv_lo.min(d);
+                sv_hi = sv_hi.max(d);
+            }
+        }
+    }
+    let product = |a_lo: f64, a_hi: f64, b_lo: f64, b_hi: f64| {
+        let c = [a_lo * b_lo, a_lo * b_hi, a_hi * b_lo, a_hi * b_hi];
+        (
+            c.iter().copied().fold(f64::INFINITY, f64::min),
+            c.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        )
+    };
+    let (a_lo, a_hi) = product(su_lo.x, su_hi.x, sv_lo.y, sv_hi.y);
+    let (b_lo, b_hi) = product(su_lo.y, su_hi.y, sv_lo.x, sv_hi.x);
+    // det = a - b ∈ [a_lo - b_hi, a_hi - b_lo]
+    a_lo - b_hi > 0.0 || a_hi - b_lo < 0.0
+}
