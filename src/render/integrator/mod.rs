@@ -43,7 +43,7 @@ impl PassPlan {
     /// Photons of the pass after `completed` passes of a render whose full pass is `full`.
     /// An epoch that continues an earlier one's estimates (`warm`, a warm restart) ramps only
     /// its first pass: that pass stays small so that the edit's first image comes as soon as
-    /// a cold epoch's would, but from then on its image is the kept estimates plus new
+    /// it did with the doubling ramp, but from then on its image is the kept estimates plus new
     /// photons, and what improves it is photons per second, which small passes waste on each
     /// pass's fixed cost (the stochastic eye pass: about 40 ms of a 16,384-photon pass's
     /// 50 ms on `scenes/inline_patch.toml`). `caustic bench edit` (inline_patch, three

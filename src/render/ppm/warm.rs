@@ -172,9 +172,8 @@ fn carry(old: &PointRecord, new: &PointRecord, radius2: f64) -> Option<DVec3> {
 /// How a kept estimate is reopened for the new epoch ([`Reopen::prior`]).
 #[derive(Clone, Copy, Debug)]
 struct Reopen {
-    /// The most photons a prior is worth.
-    cap: f64,
-    /// Photons of the epoch's first pass.
+    /// Photons of the epoch's first pass (a prior is worth at most [`PRIOR_PASSES`] of them,
+    /// [`Reopen::cap`]).
     first_pass: f64,
     /// PPM's α (a pass adds `α M` to `N`).
     alpha: f64,
@@ -183,16 +182,23 @@ struct Reopen {
 }
 
 impl Reopen {
+    /// The most photons a prior is worth.
+    fn cap(&self) -> f64 {
+        PRIOR_PASSES * self.first_pass
+    }
+
     /// A previous slot as a prior for a new point, its flux scaled by `factor` for the new
-    /// point's weight. It is worth at most `cap` photons: flux and count `N` scaled down with
-    /// the photons it counts, so that it behaves as an estimate that gathered that many. And
+    /// point's weight. It is worth at most [`Reopen::cap`] photons: flux and count `N` scaled
+    /// down with the photons it counts, so that it behaves as an estimate that gathered that
+    /// many. And
     /// each estimate is widened ([`Reopen::widened`]) where its converged, narrow radius would
     /// hand the new epoch's first passes too few photons: at the old radius those few new
     /// photons are noisier than a cold start's (on the built-in teapot a warm restart reached
     /// the error 1e-2 later than a cold one).
     fn prior(&self, mut slot: Slot, factor: DVec3) -> Slot {
         let prior = slot.prior as f64;
-        let scale = if prior > self.cap { self.cap / prior } else { 1.0 };
+        let cap = self.cap();
+        let scale = if prior > cap { cap / prior } else { 1.0 };
         let photons = prior * scale;
         for (k, e) in [&mut slot.primary, &mut slot.indirect].into_iter().enumerate() {
             e.scale_tau(scale * factor);
@@ -364,7 +370,6 @@ impl Ppm {
         let r0_2 = self.initial_radius2;
         let indirect = self.indirect_scale.initial_radius(r0_2.sqrt());
         Reopen {
-            cap: PRIOR_PASSES * self.photons_per_pass as f64,
             first_pass: self.photons_per_pass as f64,
             alpha: self.alpha,
             ceiling2: [r0_2, indirect * indirect],
@@ -511,9 +516,9 @@ impl Ppm {
 mod tests {
     use super::*;
 
-    /// A reopening for a first pass of 10,000 photons, α = 0.5, cold radii² 1 and 4.
+    /// A reopening for a first pass of 10,000 photons (a cap of 80,000), α = 0.5, cold radii²
+    /// 1 and 4.
     const REOPEN: Reopen = Reopen {
-        cap: 80_000.0,
         first_pass: 10_000.0,
         alpha: 0.5,
         ceiling2: [1.0, 4.0],
