@@ -45,6 +45,18 @@ fn hash(c: IVec3) -> u64 {
         >> 16
 }
 
+/// The 21 low bits of `v` spread to every third bit of the result.
+#[inline]
+fn spread(v: u32) -> u64 {
+    let mut x = v as u64 & 0x1f_ffff;
+    x = (x | x << 32) & 0x1f_0000_0000_ffff;
+    x = (x | x << 16) & 0x1f_0000_ff00_00ff;
+    x = (x | x << 8) & 0x100f_00f0_0f00_f00f;
+    x = (x | x << 4) & 0x10c3_0c30_c30c_30c3;
+    x = (x | x << 2) & 0x1249_2492_4924_9249;
+    x
+}
+
 impl HashGrid {
     /// Builds the grid over `points` and returns with it the order the points must be stored
     /// in for it: place `i` holds point `order[i]` (within a bucket the points keep their
@@ -95,6 +107,18 @@ impl HashGrid {
     #[inline]
     fn cell_of(&self, p: DVec3) -> IVec3 {
         ((p - self.origin) * self.inv_cell).floor().as_ivec3()
+    }
+
+    /// A key that orders places by their cell, neighbouring cells mostly near each other
+    /// (Morton order of the cell's coordinates, clamped to 21 bits an axis): photons handled
+    /// in this order read the same points' cells one after another.
+    #[inline]
+    pub fn cell_key(&self, p: DVec3) -> u64 {
+        let c = ((p - self.origin) * self.inv_cell)
+            .floor()
+            .clamp(DVec3::ZERO, DVec3::splat(((1 << 21) - 1) as f64))
+            .as_uvec3();
+        spread(c.x) | spread(c.y) << 1 | spread(c.z) << 2
     }
 
     #[inline]

@@ -15,6 +15,15 @@ pub enum SpatialIndex {
 }
 
 impl SpatialIndex {
+    /// The order photons are best handled in ([`HashGrid::cell_key`]; none for the kd-tree).
+    #[inline]
+    pub fn sort_key(&self, p: DVec3) -> u64 {
+        match self {
+            SpatialIndex::Grid(g) => g.cell_key(p),
+            SpatialIndex::Kd(_) => 0,
+        }
+    }
+
     /// Calls `f` with candidate points near `p` (the caller checks the radius), among them
     /// every point whose sphere, of a radius at most `radius`, holds `p`.
     #[inline]

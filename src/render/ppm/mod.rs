@@ -21,6 +21,7 @@
 //! `(seed, pass, pixel)`; photons are traced in fixed chunks whose deposits are applied in
 //! chunk order, so the image is bit-identical for any number of threads.
 
+mod deposit;
 mod estimate;
 mod eye_pass;
 mod gathered;

@@ -1,13 +1,15 @@
-//! The photon pass: photons traced in fixed chunks in parallel, their deposits reduced in
-//! chunk order (so the image is the same for any thread count), batch by batch with the
-//! caller asked between batches.
+//! The photon pass: photons traced in fixed chunks in parallel, batch by batch with the
+//! caller asked between batches; where they meet diffuse surfaces is handed to the visible
+//! points a window of many batches at a time, in the order of the grid's cells
+//! ([`deposit`](super::deposit)), and reduced in that order (so the image is the same for
+//! any thread count).
 
-use glam::Vec3;
 use rayon::prelude::*;
 
+use super::deposit::{Gather, Hit, Window, WINDOW_PHOTONS};
 use super::gathered::Gathered;
-use super::guide::{EmissionGuide, GuideTally};
-use super::photon::{PhotonCounts, PhotonSource};
+use super::guide::EmissionGuide;
+use super::photon::{Emitted, PhotonCounts, PhotonSource};
 
 use super::radius::IndirectScale;
 use super::{streams, Control, Ppm, SpatialIndex};
@@ -21,32 +23,12 @@ pub(super) const CHUNK: u64 = 4096;
 /// control callback is asked between batches.
 pub const DEFAULT_BATCH_PHOTONS: u64 = 16 * CHUNK;
 
-/// Deposits one chunk may hold before they are merged per slot: bounds memory when radii are
-/// large (every photon then reaches thousands of points).
-pub(super) const MAX_CHUNK_DEPOSITS: usize = 1 << 20;
-
-/// Flux handed to a statistics slot: `(slot, flux × point weight, photon count)`, the flux
-/// in f32 as the pass sums it (20 bytes a deposit, not 32).
-pub(super) type Deposit = (u32, Vec3, u32);
-
-/// What one chunk of photons left: its deposits, counts and guide tally.
-pub(super) type ChunkResult = (Vec<Deposit>, PhotonCounts, Option<GuideTally>);
-
-/// Merges deposits to the same slot, keeping each slot's additions in photon order (a stable
-/// sort), so the sums depend only on the chunk's photons, not on threads.
-pub(super) fn compact(deposits: &mut Vec<Deposit>) {
-    deposits.sort_by_key(|d| d.0);
-    let mut merged: Vec<Deposit> = Vec::with_capacity(deposits.len() / 4);
-    for &(slot, flux, count) in deposits.iter() {
-        match merged.last_mut() {
-            Some(last) if last.0 == slot => {
-                last.1 += flux;
-                last.2 += count;
-            }
-            _ => merged.push((slot, flux, count)),
-        }
-    }
-    *deposits = merged;
+/// What one chunk of photons left: where they met surfaces whose flux is gathered, where
+/// each came from (in photon order), and counts.
+struct Traced {
+    hits: Vec<Hit>,
+    from: Vec<Emitted>,
+    counts: PhotonCounts,
 }
 
 impl Ppm {
@@ -76,33 +58,56 @@ impl Ppm {
             (max2 as f64).sqrt()
         });
         self.pass_photons = self.guided_pass_photons();
+        let gather = Gather {
+            index,
+            points: &self.points,
+            radius,
+            estimates,
+        };
+        // α as the caller sets it between batches, kept whether or not the pass completes.
+        let mut alpha = self.alpha;
+        let traced = self.trace_photons(&source, &gather, &mut out, &mut || control(&mut alpha));
+        self.alpha = alpha;
+        traced.map(|()| out)
+    }
+
+    /// Traces the pass's photons batch by batch (asking `control` before each) and hands
+    /// their hits to the points a window at a time, into `out`; `None` when `control` aborts.
+    fn trace_photons(
+        &self,
+        source: &PhotonSource,
+        gather: &Gather,
+        out: &mut Gathered,
+        control: &mut dyn FnMut() -> Control,
+    ) -> Option<()> {
         let chunks = self.pass_photons.div_ceil(CHUNK);
-        let chunks_per_batch = self.options.batch_photons.div_ceil(CHUNK).max(1);
+        let most = WINDOW_PHOTONS as u64 / CHUNK;
+        let chunks_per_batch = self.options.batch_photons.div_ceil(CHUNK).clamp(1, most);
+        let mut window = Window::default();
         let mut chunk = 0;
         while chunk < chunks {
-            if control(&mut self.alpha) == Control::Abort {
+            if control() == Control::Abort {
                 return None;
             }
             let end = (chunk + chunks_per_batch).min(chunks);
-            let results: Vec<ChunkResult> = (chunk..end)
+            let traced: Vec<Traced> = (chunk..end)
                 .into_par_iter()
-                .map(|c| self.trace_chunk(c, &source, index, radius))
+                .map(|c| {
+                    let first = window.photons() + ((c - chunk) * CHUNK) as u32;
+                    self.trace_chunk(c, first, source, gather.index)
+                })
                 .collect();
-            // Fold in chunk order: the same sums whatever the thread count.
-            for (deposits, c, tally) in results {
-                if let (Some(all), Some(t)) = (&mut out.tally, &tally) {
-                    all.add(t);
-                }
-                for (at, flux, count) in deposits {
-                    out.add(at, flux, count);
-                }
-                out.counts.paths += c.paths;
-                out.counts.bounces += c.bounces;
-                out.counts.useful += c.useful;
+            for t in traced {
+                window.push(t.hits, t.from);
+                out.counts.paths += t.counts.paths;
+                out.counts.bounces += t.counts.bounces;
             }
             chunk = end;
+            if window.is_full() || chunk == chunks {
+                window.hand(gather, out, control)?;
+            }
         }
-        Some(out)
+        Some(())
     }
 
     /// Estimates each slot gathers into this pass: 2, or 1 when the indirect one is off.
@@ -126,51 +131,25 @@ impl Ppm {
         }
     }
 
-    /// Traces photon chunk `c` of this pass: the deposits it makes and its counts.
-    pub(super) fn trace_chunk(
-        &self,
-        c: u64,
-        source: &PhotonSource,
-        index: &SpatialIndex,
-        radius: [f64; 2],
-    ) -> ChunkResult {
-        let mut deposits: Vec<Deposit> = Vec::new();
+    /// Traces photon chunk `c` of this pass, whose first photon is the `first`th of its window:
+    /// where its photons met surfaces whose flux is gathered, where they came from, its counts.
+    fn trace_chunk(&self, c: u64, first: u32, source: &PhotonSource, index: &SpatialIndex) -> Traced {
         let mut counts = PhotonCounts::default();
-        let mut tally = self.guide.as_ref().map(EmissionGuide::tally);
         let (photons, first_photon) = (self.pass_photons, self.first_photon());
-        let (reach, shade) = (&self.points.reach, &self.points.shade);
-        let estimates = self.estimates();
-        let split = estimates == 2;
-        for i in c * CHUNK..((c + 1) * CHUNK).min(photons) {
+        let split = self.estimates() == 2;
+        let (start, end) = (c * CHUNK, ((c + 1) * CHUNK).min(photons));
+        let mut hits = Vec::with_capacity(2 * (end - start) as usize);
+        let mut from = Vec::with_capacity((end - start) as usize);
+        for i in start..end {
             let mut rng = stream_rng(self.seed, streams::PHOTON, first_photon + i);
-            let mut useful = false;
-            let from = source.trace(&mut rng, &mut counts, &mut |p, n, flux, indirect| {
-                // Hand the flux to every visible point on this side of the surface whose
-                // search sphere (of the photon's estimate) holds the photon.
-                let estimate = usize::from(indirect && split);
-                index.for_candidates(reach, p, radius[estimate], &mut |k| {
-                    let r = &reach[k as usize];
-                    if (r.position - p).length_squared() <= r.radius2[estimate] as f64 {
-                        let s = &shade[k as usize];
-                        if s.normal.as_dvec3().dot(n) > 1e-3 {
-                            deposits.push((
-                                Gathered::at(estimates, s.slot, estimate),
-                                (s.weight.as_dvec3() * flux).as_vec3(),
-                                1,
-                            ));
-                            useful = true;
-                        }
-                    }
-                });
-            });
-            counts.useful += useful as u64;
-            if let Some(t) = &mut tally {
-                t.record(from.light, from.bin, useful);
-            }
-            if deposits.len() > MAX_CHUNK_DEPOSITS {
-                compact(&mut deposits);
-            }
+            let photon = first + (i - start) as u32;
+            let mut nth = 0;
+            from.push(source.trace(&mut rng, &mut counts, &mut |p, n, flux, indirect| {
+                let key = index.sort_key(p);
+                hits.push(Hit::new(key, p, n, flux, (photon, nth), indirect && split));
+                nth += 1;
+            }));
         }
-        (deposits, counts, tally)
+        Traced { hits, from, counts }
     }
 }
