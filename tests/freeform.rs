@@ -326,9 +326,9 @@ material = "m"
         .intersect(&Ray::new(DVec3::new(1.0, 0.8, 6.0), DVec3::NEG_Z), f64::INFINITY)
         .expect("hits the surface");
     assert!(
-        (3.0..=5.0).contains(&hit.uv.x) && (3.0..=5.0).contains(&hit.uv.y),
+        (3.0..=5.0).contains(&hit.uv().x) && (3.0..=5.0).contains(&hit.uv().y),
         "uv {} is not in the surface's parameters",
-        hit.uv
+        hit.uv()
     );
     // Edited and saved, the patches keep their windows.
     let loaded: Vec<BezierPatch> = scene.geometry.patches().iter().map(|(p, _)| *p).collect();

@@ -12,7 +12,7 @@ use rayon::prelude::*;
 
 fn assert_finite(hit: &Hit) {
     assert!(
-        hit.t.is_finite() && hit.point.is_finite() && hit.uv.is_finite(),
+        hit.t.is_finite() && hit.point.is_finite() && hit.uv().is_finite(),
         "{hit:?}"
     );
     assert!(
@@ -67,11 +67,11 @@ fn round_trip_hits_the_aimed_point() {
             assert_finite(&hit);
             assert_eq!(hit.shape, ShapeRef::Patch(0));
             // Every hit lies on the patch at its reported (u,v).
-            let on_surface = (patch.eval(hit.uv.x, hit.uv.y) - hit.point).length();
+            let on_surface = (patch.eval(hit.uv().x, hit.uv().y) - hit.point).length();
             assert!(
                 on_surface <= 1e-9 * diag,
                 "patch {k} ({u},{v}) dir {dir} n {n}: hit {on_surface:e} off the surface at {}",
-                hit.uv
+                hit.uv()
             );
             // The patch may fold in front of the target (never by more than rounding otherwise).
             if hit.t < distance - 1e-9 * diag {
@@ -86,7 +86,7 @@ fn round_trip_hits_the_aimed_point() {
             // (u,v) is recoverable where the parameterisation is regular.
             let sp = patch.eval_with_derivs(u, v);
             if sp.dp_du.cross(sp.dp_dv).length() > 1e-3 * diag * diag {
-                let uv_error = (hit.uv - DVec2::new(u, v)).length();
+                let uv_error = (hit.uv() - DVec2::new(u, v)).length();
                 assert!(uv_error < 1e-7, "patch {k}: (u,v) error {uv_error:e}");
                 checked_uv += 1;
             }
@@ -279,7 +279,7 @@ fn axis_aligned_and_grazing_rays_stay_finite() {
                 let ShapeRef::Patch(hp) = hit.shape else {
                     panic!("only patches here")
                 };
-                let off = (patches[hp as usize].eval(hit.uv.x, hit.uv.y) - hit.point).length();
+                let off = (patches[hp as usize].eval(hit.uv().x, hit.uv().y) - hit.point).length();
                 assert!(
                     off < 1e-7 * diag,
                     "patch {k}: grazing hit {off:e} off its surface"
@@ -326,7 +326,11 @@ fn rays_leaving_a_surface_do_not_hit_it_again_at_zero() {
 /// Nearest hits of many random rays through the teapot's bounds: `(t, uv, shape)`.
 fn hits_of(geometry: &caustic::geometry::SceneGeometry, rays: &[Ray]) -> Vec<Option<(f64, DVec2, ShapeRef)>> {
     rays.par_iter()
-        .map(|r| geometry.intersect(r, f64::INFINITY).map(|h| (h.t, h.uv, h.shape)))
+        .map(|r| {
+            geometry
+                .intersect(r, f64::INFINITY)
+                .map(|h| (h.t, h.uv(), h.shape))
+        })
         .collect()
 }
 

@@ -93,9 +93,9 @@ pub struct Hit {
     pub normal: DVec3,
     /// Unit shading normal (interpolated for meshes with normals), same side as `normal`.
     pub shading_normal: DVec3,
-    /// Surface parameters: the original patch's `(u,v)`, sphere `(φ/2π, θ/π)`, quad `(a,b)`,
-    /// plane coordinates in scene units, mesh texture coordinates (or barycentrics).
-    pub uv: DVec2,
+    /// [`Hit::uv`], but for spheres, whose `(u,v)` (two inverse trigonometric functions) is
+    /// computed from the normal only when asked for: most hits never need it.
+    param: DVec2,
     /// The caller's object id given when the shape was added.
     pub object: u32,
     /// The shape hit.
@@ -103,6 +103,15 @@ pub struct Hit {
 }
 
 impl Hit {
+    /// Surface parameters: the original patch's `(u,v)`, sphere `(φ/2π, θ/π)`, quad `(a,b)`,
+    /// plane coordinates in scene units, mesh texture coordinates (or barycentrics).
+    pub fn uv(&self) -> DVec2 {
+        match self.shape {
+            ShapeRef::Sphere(_) => Sphere::uv_of_normal(self.normal),
+            _ => self.param,
+        }
+    }
+
     /// A ray leaving this hit in direction `dir`, offset so it cannot re-hit this point.
     pub fn spawn(&self, dir: DVec3) -> Ray {
         spawn_ray(self.point, self.normal, dir)
@@ -533,7 +542,7 @@ impl SceneGeometry {
             Primitive::Sphere(i) => {
                 let (s, obj) = &self.spheres[i as usize];
                 let n = s.normal(point);
-                (n, n, s.uv(point), *obj, ShapeRef::Sphere(i))
+                (n, n, DVec2::ZERO, *obj, ShapeRef::Sphere(i))
             }
             Primitive::Plane(i) => {
                 let (p, obj) = &self.planes[i as usize];
@@ -570,7 +579,7 @@ impl SceneGeometry {
             point,
             normal,
             shading_normal,
-            uv,
+            param: uv,
             object,
             shape,
         })
@@ -649,4 +658,49 @@ pub struct GeometryStats {
     pub patches: usize,
     /// Prepared patch leaves.
     pub patch_leaves: usize,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A sphere hit's `(u,v)`, made from its normal when asked for, is the sphere's own at the
+    /// hit point; other shapes keep the parameters their test found.
+    #[test]
+    fn a_sphere_hits_uv_is_the_spheres_at_the_point() {
+        let sphere = Sphere {
+            center: DVec3::new(1.0, 2.0, -3.0),
+            radius: 1.5,
+        };
+        let mut builder = GeometryBuilder::default();
+        builder.add_sphere(sphere, 0);
+        let quad = builder.add_quad(
+            Quad {
+                corner: DVec3::new(-10.0, -10.0, 5.0),
+                edge_u: DVec3::X * 20.0,
+                edge_v: DVec3::Y * 20.0,
+            },
+            1,
+        );
+        let geometry = builder.build();
+        let origin = DVec3::new(0.5, 1.0, 4.0);
+        for offset in [
+            DVec3::ZERO,
+            DVec3::new(0.9, -0.4, 0.0),
+            DVec3::new(-1.0, 0.7, 0.2),
+        ] {
+            let ray = Ray::new(origin, sphere.center + offset - origin);
+            let hit = geometry
+                .intersect(&ray, f64::INFINITY)
+                .expect("the ray meets the sphere");
+            assert!(matches!(hit.shape, ShapeRef::Sphere(_)));
+            assert_eq!(hit.uv(), sphere.uv(hit.point));
+        }
+        let up = Ray::new(DVec3::new(-9.0, -9.0, 0.0), DVec3::Z);
+        let hit = geometry
+            .intersect(&up, f64::INFINITY)
+            .expect("the ray meets the quad");
+        assert_eq!(hit.shape, quad);
+        assert!((hit.uv() - DVec2::new(0.05, 0.05)).length() < 1e-12);
+    }
 }

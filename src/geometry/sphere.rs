@@ -48,7 +48,11 @@ impl Sphere {
 
     /// Spherical `(u,v)`: `u = φ/2π` around the y axis, `v = θ/π` from +y.
     pub fn uv(&self, p: DVec3) -> DVec2 {
-        let n = self.normal(p);
+        Self::uv_of_normal(self.normal(p))
+    }
+
+    /// Spherical `(u,v)` of the point whose outward unit normal is `n` ([`Sphere::uv`]).
+    pub fn uv_of_normal(n: DVec3) -> DVec2 {
         let phi = n.z.atan2(n.x);
         let u = (phi / std::f64::consts::TAU).rem_euclid(1.0);
         let v = n.y.clamp(-1.0, 1.0).acos() / std::f64::consts::PI;

@@ -99,7 +99,7 @@ impl Scene {
     /// The colour (reflectance or tint) of a material at a hit, with its texture applied.
     pub fn albedo(&self, material: &Material, hit: &Hit) -> DVec3 {
         match material.texture {
-            Some(t) => self.textures[t].lookup(hit.point, hit.uv),
+            Some(t) => self.textures[t].lookup(hit.point, hit.uv()),
             None => material.color,
         }
     }

@@ -88,7 +88,7 @@ fn shoot_at(patches: &[(BezierPatch, Window)]) {
             let ray = Ray::new(centre - dir * 2.0 * size, dir);
             if let Some(hit) = geometry.intersect(&ray, f64::INFINITY) {
                 assert!(
-                    hit.t.is_finite() && hit.point.is_finite() && hit.uv.is_finite(),
+                    hit.t.is_finite() && hit.point.is_finite() && hit.uv().is_finite(),
                     "non-finite hit {hit:?}"
                 );
             }
