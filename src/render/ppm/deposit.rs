@@ -146,6 +146,12 @@ impl Window {
         self.from.extend(from);
     }
 
+    /// Drops what it holds, keeping its memory.
+    pub(super) fn clear(&mut self) {
+        self.hits.clear();
+        self.from.clear();
+    }
+
     /// Whether it holds enough hits to be handed.
     pub(super) fn is_full(&self) -> bool {
         self.hits.len() >= WINDOW_HITS || self.from.len() >= WINDOW_PHOTONS
@@ -192,8 +198,7 @@ impl Window {
             }
             out.counts.useful += useful as u64;
         }
-        self.hits.clear();
-        self.from.clear();
+        self.clear();
         Some(())
     }
 }

@@ -173,6 +173,9 @@ pub struct Ppm {
     /// Per pixel, its visible point in the last completed stochastic pass, with
     /// [`PpmOptions::warm_restarts`] ([`warm::records`]).
     last_points: Vec<warm::PointRecord>,
+    /// The photon pass's hits awaiting their points, empty between passes; kept so that its
+    /// tens of MiB are not mapped afresh (page by page) every pass.
+    window: deposit::Window,
     /// Per pixel, the light seen directly that a warm restart kept (empty when cold).
     prior_light: Vec<warm::PriorLight>,
     /// The global radius schedule's state (`None`: per-point statistics).
@@ -254,6 +257,7 @@ impl Ppm {
             offset: StreamOffset::default(),
             inherited: None,
             last_points: Vec::new(),
+            window: deposit::Window::default(),
             prior_light: Vec::new(),
             global: (scene.params.radius_schedule == RadiusSchedule::Global)
                 .then(|| global::Global::new(options.shard, scene.params.alpha, cam.width, cam.height)),

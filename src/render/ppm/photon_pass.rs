@@ -66,8 +66,13 @@ impl Ppm {
         };
         // α as the caller sets it between batches, kept whether or not the pass completes.
         let mut alpha = self.alpha;
-        let traced = self.trace_photons(&source, &gather, &mut out, &mut || control(&mut alpha));
+        let mut window = std::mem::take(&mut self.window);
+        let traced = self.trace_photons(&source, &gather, &mut window, &mut out, &mut || {
+            control(&mut alpha)
+        });
         self.alpha = alpha;
+        window.clear();
+        self.window = window;
         traced.map(|()| out)
     }
 
@@ -77,13 +82,13 @@ impl Ppm {
         &self,
         source: &PhotonSource,
         gather: &Gather,
+        window: &mut Window,
         out: &mut Gathered,
         control: &mut dyn FnMut() -> Control,
     ) -> Option<()> {
         let chunks = self.pass_photons.div_ceil(CHUNK);
         let most = WINDOW_PHOTONS as u64 / CHUNK;
         let chunks_per_batch = self.options.batch_photons.div_ceil(CHUNK).clamp(1, most);
-        let mut window = Window::default();
         let mut chunk = 0;
         while chunk < chunks {
             if control() == Control::Abort {
