@@ -48,15 +48,16 @@ impl Ppm {
             self.guide.as_ref().map(EmissionGuide::tally),
         );
         // Each estimate's largest radius: how far from a photon its points are looked for.
-        let radius = [0, 1].map(|e| {
-            let max2 = self
-                .points
-                .reach
-                .iter()
-                .map(|r| r.radius2[e])
-                .fold(0.0f32, f32::max);
-            (max2 as f64).sqrt()
-        });
+        let max2 = self
+            .points
+            .reach
+            .par_iter()
+            .fold(
+                || [0.0f32; 2],
+                |m, r| [m[0].max(r.radius2[0]), m[1].max(r.radius2[1])],
+            )
+            .reduce(|| [0.0f32; 2], |a, b| [a[0].max(b[0]), a[1].max(b[1])]);
+        let radius = max2.map(|m| (m as f64).sqrt());
         self.pass_photons = self.guided_pass_photons();
         let gather = Gather {
             index,
