@@ -56,9 +56,11 @@ pub(super) const WINDOW_HITS: usize = 1 << 19;
 /// reduction.
 const GROUP: usize = 4096;
 
-/// Groups handed between two looks at the caller's control (and folded together): bounds
-/// the deposits held at once.
-const WAVE: usize = 32;
+/// Groups handed between two looks at the caller's control, and folded together, per
+/// thread: enough to keep every thread busy, few enough that the deposits held at once (a
+/// wave's and the one before it, being folded) stay near what the pass held when photons
+/// were handed chunk by chunk.
+const WAVE_PER_THREAD: usize = 4;
 
 /// What a group of hits handed: deposits, and the window places of the photons that reached
 /// a point.
@@ -181,7 +183,8 @@ impl Window {
             }
         };
         let mut waiting: Vec<Handed> = Vec::new();
-        for wave in self.hits.chunks(GROUP * WAVE) {
+        let wave = GROUP * WAVE_PER_THREAD * rayon::current_num_threads();
+        for wave in self.hits.chunks(wave) {
             if control() == Control::Abort {
                 return None;
             }
@@ -355,6 +358,12 @@ mod tests {
             assert!(useful > 100, "the test reaches points ({useful} photons)");
             assert_eq!(out.counts.useful, useful);
         }
+    }
+
+    /// The window's memory is what its docs say: 64 bytes a hit.
+    #[test]
+    fn a_hit_is_64_bytes() {
+        assert_eq!(std::mem::size_of::<Hit>(), 64);
     }
 
     /// A control that aborts stops the handing before anything is folded.
