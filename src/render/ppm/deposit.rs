@@ -3,10 +3,11 @@
 //! ([`Hit`]s, gathered in a [`Window`]), the window's hits are sorted by cell
 //! ([`SpatialIndex::sort_key`], Morton order), and groups of sorted hits are handed to the
 //! points near them. Consecutive hits then read the same cells' points while they are in
-//! cache, where photon by photon nearly every search missed it (at 1024×768 the points are
-//! 50 MiB of positions and 45 MiB of shading, more than the cache). Work is reordered for
-//! the memory it reads, as Pharr et al. 1997 ("Rendering complex scenes with
-//! memory-coherent ray tracing") reorder rays; the points stay where the grid put them.
+//! cache, where photon by photon nearly every search missed it (the 1.6M points of
+//! smallppm's scene at 1024×768 are 50 MiB of positions and 45 MiB of shading, more than
+//! the cache). Work is reordered for the memory it reads, as Pharr et al. 1997 ("Rendering
+//! complex scenes with memory-coherent ray tracing") reorder rays; the points stay where the
+//! grid put them.
 
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -49,7 +50,8 @@ fn compact(deposits: &mut Vec<Deposit>) {
 /// often consecutive hits share cells. `bench ppm --indirect-radius-scale 1 --threads 1`
 /// (smallppm's scene, 2.25 hits a photon, about 110,000 cells hit in a window), two runs
 /// each, in paths per core-second: 2^18 hits 378k/368k, 2^19 435k/409k, 2^20 446k/414k,
-/// 2^21 452k/405k — beyond 2^19, twice the memory buys 1–2 %.
+/// 2^21 452k/405k — beyond 2^19, twice the memory buys 1–2 % (measured before neighbouring
+/// cells' buckets were put side by side, [`HashGrid`](super::HashGrid)).
 pub(super) const WINDOW_HITS: usize = 1 << 19;
 
 /// Sorted hits handed to the points as one unit of parallel work and of the deterministic

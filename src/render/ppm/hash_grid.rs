@@ -5,7 +5,7 @@
 //! within its estimate's largest radius of it (1 or 2 per axis), and the points themselves
 //! are stored sorted by bucket (counting sort), so each bucket's points lie together — what a
 //! photon reads is contiguous (and a block of neighbouring cells' buckets are neighbours,
-//! [`HashGrid::bucket`]), and the grid is only its bucket starts (at 1920×1080: 17 MiB,
+//! `HashGrid::bucket`), and the grid is only its bucket starts (at 1920×1080: 17 MiB,
 //! where eight entries per point in the cells their sphere overlaps took 83 MiB and sent every
 //! candidate to a random place).
 
@@ -34,7 +34,7 @@ pub struct HashGrid {
 /// times the candidates. `bench ppm --indirect-radius-scale 1 --photons 300000 --threads 1`,
 /// 6 interleaved runs each: median 191k paths per core-second against 163k with cells of
 /// 2 radii; with smallppm's automatic (wider) indirect radius 70k against 72k.
-/// Measured again once photons were handed in cell order ([`deposit`](super::deposit)), two
+/// Measured again once photons were handed in cell order (`ppm/deposit.rs`), two
 /// runs each: cells of 2, 3 and 4 radii 386k/349k, 433k/412k and 408k/400k paths per
 /// core-second; with the automatic indirect radius 278k, 266k and 235k (one run).
 pub const CELL_PER_RADIUS: f64 = 3.0;

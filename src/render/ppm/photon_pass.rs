@@ -19,8 +19,8 @@ use crate::scene::Scene;
 /// Photons per chunk: the unit of parallel work and of deterministic reduction.
 pub(super) const CHUNK: u64 = 4096;
 
-/// Photons per batch unless [`PpmOptions::batch_photons`] says otherwise: the caller's
-/// control callback is asked between batches.
+/// Photons per batch unless [`PpmOptions::batch_photons`](super::PpmOptions::batch_photons)
+/// says otherwise: the caller's control callback is asked between batches.
 pub const DEFAULT_BATCH_PHOTONS: u64 = 16 * CHUNK;
 
 /// What one chunk of photons left: where they met surfaces whose flux is gathered, where
