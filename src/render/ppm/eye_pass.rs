@@ -34,6 +34,8 @@ impl Ppm {
         let interrupt = self.interrupt.as_deref();
         let skipped = std::sync::atomic::AtomicBool::new(false);
         let pixels = (w * h) as usize;
+        // New points: the grid over the old ones no longer holds them.
+        self.kept_grid = None;
         self.points.reset(pixels);
         self.pass_direct.clear();
         self.pass_direct.resize(pixels, Vec3::ZERO);
@@ -158,6 +160,7 @@ impl Ppm {
             for (d, p) in self.direct.iter_mut().zip(direct) {
                 *d += p;
             }
+            self.kept_grid = None;
             self.points = points.into_iter().collect();
             for shade in &mut self.points.shade {
                 let pixel = shade.slot;

@@ -39,6 +39,10 @@ pub struct HashGrid {
 /// core-second; with the automatic indirect radius 278k, 266k and 235k (one run).
 pub const CELL_PER_RADIUS: f64 = 3.0;
 
+/// How far the largest radius may shrink below the one a grid was built for while the grid
+/// is used again (its cells then up to this many times [`CELL_PER_RADIUS`] radii wide).
+pub const KEEP_WHILE_SHRUNK: f64 = 1.5;
+
 #[inline]
 fn hash(c: IVec3) -> u64 {
     // Teschner et al. 2003 spatial hash.
@@ -118,6 +122,16 @@ impl HashGrid {
             order[grid.starts[b as usize] as usize] = k as u32;
         }
         (grid, order)
+    }
+
+    /// Whether this grid, built over the same points with larger or equal radii, still
+    /// serves `points` with their radii now: none reaches beyond the radius it was built for,
+    /// and the largest is at least 1/[`KEEP_WHILE_SHRUNK`] of it (beyond that its cells hold
+    /// too many candidates for a search).
+    pub fn serves<P: SearchSphere + Sync>(&self, points: &[P]) -> bool {
+        let reach2 = points.par_iter().map(|p| p.reach2()).reduce(|| 0.0, f64::max);
+        let reach = reach2.sqrt();
+        !self.starts.is_empty() && reach <= self.reach && reach * KEEP_WHILE_SHRUNK >= self.reach
     }
 
     #[inline]
@@ -288,6 +302,31 @@ mod tests {
             });
             assert_eq!(inside, [k as u32]);
         }
+    }
+
+    /// A grid serves its points again while their largest radius has shrunk by less than
+    /// [`KEEP_WHILE_SHRUNK`], never once any radius outgrew the one it was built for; an
+    /// empty grid serves nothing.
+    #[test]
+    fn a_grid_serves_while_the_radii_shrink_a_little() {
+        let with_radius = |r: f64| -> Vec<VisiblePoint> {
+            (0..100u32)
+                .map(|k| VisiblePoint {
+                    slot: k,
+                    position: DVec3::new(k as f64 * 0.1, 0.0, 0.0),
+                    normal: DVec3::Z,
+                    weight: DVec3::ONE,
+                    radius2: r * r * (1.0 - k as f64 * 1e-3),
+                })
+                .collect()
+        };
+        let (grid, _) = HashGrid::build(&with_radius(0.3));
+        assert!(grid.serves(&with_radius(0.3)));
+        assert!(grid.serves(&with_radius(0.3 / (KEEP_WHILE_SHRUNK * 0.99))));
+        assert!(!grid.serves(&with_radius(0.3 / (KEEP_WHILE_SHRUNK * 1.01))));
+        assert!(!grid.serves(&with_radius(0.3 * 1.000_001)));
+        let (empty, _) = HashGrid::build::<VisiblePoint>(&[]);
+        assert!(!empty.serves::<VisiblePoint>(&[]));
     }
 
     #[test]

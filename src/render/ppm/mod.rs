@@ -176,6 +176,10 @@ pub struct Ppm {
     /// The photon pass's hits awaiting their points, empty between passes; kept so that its
     /// tens of MiB are not mapped afresh (page by page) every pass.
     window: deposit::Window,
+    /// The hash grid over the points as they lie now, kept while no eye pass replaces them
+    /// (classic PPM traces one) for as long as it serves the shrinking radii
+    /// ([`HashGrid::serves`]).
+    kept_grid: Option<HashGrid>,
     /// Per pixel, the light seen directly that a warm restart kept (empty when cold).
     prior_light: Vec<warm::PriorLight>,
     /// The global radius schedule's state (`None`: per-point statistics).
@@ -258,6 +262,7 @@ impl Ppm {
             inherited: None,
             last_points: Vec::new(),
             window: deposit::Window::default(),
+            kept_grid: None,
             prior_light: Vec::new(),
             global: (scene.params.radius_schedule == RadiusSchedule::Global)
                 .then(|| global::Global::new(options.shard, scene.params.alpha, cam.width, cam.height)),
@@ -333,25 +338,39 @@ impl Ppm {
     ) -> Option<gathered::Gathered> {
         let index = self.build_index();
         if self.interrupted() {
+            self.keep(index);
             return None;
         }
         let start = Instant::now();
-        let gathered = self.photon_pass(scene, &index, control)?;
+        let gathered = self.photon_pass(scene, &index, control);
+        self.keep(index);
+        let gathered = gathered?;
         self.stats.photon_secs += start.elapsed().as_secs_f64();
         Some(gathered)
     }
 
+    /// Keeps the hash grid for the next pass, should its points not change.
+    fn keep(&mut self, index: SpatialIndex) {
+        if let SpatialIndex::Grid(grid) = index {
+            self.kept_grid = Some(grid);
+        }
+    }
+
     /// The spatial index over this pass's visible points, their radii first copied from
-    /// their slots (the hash grid puts the points in its order).
+    /// their slots (the hash grid puts the points in its order; the last pass's grid is used
+    /// again when the points are the same and it serves their radii).
     fn build_index(&mut self) -> SpatialIndex {
         let start = Instant::now();
         self.points.set_radii(&self.slots);
         let index = match self.index {
-            IndexKind::HashGrid => {
-                let (grid, mut order) = HashGrid::build(&self.points.reach);
-                self.points.permute(&mut order);
-                SpatialIndex::Grid(grid)
-            }
+            IndexKind::HashGrid => match self.kept_grid.take() {
+                Some(grid) if grid.serves(&self.points.reach) => SpatialIndex::Grid(grid),
+                _ => {
+                    let (grid, mut order) = HashGrid::build(&self.points.reach);
+                    self.points.permute(&mut order);
+                    SpatialIndex::Grid(grid)
+                }
+            },
             IndexKind::KdTree => SpatialIndex::Kd(KdTree::build(&self.points.reach)),
         };
         self.stats.index_secs += start.elapsed().as_secs_f64();
