@@ -178,7 +178,8 @@ pub struct Ppm {
     window: deposit::Window,
     /// The hash grid over the points as they lie now, kept while no eye pass replaces them
     /// (classic PPM traces one) for as long as it serves the shrinking radii
-    /// ([`HashGrid::serves`]).
+    /// ([`HashGrid::serves`]); never used again on the global schedule, whose passes must not
+    /// depend on the passes before them.
     kept_grid: Option<HashGrid>,
     /// Per pixel, the light seen directly that a warm restart kept (empty when cold).
     prior_light: Vec<warm::PriorLight>,
@@ -364,7 +365,11 @@ impl Ppm {
         self.points.set_radii(&self.slots);
         let index = match self.index {
             IndexKind::HashGrid => match self.kept_grid.take() {
-                Some(grid) if grid.serves(&self.points.reach) => SpatialIndex::Grid(grid),
+                // Not on the global schedule: each of its passes must come out the same
+                // whichever passes this process rendered before (shards render some of them).
+                Some(grid) if self.global.is_none() && grid.serves(&self.points.reach) => {
+                    SpatialIndex::Grid(grid)
+                }
                 _ => {
                     let (grid, mut order) = HashGrid::build(&self.points.reach);
                     self.points.permute(&mut order);
