@@ -247,9 +247,12 @@ impl Gather<'_> {
 
 #[cfg(test)]
 mod tests {
+    use rand::Rng;
+
     use super::*;
     use crate::render::ppm::visible::VisiblePoint;
     use crate::render::ppm::{HashGrid, KdTree};
+    use crate::render::rng::stream_rng;
 
     /// Points on three walls of a box, two estimates with different radii, and hits on the
     /// same walls from photons of several hits each: handed a window at a time in cell order,
@@ -258,13 +261,8 @@ mod tests {
     /// marked useful are those that reached some point.
     #[test]
     fn hits_handed_in_cell_order_reach_exactly_the_points_in_range() {
-        let mut x = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            (x >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = stream_rng(0x9e37_79b9, 0, 0);
+        let mut next = || rng.random::<f64>();
         let wall = |k: usize, a: f64, b: f64| match k % 3 {
             0 => (DVec3::new(0.0, a, b), DVec3::X),
             1 => (DVec3::new(a, 0.0, b), DVec3::Y),
