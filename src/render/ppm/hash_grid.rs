@@ -125,12 +125,10 @@ impl HashGrid {
     }
 
     /// Whether this grid, built over the same points with larger or equal radii, still
-    /// serves `points` with their radii now: none reaches beyond the radius it was built for,
-    /// and the largest is at least 1/[`KEEP_WHILE_SHRUNK`] of it (beyond that its cells hold
-    /// too many candidates for a search).
-    pub fn serves<P: SearchSphere + Sync>(&self, points: &[P]) -> bool {
-        let reach2 = points.par_iter().map(|p| p.reach2()).reduce(|| 0.0, f64::max);
-        let reach = reach2.sqrt();
+    /// serves them now that their largest radius is `reach`: it reaches no farther than the
+    /// radius the grid was built for, and is at least 1/[`KEEP_WHILE_SHRUNK`] of it (beyond
+    /// that the grid's cells hold too many candidates for a search).
+    pub fn serves(&self, reach: f64) -> bool {
         !self.starts.is_empty() && reach <= self.reach && reach * KEEP_WHILE_SHRUNK >= self.reach
     }
 
@@ -320,13 +318,15 @@ mod tests {
                 })
                 .collect()
         };
+        let reach = |points: &[VisiblePoint]| points.iter().map(|p| p.radius2).fold(0.0, f64::max).sqrt();
         let (grid, _) = HashGrid::build(&with_radius(0.3));
-        assert!(grid.serves(&with_radius(0.3)));
-        assert!(grid.serves(&with_radius(0.3 / (KEEP_WHILE_SHRUNK * 0.99))));
-        assert!(!grid.serves(&with_radius(0.3 / (KEEP_WHILE_SHRUNK * 1.01))));
-        assert!(!grid.serves(&with_radius(0.3 * 1.000_001)));
+        let serves = |r: f64| grid.serves(reach(&with_radius(r)));
+        assert!(serves(0.3));
+        assert!(serves(0.3 / (KEEP_WHILE_SHRUNK * 0.99)));
+        assert!(!serves(0.3 / (KEEP_WHILE_SHRUNK * 1.01)));
+        assert!(!serves(0.3 * 1.000_001));
         let (empty, _) = HashGrid::build::<VisiblePoint>(&[]);
-        assert!(!empty.serves::<VisiblePoint>(&[]));
+        assert!(!empty.serves(0.0));
     }
 
     #[test]

@@ -337,13 +337,15 @@ impl Ppm {
         scene: &Scene,
         control: &mut dyn FnMut(&mut f64) -> Control,
     ) -> Option<gathered::Gathered> {
-        let index = self.build_index();
+        let (index, largest) = self.build_index();
         if self.interrupted() {
             self.keep(index);
             return None;
         }
         let start = Instant::now();
-        let gathered = self.photon_pass(scene, &index, control);
+        // Each estimate's largest radius: how far from a photon its points are looked for.
+        let radius = largest.map(|r2| (r2 as f64).sqrt());
+        let gathered = self.photon_pass(scene, &index, radius, control);
         self.keep(index);
         let gathered = gathered?;
         self.stats.photon_secs += start.elapsed().as_secs_f64();
@@ -359,17 +361,17 @@ impl Ppm {
 
     /// The spatial index over this pass's visible points, their radii first copied from
     /// their slots (the hash grid puts the points in its order; the last pass's grid is used
-    /// again when the points are the same and it serves their radii).
-    fn build_index(&mut self) -> SpatialIndex {
+    /// again when the points are the same and it serves their radii), and each estimate's
+    /// largest radius².
+    fn build_index(&mut self) -> (SpatialIndex, [f32; 2]) {
         let start = Instant::now();
-        self.points.set_radii(&self.slots);
+        let largest = self.points.set_radii(&self.slots);
+        let reach = (largest[0].max(largest[1]) as f64).sqrt();
         let index = match self.index {
             IndexKind::HashGrid => match self.kept_grid.take() {
                 // Not on the global schedule: each of its passes must come out the same
                 // whichever passes this process rendered before (shards render some of them).
-                Some(grid) if self.global.is_none() && grid.serves(&self.points.reach) => {
-                    SpatialIndex::Grid(grid)
-                }
+                Some(grid) if self.global.is_none() && grid.serves(reach) => SpatialIndex::Grid(grid),
                 _ => {
                     let (grid, mut order) = HashGrid::build(&self.points.reach);
                     self.points.permute(&mut order);
@@ -379,7 +381,7 @@ impl Ppm {
             IndexKind::KdTree => SpatialIndex::Kd(KdTree::build(&self.points.reach)),
         };
         self.stats.index_secs += start.elapsed().as_secs_f64();
-        index
+        (index, largest)
     }
 
     /// The pass whose random streams the eye pass and light samples use.

@@ -32,12 +32,14 @@ struct Traced {
 }
 
 impl Ppm {
-    /// Traces this pass's photons in batches and gathers their flux at the visible points;
-    /// `None` when `control` aborts the pass.
+    /// Traces this pass's photons in batches and gathers their flux at the visible points,
+    /// looking as far as `radius`, each estimate's largest radius; `None` when `control`
+    /// aborts the pass.
     pub(super) fn photon_pass(
         &mut self,
         scene: &Scene,
         index: &SpatialIndex,
+        radius: [f64; 2],
         control: &mut dyn FnMut(&mut f64) -> Control,
     ) -> Option<Gathered> {
         let source = PhotonSource::new(scene, self.direct_light).with_guide(self.guide.as_ref());
@@ -47,17 +49,6 @@ impl Ppm {
             estimates,
             self.guide.as_ref().map(EmissionGuide::tally),
         );
-        // Each estimate's largest radius: how far from a photon its points are looked for.
-        let max2 = self
-            .points
-            .reach
-            .par_iter()
-            .fold(
-                || [0.0f32; 2],
-                |m, r| [m[0].max(r.radius2[0]), m[1].max(r.radius2[1])],
-            )
-            .reduce(|| [0.0f32; 2], |a, b| [a[0].max(b[0]), a[1].max(b[1])]);
-        let radius = max2.map(|m| (m as f64).sqrt());
         self.pass_photons = self.guided_pass_photons();
         let gather = Gather {
             index,

@@ -146,12 +146,16 @@ impl VisiblePoints {
         );
     }
 
-    /// Copies each point's slot's radii² into its reach.
-    pub fn set_radii(&mut self, slots: &[Slot]) {
+    /// Copies each point's slot's radii² into its reach; returns the largest radius² of each
+    /// estimate (0 without points).
+    pub fn set_radii(&mut self, slots: &[Slot]) -> [f32; 2] {
+        let mut largest = [0.0f32; 2];
         for (r, s) in self.reach.iter_mut().zip(&self.shade) {
             let slot = &slots[s.slot as usize];
             r.radius2 = [slot.primary.radius2() as f32, slot.indirect.radius2() as f32];
+            largest = [largest[0].max(r.radius2[0]), largest[1].max(r.radius2[1])];
         }
+        largest
     }
 }
 
@@ -210,7 +214,7 @@ mod tests {
         let mut slots: Vec<Slot> = (0..4).map(Slot::new).collect();
         slots[3].primary = Estimate::empty(4.0);
         slots[3].indirect = Estimate::empty(9.0);
-        points.set_radii(&slots);
+        assert_eq!(points.set_radii(&slots), [4.0, 9.0]);
         assert_eq!(points.reach[1].radius2, [4.0, 9.0]);
         assert_eq!(points.reach[1].reach2(), 9.0);
         assert_eq!(points.reach[0].reach2(), 0.0);
