@@ -18,8 +18,9 @@
 //! Jensen 2001, chosen once and then shrunk by the paper's rule).
 //!
 //! Determinism: photon `i` of the render uses the random stream `(seed, photon, i)`, pixels
-//! `(seed, pass, pixel)`; photons are traced in fixed chunks whose deposits are applied in
-//! chunk order, so the image is bit-identical for any number of threads.
+//! `(seed, pass, pixel)`; photons are traced in fixed chunks, their hits sorted by cell
+//! with ties in photon order and handed in fixed groups whose deposits are applied in group
+//! order (`deposit.rs`), so the image is bit-identical for any number of threads.
 
 mod deposit;
 mod estimate;

@@ -16,7 +16,8 @@ use super::{streams, Control, Ppm, SpatialIndex};
 use crate::render::rng::stream_rng;
 use crate::scene::Scene;
 
-/// Photons per chunk: the unit of parallel work and of deterministic reduction.
+/// Photons per chunk: the unit of parallel tracing (their hits are reduced in groups of the
+/// sorted window, [`deposit`](super::deposit)).
 pub(super) const CHUNK: u64 = 4096;
 
 /// Photons per batch unless [`PpmOptions::batch_photons`](super::PpmOptions::batch_photons)
