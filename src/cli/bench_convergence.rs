@@ -24,7 +24,7 @@ use caustic::settings::{IndexKind, RadiusSchedule};
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum Config {
     /// The defaults before light sampling, balanced passes, guided emission, stratified eye
-    /// rays and the wider indirect estimate: photons carry all light in one estimate, lights
+    /// rays, supersampled outlines and the wider indirect estimate: photons carry all light in one estimate, lights
     /// emit as they shine, a pass traces exactly the scene's photons per pass and eye rays are
     /// jittered independently (the baseline).
     PhotonsOnly,
@@ -35,6 +35,9 @@ pub enum Config {
     Unguided,
     /// The defaults with eye rays jittered independently (no stratification over passes).
     Unstratified,
+    /// The defaults with one eye ray per pixel a pass for the light seen directly (no
+    /// supersampled lamp outlines).
+    Unsupersampled,
     /// The defaults with one estimate for all photons (no wider indirect radius).
     OneEstimate,
     /// The defaults with every point starting at the initial radius (no adaptive radius).
@@ -70,6 +73,7 @@ impl Config {
             Config::Default => "new defaults",
             Config::Unguided => "default without guided emission",
             Config::Unstratified => "default without stratified eye rays",
+            Config::Unsupersampled => "default without supersampled outlines",
             Config::OneEstimate => "default with one estimate for all photons",
             Config::FixedRadius => "default without adaptive radius",
             Config::Alpha05 => "alpha 0.5",
@@ -89,6 +93,7 @@ impl Config {
             direct_light: true,
             guided_emission: true,
             stratified_eye_rays: true,
+            supersample_light_seen: true,
             indirect_radius_scale: None,
             adaptive_radius: true,
             ..base.clone()
@@ -99,12 +104,14 @@ impl Config {
                 p.guided_emission = false;
                 p.min_photons_per_pixel = 0.0;
                 p.stratified_eye_rays = false;
+                p.supersample_light_seen = false;
                 p.indirect_radius_scale = Some(1.0);
                 p.adaptive_radius = false;
             }
             Config::Default => {}
             Config::Unguided => p.guided_emission = false,
             Config::Unstratified => p.stratified_eye_rays = false,
+            Config::Unsupersampled => p.supersample_light_seen = false,
             Config::OneEstimate => p.indirect_radius_scale = Some(1.0),
             Config::FixedRadius => p.adaptive_radius = false,
             Config::Alpha05 => p.alpha = 0.5,
@@ -149,7 +156,7 @@ pub struct ConvergenceArgs {
         long,
         value_enum,
         value_delimiter = ',',
-        default_value = "photons-only,default,unguided,unstratified,one-estimate,fixed-radius,alpha-0.5,alpha-0.667,alpha-0.9,radius-x4"
+        default_value = "photons-only,default,unguided,unstratified,unsupersampled,one-estimate,fixed-radius,alpha-0.5,alpha-0.667,alpha-0.9,radius-x4"
     )]
     configs: Vec<Config>,
     /// Rows (configuration, pass, seconds, RMSE, relMSE) and the plot of RMSE against seconds.

@@ -121,6 +121,13 @@ pub struct PpmArgs {
     #[arg(long, value_name = "on|off", action = clap::ArgAction::Set,
           value_parser = clap::builder::BoolishValueParser::new())]
     stratified_eye_rays: Option<bool>,
+    /// Photon mapping: where the light a pixel sees directly changes within it (a lamp's
+    /// outline, its images in mirrors and glass), trace 16 more eye rays a pass there for that
+    /// light, when eye rays are jittered (default: the scene's `supersample_light_seen`, on
+    /// unless it says otherwise).
+    #[arg(long, value_name = "on|off", action = clap::ArgAction::Set,
+          value_parser = clap::builder::BoolishValueParser::new())]
+    supersample_light_seen: Option<bool>,
     /// Photon mapping: initial radius of the indirect light's estimate (photons after a
     /// diffuse bounce) as a multiple of the initial radius; 1 for one estimate of all photons
     /// (default: the scene's `indirect_radius_scale`, or chosen from the first pass's photon
@@ -168,6 +175,9 @@ impl PpmArgs {
         }
         if let Some(on) = self.stratified_eye_rays {
             params.stratified_eye_rays = on;
+        }
+        if let Some(on) = self.supersample_light_seen {
+            params.supersample_light_seen = on;
         }
         if let Some(k) = self.indirect_radius_scale {
             params.indirect_radius_scale = Some(k);

@@ -77,6 +77,14 @@ pub struct RenderParams {
     /// default; matters only when the eye pass is traced every pass (anti-aliasing, depth of
     /// field).
     pub stratified_eye_rays: bool,
+    /// Photon mapping: where the light a pixel sees directly changes within the pixel (a
+    /// lamp's outline, its images in mirrors and glass), that pixel traces 16 more eye rays a
+    /// pass that only look for that light (`ppm::seen`), so the outline converges as if it had
+    /// 16 times the passes. The pixels are chosen from the passes so far; a chosen pixel's
+    /// light seen counts only its later passes, so the image converges to the same result.
+    /// On by default; matters only when the eye pass is traced every pass (anti-aliasing,
+    /// depth of field).
+    pub supersample_light_seen: bool,
     /// Photon mapping: the spatial index over visible points (the image does not depend on it).
     pub index: IndexKind,
     /// Photon mapping: how the radius shrinks pass by pass. Per point (default) keeps each
@@ -106,6 +114,7 @@ impl Default for RenderParams {
             direct_light: true,
             guided_emission: true,
             stratified_eye_rays: true,
+            supersample_light_seen: true,
             index: IndexKind::HashGrid,
             radius_schedule: RadiusSchedule::PerPoint,
         }

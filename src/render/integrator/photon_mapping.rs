@@ -159,6 +159,11 @@ fn rows(s: &PpmStats) -> Vec<StatRow> {
             format!("{:.1} %", 100.0 * s.narrowed_share),
             "Share of the points whose radius was narrowed after the first pass, where photons were dense (adaptive radius)",
         ),
+        StatRow::new(
+            "Supersampled",
+            format!("{:.2} %", 100.0 * s.supersampled_share),
+            "Share of the pixels whose light seen directly (a lamp's outline, its images in mirrors and glass) takes 16 more eye rays a pass",
+        ),
     ]
 }
 
@@ -190,6 +195,13 @@ fn summary(s: &PpmStats, guided: bool) -> Vec<String> {
         lines.push(format!(
             "  adaptive radius: {:.1} % of the points narrowed after the first pass, where photons were dense",
             100.0 * s.narrowed_share
+        ));
+    }
+    if s.supersampled_share > 0.0 {
+        lines.push(format!(
+            "  light seen directly supersampled ({} eye rays a pass) in {:.2} % of the pixels, where it changes within them",
+            crate::render::ppm::SUBSAMPLES,
+            100.0 * s.supersampled_share
         ));
     }
     lines.push(format!(

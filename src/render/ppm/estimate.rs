@@ -175,10 +175,13 @@ impl Ppm {
             self.last_points = self.point_records();
         }
         if self.stochastic {
+            self.forget_before_supersampling();
             for (d, p) in self.direct.iter_mut().zip(self.pass_direct.drain(..)) {
                 *d += p.as_dvec3();
             }
             self.stats.eye_passes += 1;
+            self.seen.choose(self.stats.eye_passes);
+            self.stats.supersampled_share = self.seen.count() as f64 / self.direct.len().max(1) as f64;
         }
         self.stats.passes += 1;
         self.inherited = None;

@@ -11,7 +11,7 @@ use rayon::prelude::*;
 use super::points::{self, Shade, VisiblePoints};
 use super::visible::{trace_eye, Branching, VisiblePoint};
 
-use super::{direct, streams, Estimate, Ppm, Slot};
+use super::{direct, global, seen, streams, Estimate, Ppm, Slot};
 use crate::render::rng::stream_rng;
 use crate::render::sequence;
 use crate::scene::camera::concentric_disk;
@@ -40,6 +40,16 @@ impl Ppm {
         self.pass_direct.clear();
         self.pass_direct.resize(pixels, Vec3::ZERO);
         let rays = scene.camera.eye_rays();
+        let subsampler = seen::Subsampler {
+            scene,
+            rays: &rays,
+            seed,
+            pass,
+            pixels: w * h,
+            stratified: self.stratified_eye_rays,
+            direct_light,
+        };
+        let seen = &self.seen;
         let VisiblePoints { reach, shade } = &mut self.points;
         reach
             .par_iter_mut()
@@ -76,7 +86,7 @@ impl Ppm {
                     debug_assert!(shade.slot == Shade::NONE, "a chosen path ends once");
                     (*reach, *shade) = points::split(&vp);
                 };
-                *direct = trace_eye(
+                let seen_once = trace_eye(
                     scene,
                     &rays.ray(px, lens),
                     i as u32,
@@ -84,11 +94,20 @@ impl Ppm {
                     direct_light,
                     &mut rng,
                     &mut sink,
-                )
+                );
+                // A supersampled pixel's light seen comes from its extra rays alone.
+                *direct = if seen.chosen(i as usize) {
+                    subsampler.light_seen(i, x, y)
+                } else {
+                    seen_once
+                }
                 .as_vec3();
             });
         if skipped.into_inner() {
             return false;
+        }
+        if self.global.as_ref().is_none_or(global::Global::learning) {
+            self.seen.observe(&self.pass_direct, w as usize);
         }
         self.points.drop_empty();
         true

@@ -58,6 +58,12 @@ impl Global {
         }
     }
 
+    /// Whether the pilot pass is still to complete: what per-point PPM learns from its passes
+    /// is learned from the pilot only.
+    pub(super) fn learning(&self) -> bool {
+        self.pilot.is_none()
+    }
+
     /// The pass index of the eye pass's and light samples' streams.
     pub(super) fn stream_pass(&self) -> u64 {
         self.stream

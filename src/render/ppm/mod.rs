@@ -10,7 +10,8 @@
 //!
 //! `N' = N + αM`, `R'² = R²·(N + αM)/(N + M)`, `τ' = (τ + φ)·(N + αM)/(N + M)`;
 //!
-//! and the radiance is `L = τ / (π R² N_emitted)` plus light seen directly. No brightness
+//! and the radiance is `L = τ / (π R² N_emitted)` plus light seen directly (in stochastic
+//! passes supersampled where it changes within a pixel, [`seen`]). No brightness
 //! factor: exposure belongs to the viewer. After the first pass, two per-point choices are
 //! made from its photon counts: the indirect estimate's radius ([`Ppm::widen_indirect`]) and,
 //! where photons are dense, a narrower restart of the primary one ([`Ppm::narrow_dense`], the
@@ -31,6 +32,7 @@ mod index;
 mod photon_pass;
 mod points;
 mod radius;
+mod seen;
 mod stats;
 
 pub mod direct;
@@ -60,6 +62,7 @@ pub use global::schedule_factor;
 pub use index::SpatialIndex;
 pub use photon_pass::DEFAULT_BATCH_PHOTONS;
 use radius::IndirectScale;
+pub use seen::SUBSAMPLES;
 pub use stats::PpmStats;
 pub use warm::{StreamOffset, WarmStart};
 
@@ -69,6 +72,10 @@ mod streams {
     pub const PHOTON: u64 = 11;
     /// Each pixel's fixed offsets of its eye-ray sequences (12 is `direct`'s).
     pub const EYE_OFFSETS: u64 = 13;
+    /// The extra eye rays of pixels whose light seen is supersampled ([`super::seen`]).
+    pub const SEEN: u64 = 14;
+    /// Each such pixel's fixed offsets of its extra rays' sequences.
+    pub const SEEN_OFFSETS: u64 = 15;
 }
 
 /// How photon mapping runs, beyond the scene's render parameters (which hold every setting
@@ -186,6 +193,9 @@ pub struct Ppm {
     prior_light: Vec<warm::PriorLight>,
     /// The global radius schedule's state (`None`: per-point statistics).
     global: Option<global::Global>,
+    /// Which pixels' light seen directly is supersampled, learned from completed stochastic
+    /// passes ([`seen`]).
+    seen: seen::SeenLight,
 }
 
 /// Asked often during a pass (from any thread); returning true abandons the pass. The render
@@ -268,6 +278,11 @@ impl Ppm {
             prior_light: Vec::new(),
             global: (scene.params.radius_schedule == RadiusSchedule::Global)
                 .then(|| global::Global::new(options.shard, scene.params.alpha, cam.width, cam.height)),
+            seen: if stochastic && scene.params.supersample_light_seen {
+                seen::SeenLight::new(pixels)
+            } else {
+                seen::SeenLight::default()
+            },
         }
     }
 
@@ -448,13 +463,25 @@ impl Ppm {
     /// points), with what a warm restart kept of it counted as earlier passes.
     fn light_seen(&self, i: usize) -> DVec3 {
         let prior = self.prior_light.get(i).copied().unwrap_or_default();
-        let eye = self.stats.eye_passes as f64 + prior.direct_passes;
+        let eye = self.seen.passes(i, self.stats.eye_passes) as f64 + prior.direct_passes;
         let passes = self.stats.passes as f64 + prior.area_passes;
         let mut light = (self.direct[i] + prior.direct) / eye.max(1.0);
         if let Some(a) = self.area_direct.get(i) {
             light += (*a + prior.area) / passes.max(1.0);
         }
         light
+    }
+
+    /// Empties the light seen so far of the pixels chosen to be supersampled before this pass,
+    /// their first supersampled one, and of what a warm restart kept for them ([`seen`]).
+    fn forget_before_supersampling(&mut self) {
+        for i in self.seen.take_pending() {
+            self.direct[i as usize] = DVec3::ZERO;
+            if let Some(prior) = self.prior_light.get_mut(i as usize) {
+                prior.direct = DVec3::ZERO;
+                prior.direct_passes = 0.0;
+            }
+        }
     }
 
     /// Each pixel's statistics slots, in pixel order (none for a pixel without a visible

@@ -24,6 +24,9 @@ pub struct PpmStats {
     /// Share of the statistics slots whose estimate restarted with a narrower radius after
     /// the first pass (adaptive radius; 0 before it or when off).
     pub narrowed_share: f64,
+    /// Share of the pixels whose light seen directly takes extra eye rays every pass, where it
+    /// changes within the pixel (a lamp's outline and its images; [`super::seen`]).
+    pub supersampled_share: f64,
     /// Share of the pixels whose statistics a warm restart kept from the previous epoch (0
     /// for a cold start).
     pub kept_share: f64,

@@ -290,7 +290,7 @@ impl Ppm {
                 let prior = self.prior_light.get(i).copied().unwrap_or_default();
                 PriorLight {
                     direct: self.direct[i] + prior.direct,
-                    direct_passes: self.stats.eye_passes as f64 + prior.direct_passes,
+                    direct_passes: self.seen.passes(i, self.stats.eye_passes) as f64 + prior.direct_passes,
                     area: self.area_direct.get(i).copied().unwrap_or_default() + prior.area,
                     area_passes: self.stats.passes as f64 + prior.area_passes,
                 }
