@@ -652,6 +652,28 @@ fn a_sphere_light_lights_like_a_point_light_of_equal_power() {
     assert!((b / a - 1.0).abs() < 0.01, "sphere / point = {}", b / a);
 }
 
+/// The root-mean-square difference of the red channels of `image` and `reference`.
+fn rms_red(image: &[[f32; 3]], reference: &[[f32; 3]]) -> f64 {
+    let sum: f64 = image
+        .iter()
+        .zip(reference)
+        .map(|(a, b)| (a[0] as f64 - b[0] as f64).powi(2))
+        .sum();
+    (sum / image.len() as f64).sqrt()
+}
+
+/// Asserts that each named image's mean red is within 1 % of `reference`'s.
+fn assert_means_within_1_percent<const N: usize>(
+    reference: &[[f32; 3]],
+    images: [(&str, &Vec<[f32; 3]>); N],
+) {
+    let mean = mean_red(reference);
+    for (name, image) in images {
+        let ratio = mean_red(image) / mean;
+        assert!((ratio - 1.0).abs() < 0.01, "{name}: mean / reference {ratio}");
+    }
+}
+
 /// Stratified eye rays (the default): a sphere light seen directly, its outline crossing
 /// pixels. After 64 passes the image is much closer to a long render than with independent
 /// jitter (an outline pixel's coverage error falls nearly as 1/n, not 1/√n), and the same on
@@ -674,24 +696,16 @@ fn stratified_eye_rays_settle_a_lights_outline_sooner() {
     let reference = render_passes(&scene(true, 7), PpmOptions::default(), 2048);
     let [stratified, independent] =
         [true, false].map(|on| render_passes(&scene(on, 1), PpmOptions::default(), 64));
-    let rms = |image: &[[f32; 3]]| {
-        let sum: f64 = image
-            .iter()
-            .zip(&reference)
-            .map(|(a, b)| (a[0] as f64 - b[0] as f64).powi(2))
-            .sum();
-        (sum / image.len() as f64).sqrt()
-    };
+    let rms = |image: &[[f32; 3]]| rms_red(image, &reference);
     let (e_stratified, e_independent) = (rms(&stratified), rms(&independent));
     assert!(
         e_stratified < 0.5 * e_independent,
         "RMS error after 64 passes: stratified {e_stratified}, independent {e_independent}"
     );
-    let mean = mean_red(&reference);
-    for (name, image) in [("stratified", &stratified), ("independent", &independent)] {
-        let ratio = mean_red(image) / mean;
-        assert!((ratio - 1.0).abs() < 0.01, "{name}: mean / reference {ratio}");
-    }
+    assert_means_within_1_percent(
+        &reference,
+        [("stratified", &stratified), ("independent", &independent)],
+    );
 }
 
 /// Supersampled light seen (the default): a small sphere light seen directly, high above the
@@ -719,25 +733,17 @@ fn supersampled_outlines_settle_sooner_and_keep_the_image() {
     let reference = render_passes(&scene(true, 7), PpmOptions::default(), 512);
     let [supersampled, single] =
         [true, false].map(|on| render_passes(&scene(on, 1), PpmOptions::default(), 32));
-    let rms = |image: &[[f32; 3]]| {
-        let sum: f64 = image
-            .iter()
-            .zip(&reference)
-            .map(|(a, b)| (a[0] as f64 - b[0] as f64).powi(2))
-            .sum();
-        (sum / image.len() as f64).sqrt()
-    };
+    let rms = |image: &[[f32; 3]]| rms_red(image, &reference);
     let (e_on, e_off) = (rms(&supersampled), rms(&single));
     // Measured: 0.016 against 0.164.
     assert!(
         e_on < 0.25 * e_off,
         "RMS error after 32 passes: supersampled {e_on}, one ray a pass {e_off}"
     );
-    let mean = mean_red(&reference);
-    for (name, image) in [("supersampled", &supersampled), ("one ray", &single)] {
-        let ratio = mean_red(image) / mean;
-        assert!((ratio - 1.0).abs() < 0.01, "{name}: mean / reference {ratio}");
-    }
+    assert_means_within_1_percent(
+        &reference,
+        [("supersampled", &supersampled), ("one ray", &single)],
+    );
     let mut ppm = Ppm::new(&scene(true, 1), PpmOptions::default());
     ppm.run_pass(&scene(true, 1), &mut |_| Control::Continue);
     let share = ppm.stats().supersampled_share;

@@ -6,6 +6,7 @@ use std::time::Instant;
 
 use glam::{DVec2, DVec3, Vec3};
 use rand::Rng;
+use rand_pcg::Pcg64Mcg;
 use rayon::prelude::*;
 
 use super::points::{self, Shade, VisiblePoints};
@@ -64,22 +65,7 @@ impl Ppm {
                 let i = i as u64;
                 let (x, y) = (i % w, i / w);
                 let mut rng = stream_rng(seed, streams::EYE, pass * w * h + i);
-                let (jitter, lens, first) = match sequences {
-                    // This pixel's shift and offsets, the same every pass (its own stream, so
-                    // the path's other random numbers stay as they were).
-                    Some((lens, choice)) => {
-                        let mut offsets = stream_rng(seed, streams::EYE_OFFSETS, i);
-                        let jitter = sequence::sobol(pass, offsets.random());
-                        let offset = DVec2::new(offsets.random(), offsets.random());
-                        let first = sequence::rotated_1d(choice, offsets.random());
-                        (jitter, sequence::rotated(lens, offset), Some(first))
-                    }
-                    None => (
-                        DVec2::new(rng.random(), rng.random()),
-                        DVec2::new(rng.random(), rng.random()),
-                        None,
-                    ),
-                };
+                let (jitter, lens, first) = eye_sample(seed, pass, i, sequences, &mut rng);
                 let px = DVec2::new(x as f64, y as f64) + jitter;
                 let lens = concentric_disk(lens);
                 let mut sink = |vp: VisiblePoint| {
@@ -228,5 +214,33 @@ impl Ppm {
             }
         }
         self.stats.direct_secs += start.elapsed().as_secs_f64();
+    }
+}
+
+/// Pixel `i`'s eye-ray numbers in pass `pass`: its place in the pixel, its place on the lens
+/// and the number of its first choice at glass. With `sequences` (this pass's points of R4 over
+/// the lens and of the golden-ratio sequence) they are the pass's points of the pixel's
+/// sequences, shifted by the pixel's own offsets, the same every pass (their own stream, so
+/// the path's other random numbers stay as they were); without, independent numbers from `rng`.
+fn eye_sample(
+    seed: u64,
+    pass: u64,
+    i: u64,
+    sequences: Option<(DVec2, f64)>,
+    rng: &mut Pcg64Mcg,
+) -> (DVec2, DVec2, Option<f64>) {
+    match sequences {
+        Some((lens, choice)) => {
+            let mut offsets = stream_rng(seed, streams::EYE_OFFSETS, i);
+            let jitter = sequence::sobol(pass, offsets.random());
+            let offset = DVec2::new(offsets.random(), offsets.random());
+            let first = sequence::rotated_1d(choice, offsets.random());
+            (jitter, sequence::rotated(lens, offset), Some(first))
+        }
+        None => (
+            DVec2::new(rng.random(), rng.random()),
+            DVec2::new(rng.random(), rng.random()),
+            None,
+        ),
     }
 }
