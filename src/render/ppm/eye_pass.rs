@@ -72,17 +72,20 @@ impl Ppm {
                     debug_assert!(shade.slot == Shade::NONE, "a chosen path ends once");
                     (*reach, *shade) = points::split(&vp);
                 };
+                // A supersampled pixel's light seen comes from its extra rays alone, so its
+                // own ray needs no shadow rays (they draw no random numbers: the point is the
+                // same).
+                let chosen = seen.chosen(i as usize);
                 let seen_once = trace_eye(
                     scene,
                     &rays.ray(px, lens),
                     i as u32,
                     Branching::Choose { first },
-                    direct_light,
+                    direct_light && !chosen,
                     &mut rng,
                     &mut sink,
                 );
-                // A supersampled pixel's light seen comes from its extra rays alone.
-                *direct = if seen.chosen(i as usize) {
+                *direct = if chosen {
                     subsampler.light_seen(i, x, y)
                 } else {
                     seen_once
