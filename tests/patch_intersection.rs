@@ -323,6 +323,70 @@ fn rays_leaving_a_surface_do_not_hit_it_again_at_zero() {
     assert!(leaving > 4000);
 }
 
+/// A ray that carries the patch point it leaves ([`Ray::leaving`]) lets the leaves around that
+/// point skip the crossing there: it must find exactly what the same ray finds without it,
+/// nearest hit and occlusion, whichever way it leaves (into the teapot too, where it meets the
+/// same patch again on the far side) and at angles down to the least one that records it.
+#[test]
+fn a_departure_point_changes_no_hit() {
+    let diag = diagonal(&teapot_from_assets());
+    let geometry = teapot_geometry(PatchMethod::default());
+    let mut rng = rng(9);
+    let (mut rays, mut departing, mut same_patch_again, mut blocked) = (0, 0, 0, 0);
+    for ray in teapot_view(48, 48) {
+        let Some(hit) = geometry.intersect(&ray, f64::INFINITY) else {
+            continue;
+        };
+        for k in 0..12 {
+            let dir = loop {
+                let d = unit_vector(&mut rng);
+                // A third of the rays leave at slants between 0.1° and 6°.
+                let least = if k % 3 == 0 { 2e-3 } else { 0.1 };
+                let cos = d.dot(hit.normal).abs();
+                if cos >= least && (k % 3 != 0 || cos < 0.1) {
+                    break d;
+                }
+            };
+            let next = hit.spawn(dir);
+            let plain = next.leaving(None);
+            rays += 1;
+            departing += next.leaving.is_some() as usize;
+            let (a, b) = (
+                geometry.intersect(&next, f64::INFINITY),
+                geometry.intersect(&plain, f64::INFINITY),
+            );
+            match (a, b) {
+                (Some(a), Some(b)) => {
+                    assert_eq!(a.shape, b.shape, "from {} along {dir}", hit.point);
+                    assert!((a.t - b.t).abs() <= 1e-9 * diag, "t {} against {}", a.t, b.t);
+                    same_patch_again += (a.shape == hit.shape) as usize;
+                }
+                (a, b) => assert_eq!(a.is_some(), b.is_some(), "from {} along {dir}", hit.point),
+            }
+            for reach in [0.05 * diag, diag] {
+                let occluded = geometry.occluded(&next, reach);
+                assert_eq!(
+                    occluded,
+                    geometry.occluded(&plain, reach),
+                    "from {} along {dir}",
+                    hit.point
+                );
+                blocked += occluded as usize;
+            }
+        }
+    }
+    assert!(rays > 6000, "{rays} rays");
+    assert!(
+        departing > rays * 9 / 10,
+        "{departing} of {rays} rays carried their departure"
+    );
+    assert!(
+        same_patch_again > 500,
+        "{same_patch_again} rays met their own patch again"
+    );
+    assert!(blocked > 2000, "{blocked} occluded");
+}
+
 /// Nearest hits of many random rays through the teapot's bounds: `(t, uv, shape)`.
 fn hits_of(geometry: &caustic::geometry::SceneGeometry, rays: &[Ray]) -> Vec<Option<(f64, DVec2, ShapeRef)>> {
     rays.par_iter()

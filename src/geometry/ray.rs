@@ -2,6 +2,8 @@
 
 use glam::DVec3;
 
+use super::patch::PatchPoint;
+
 /// A ray `origin + t * dir` with a unit direction, so `t` is a distance in scene units.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ray {
@@ -9,6 +11,10 @@ pub struct Ray {
     pub origin: DVec3,
     /// Unit direction.
     pub dir: DVec3,
+    /// The point of a Bézier patch the ray leaves from, when it was spawned there: the patch's
+    /// intersector then knows the ray's own crossing of that patch instead of finding it again
+    /// ([`PatchPoint`]).
+    pub leaving: Option<PatchPoint>,
 }
 
 impl Ray {
@@ -17,6 +23,15 @@ impl Ray {
         Self {
             origin,
             dir: dir.normalize(),
+            leaving: None,
+        }
+    }
+
+    /// This ray, known to leave the patch point `point`.
+    pub fn leaving(self, point: Option<PatchPoint>) -> Self {
+        Self {
+            leaving: point,
+            ..self
         }
     }
 

@@ -20,8 +20,8 @@ use super::bezier::BezierPatch;
 use super::bvh::Bvh;
 use super::mesh::TriangleMesh;
 use super::patch::{
-    intersect_leaf, intersect_per_ray, leaf_occludes, subdivide, PatchLeaf, RayFrame, SubdivisionParams,
-    Window,
+    intersect_leaf, intersect_per_ray, leaf_occludes, subdivide, PatchLeaf, PatchPoint, RayFrame,
+    SubdivisionParams, Window,
 };
 use super::quad::{Plane, Quad};
 use super::ray::{spawn_ray, Ray};
@@ -100,7 +100,15 @@ pub struct Hit {
     pub object: u32,
     /// The shape hit.
     pub shape: ShapeRef,
+    /// The patch point hit (the patch's own `(u,v)`, before any domain mapping), for rays
+    /// that leave it ([`Hit::departure`]).
+    patch_point: Option<PatchPoint>,
 }
+
+/// A ray that leaves a surface closer to it than this (the sine of the angle to the tangent
+/// plane) records no departure point ([`Hit::departure`]): its own crossing of the surface,
+/// behind its offset origin, may then lie far from the point it left.
+const GRAZING_DEPARTURE: f64 = 1e-3;
 
 impl Hit {
     /// Surface parameters: the original patch's `(u,v)`, sphere `(φ/2π, θ/π)`, quad `(a,b)`,
@@ -112,9 +120,18 @@ impl Hit {
         }
     }
 
-    /// A ray leaving this hit in direction `dir`, offset so it cannot re-hit this point.
+    /// A ray leaving this hit in direction `dir`, offset so it cannot re-hit this point, and
+    /// carrying its departure point ([`Hit::departure`]).
     pub fn spawn(&self, dir: DVec3) -> Ray {
-        spawn_ray(self.point, self.normal, dir)
+        spawn_ray(self.point, self.normal, dir).leaving(self.departure(dir))
+    }
+
+    /// Where a ray leaving this hit in direction `dir` leaves a Bézier patch, so that the
+    /// patch's intersector need not find that crossing again ([`Ray::leaving`]): the patch
+    /// point hit, unless the ray leaves at a grazing angle or the hit is on another shape.
+    pub fn departure(&self, dir: DVec3) -> Option<PatchPoint> {
+        self.patch_point
+            .filter(|_| self.normal.dot(dir).abs() > GRAZING_DEPARTURE * dir.length())
     }
 }
 
@@ -538,6 +555,13 @@ impl SceneGeometry {
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<Hit> {
         let c = self.nearest(ray, t_max)?;
         let point = ray.at(c.t);
+        let patch_point = match c.primitive {
+            Primitive::PatchLeaf(i) => Some(PatchPoint {
+                patch: self.leaves[i as usize].patch,
+                uv: c.param,
+            }),
+            _ => None,
+        };
         let (normal, shading_normal, uv, object, shape) = match c.primitive {
             Primitive::Sphere(i) => {
                 let (s, obj) = &self.spheres[i as usize];
@@ -569,10 +593,10 @@ impl SceneGeometry {
                 )
             }
             Primitive::PatchLeaf(i) => {
-                let patch = self.leaves[i as usize].patch;
-                self.patch_surface(patch, c.param)
+                let leaf = &self.leaves[i as usize];
+                self.patch_surface(leaf.patch, c.param, Some(leaf.scale))
             }
-            Primitive::Patch(patch) => self.patch_surface(patch, c.param),
+            Primitive::Patch(patch) => self.patch_surface(patch, c.param, None),
         };
         Some(Hit {
             t: c.t,
@@ -582,13 +606,25 @@ impl SceneGeometry {
             param: uv,
             object,
             shape,
+            patch_point,
         })
     }
 
-    fn patch_surface(&self, patch: u32, uv: DVec2) -> (DVec3, DVec3, DVec2, u32, ShapeRef) {
+    /// A patch hit's normals, surface `(u,v)`, object and shape; `scale`, the patch's bounds'
+    /// diagonal, when a prepared leaf knows it.
+    fn patch_surface(
+        &self,
+        patch: u32,
+        uv: DVec2,
+        scale: Option<f64>,
+    ) -> (DVec3, DVec3, DVec2, u32, ShapeRef) {
         let (p, obj) = &self.patches[patch as usize];
+        let n = match scale {
+            Some(scale) => p.normal_at_scale(uv.x, uv.y, scale),
+            None => p.normal(uv.x, uv.y),
+        };
         // A patch degenerate everywhere has no normal; any unit vector keeps shading finite.
-        let n = p.normal(uv.x, uv.y).unwrap_or(DVec3::Z);
+        let n = n.unwrap_or(DVec3::Z);
         let surface_uv = self.patch_domains[patch as usize].map(uv.x, uv.y);
         (n, n, surface_uv, *obj, ShapeRef::Patch(patch))
     }

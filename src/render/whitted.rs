@@ -139,7 +139,7 @@ impl Tracer<'_> {
                         if cos <= 0.0 {
                             continue;
                         }
-                        if scene.occluded_from(hit.point, hit.normal, k, &ls) {
+                        if scene.occluded_from_hit(&hit, k, &ls) {
                             continue;
                         }
                         visible += 1;

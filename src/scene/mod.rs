@@ -174,8 +174,22 @@ impl Scene {
     /// [`light::LightSample::shadow_ray`], passing the light's own surface.
     pub fn occluded_from(&self, point: DVec3, normal: DVec3, light: usize, ls: &light::LightSample) -> bool {
         let (ray, reach) = ls.shadow_ray(point, normal);
+        self.shadow_ray_blocked(&ray, reach, light)
+    }
+
+    /// [`Scene::occluded_from`] the point of `hit`: the shadow ray also carries where it leaves
+    /// a Bézier patch ([`Hit::departure`]), so the patch's leaves around that point need not
+    /// find the ray's own crossing again.
+    pub fn occluded_from_hit(&self, hit: &Hit, light: usize, ls: &light::LightSample) -> bool {
+        let (ray, reach) = ls.shadow_ray(hit.point, hit.normal);
+        self.shadow_ray_blocked(&ray.leaving(hit.departure(ls.wi)), reach, light)
+    }
+
+    /// Whether something but light `light`'s own surface lies on the shadow ray `ray` within
+    /// `reach`.
+    fn shadow_ray_blocked(&self, ray: &crate::geometry::Ray, reach: f64, light: usize) -> bool {
         let own = self.light_objects.get(light).copied().flatten();
-        self.geometry.occluded_except(&ray, reach, own)
+        self.geometry.occluded_except(ray, reach, own)
     }
 
     /// What the scene contains, for skipping work it does not need.

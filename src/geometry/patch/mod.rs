@@ -30,6 +30,15 @@
 //! root inside the window, the sub-patch is split in four and each quarter that still surrounds
 //! the ray is solved again, nearest first (the seed's subdivision, used as a fallback only).
 //!
+//! A ray spawned on a patch ([`Ray::leaving`]) crosses that patch where it leaves it, behind its
+//! offset origin; every leaf around that point would find this crossing again with a Newton
+//! solve (and, where the ray leaves at a slant, a split or two) only to reject it. Instead, a
+//! leaf whose window holds the departure point, or lies beside it, is ruled out at once when
+//! the Jacobian's sign is fixed over the leaf and agrees with its sign at the departure: the
+//! ray then crosses the leaf at most once and that crossing is the departure (see
+//! [`departure`]). Shadow rays from a patch's own points are most of a ray-traced patch
+//! scene's rays.
+//!
 //! Sub-patch `(s,t)` map back to the original patch as `u = u0 + s(u1-u0)`, `v = v0 + t(v1-v0)`
 //! (seed report §2.4: the linear map survives any number of De Casteljau splits), so texture
 //! coordinates always refer to the original patch.
@@ -40,9 +49,12 @@ use super::aabb::Aabb;
 use super::bezier::BezierPatch;
 use super::ray::Ray;
 
+mod cone;
 mod root;
 
-use root::{beside, bilinear_start, jacobian_sign_is_fixed, newton};
+pub use cone::NormalCone;
+
+use root::{beside, bilinear_start, jacobian_at, jacobian_sign, newton};
 
 /// A rectangle `[u0,u1] × [v0,v1]` of a patch's parameter domain.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -118,6 +130,9 @@ pub struct PatchLeaf {
     pub bounds: Aabb,
     /// Diagonal of the original patch's bounds: the length scale for tolerances.
     pub scale: f64,
+    /// A cone holding every normal of the sub-patch: tells a ray that leaves the leaf whether
+    /// the normal keeps one side towards it, before the leaf is projected ([`departure`]).
+    pub normals: NormalCone,
 }
 
 /// How finely [`subdivide`] cuts a patch.
@@ -162,6 +177,7 @@ pub fn subdivide(patch: &BezierPatch, patch_index: u32, params: &SubdivisionPara
                 bounds: sub.bounds().padded(BOUNDS_PAD * scale.max(f64::MIN_POSITIVE)),
                 sub_patch: sub,
                 scale,
+                normals: NormalCone::of(&sub),
             });
         } else {
             for (child, w) in sub.split_quad().into_iter().zip(window.quarters()) {
@@ -170,6 +186,73 @@ pub fn subdivide(patch: &BezierPatch, patch_index: u32, params: &SubdivisionPara
         }
     }
     leaves
+}
+
+/// A point of a prepared patch: the patch's index in the scene geometry and its own `(u,v)`
+/// (before any domain mapping), where a ray leaves that patch ([`Ray::leaving`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PatchPoint {
+    /// Index of the patch in the scene geometry.
+    pub patch: u32,
+    /// The patch's own parameters, in `[0,1]²`.
+    pub uv: DVec2,
+}
+
+/// How far outside a leaf's window (in units of the window's own size) a ray's departure point
+/// may lie for the leaf to be ruled out by [`departure`]: the leaves beside the one holding
+/// it, whose bounds the ray starts in as often as in its own.
+const DEPARTURE_MARGIN: f64 = 0.5;
+
+/// What a ray's departure point tells a leaf's search ([`departure`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Departure {
+    /// The ray provably meets the leaf nowhere in front of it.
+    Only,
+    /// The departure lies in the leaf's window, at these sub-patch parameters: a root the
+    /// search knows without solving (behind the ray), though the leaf may hold another.
+    Inside(f64, f64),
+    /// The departure says nothing about the leaf.
+    Away,
+}
+
+/// Where the departure point `from` of a ray lies in `leaf`'s sub-patch parameters, when it is
+/// on the same patch and in the leaf's window or beside it.
+fn departure_point(leaf: &PatchLeaf, from: Option<PatchPoint>) -> Option<(f64, f64)> {
+    let from = from.filter(|f| f.patch == leaf.patch)?;
+    let w = &leaf.window;
+    let s = (from.uv.x - w.u0) / (w.u1 - w.u0);
+    let t = (from.uv.y - w.v0) / (w.v1 - w.v0);
+    let near = |x: f64| (-DEPARTURE_MARGIN..=1.0 + DEPARTURE_MARGIN).contains(&x);
+    (near(s) && near(t)).then_some((s, t))
+}
+
+/// Whether `(s, t)` lies in the unit square.
+fn in_window(s: f64, t: f64) -> bool {
+    (0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&t)
+}
+
+/// What a ray's departure point `(s, t)` (in the leaf's sub-patch parameters) says about the
+/// leaf, given the sign the normal keeps against the ray over the leaf (`sign`, when it is
+/// fixed) and the sign of `n·d` at the departure (`at_departure`, asked only when needed).
+///
+/// When the Jacobian's sign (in ray space, the normal against the ray direction) is fixed over
+/// the leaf, the ray crosses it at most once (as [`Problem::solve`] argues). If the departure
+/// point lies in the leaf's window, that one crossing is the departure itself, behind the ray's
+/// offset origin. If it lies just outside (beside a seam) and the Jacobian has the same sign
+/// there, a second crossing inside the window would have to be in the departure's own sense:
+/// the ray would pass the surface twice the same way with no crossing back between them, which
+/// a smooth patch that keeps one orientation towards the ray across the seam does not allow.
+/// [`Hit`](super::scene_geometry::Hit) only records a departure for rays that leave the surface
+/// at more than a grazing angle, so the departure crossing lies within rounding of the
+/// departure point.
+fn departure((s, t): (f64, f64), sign: Option<f64>, at_departure: impl FnOnce() -> f64) -> Departure {
+    let inside = in_window(s, t);
+    match sign {
+        Some(_) if inside => Departure::Only,
+        Some(sign) if at_departure() * sign > 0.0 => Departure::Only,
+        _ if inside => Departure::Inside(s, t),
+        _ => Departure::Away,
+    }
 }
 
 /// A ray/patch intersection: distance along the ray and the original patch's `(u,v)`.
@@ -181,13 +264,14 @@ pub struct PatchHit {
     pub uv: DVec2,
 }
 
-/// The frame of a ray: `n1`, `n2`, `dir` orthonormal.
+/// The frame of a ray: `n1`, `n2`, `dir` orthonormal; and the patch point it leaves, if any.
 #[derive(Clone, Copy, Debug)]
 pub struct RayFrame {
     origin: DVec3,
     n1: DVec3,
     n2: DVec3,
     dir: DVec3,
+    leaving: Option<PatchPoint>,
 }
 
 impl RayFrame {
@@ -199,6 +283,7 @@ impl RayFrame {
             n1,
             n2,
             dir: ray.dir,
+            leaving: ray.leaving,
         }
     }
 
@@ -283,7 +368,7 @@ impl Problem {
             }
             // With n·d of one sign over the sub-patch the ray crosses it at most once: the
             // root Newton found (inside or outside the window) is the only one there is.
-            if jacobian_sign_is_fixed(p) {
+            if jacobian_sign(p).is_some() {
                 return;
             }
         }
@@ -410,6 +495,18 @@ pub fn leaf_occludes(leaf: &PatchLeaf, frame: &RayFrame, t_min: f64, t_max: f64)
 }
 
 fn search_leaf(leaf: &PatchLeaf, frame: &RayFrame, t_min: f64, t_max: f64, any: bool) -> Option<PatchHit> {
+    let from = departure_point(leaf, frame.leaving);
+    // A leaf the ray leaves, first by its normal cone: no projection needed.
+    if let Some((s, t)) = from {
+        let sign = leaf.normals.sign_along(frame.dir);
+        let at = || {
+            let d = leaf.sub_patch.eval_with_derivs(s, t);
+            d.dp_du.cross(d.dp_dv).dot(frame.dir)
+        };
+        if sign.is_some() && departure((s, t), sign, at) == Departure::Only {
+            return None;
+        }
+    }
     let p = frame.project(&leaf.sub_patch);
     let mut problem = Problem {
         budget: SPLIT_BUDGET,
@@ -418,7 +515,17 @@ fn search_leaf(leaf: &PatchLeaf, frame: &RayFrame, t_min: f64, t_max: f64, any: 
         best: None,
         any,
     };
-    problem.run(&p, leaf.window, LEAF_FALLBACK_DEPTH, t_max);
+    if problem.may_hit(hull(&p), t_max) {
+        // In ray space the Jacobian is n·d too; its interval test sometimes proves the sign
+        // where the cone does not.
+        let known = match from.map(|st| departure(st, jacobian_sign(&p), || jacobian_at(&p, st.0, st.1))) {
+            Some(Departure::Only) => return None,
+            // The departure stands for the root Newton would find there (behind the ray).
+            Some(Departure::Inside(s, t)) => Some((s, t, f64::NEG_INFINITY)),
+            _ => None,
+        };
+        problem.solve(&p, leaf.window, LEAF_FALLBACK_DEPTH, t_max, known);
+    }
     problem.best
 }
 

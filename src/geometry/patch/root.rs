@@ -190,8 +190,8 @@ const MAX_STEP: f64 = 0.5;
 /// patches' control points are differences of `p`'s; interval products of their bounds bound
 /// the determinant. Between two crossings of a smooth surface piece the ray would have to be
 /// tangent to it somewhere, where the determinant is zero, so a fixed sign means at most one
-/// root.
-pub(super) fn jacobian_sign_is_fixed(p: &BezierPatch) -> bool {
+/// root. Returns that sign (±1), or `None` when it is not proven fixed.
+pub(super) fn jacobian_sign(p: &BezierPatch) -> Option<f64> {
     let (mut su_lo, mut su_hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
     let (mut sv_lo, mut sv_hi) = (su_lo, su_hi);
     for i in 0..4 {
@@ -218,5 +218,18 @@ pub(super) fn jacobian_sign_is_fixed(p: &BezierPatch) -> bool {
     let (a_lo, a_hi) = product(su_lo.x, su_hi.x, sv_lo.y, sv_hi.y);
     let (b_lo, b_hi) = product(su_lo.y, su_hi.y, sv_lo.x, sv_hi.x);
     // det = a - b ∈ [a_lo - b_hi, a_hi - b_lo]
-    a_lo - b_hi > 0.0 || a_hi - b_lo < 0.0
+    if a_lo - b_hi > 0.0 {
+        Some(1.0)
+    } else if a_hi - b_lo < 0.0 {
+        Some(-1.0)
+    } else {
+        None
+    }
+}
+
+/// The Jacobian `det [∂(x,y)/∂s ∂(x,y)/∂t]` of the ray-space patch `p` at `(s, t)` (the
+/// polynomial's value, also outside `[0,1]²`).
+pub(super) fn jacobian_at(p: &BezierPatch, s: f64, t: f64) -> f64 {
+    let [_, fs, ft] = p.eval_xy_with_derivs(s, t);
+    fs.x * ft.y - fs.y * ft.x
 }

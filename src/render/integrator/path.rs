@@ -156,7 +156,7 @@ impl Path<'_> {
                 continue;
             }
             self.shadow_rays += 1;
-            if scene.occluded_from(hit.point, hit.normal, k, &ls) {
+            if scene.occluded_from_hit(hit, k, &ls) {
                 continue;
             }
             let weight = if light.is_area() {

@@ -125,7 +125,7 @@ impl EyeWalk<'_> {
                             continue;
                         };
                         let cos = n.dot(ls.wi);
-                        if cos > 0.0 && !scene.occluded_from(hit.point, hit.normal, k, &ls) {
+                        if cos > 0.0 && !scene.occluded_from_hit(&hit, k, &ls) {
                             out.direct += weight * ls.incident * cos;
                         }
                     }
