@@ -130,6 +130,10 @@ pub struct PatchLeaf {
     pub bounds: Aabb,
     /// Diagonal of the original patch's bounds: the length scale for tolerances.
     pub scale: f64,
+    /// The largest distance of the sub-patch's control points from the bilinear patch through
+    /// its corners ([`BezierPatch::bilinear_deviation`]): in ray space the projected deviation
+    /// is no larger, so [`root::beside`] can often rule a ray out without measuring it.
+    pub deviation: f64,
     /// A cone holding every normal of the sub-patch: tells a ray that leaves the leaf whether
     /// the normal keeps one side towards it, before the leaf is projected ([`departure`]).
     pub normals: NormalCone,
@@ -168,7 +172,8 @@ pub fn subdivide(patch: &BezierPatch, patch_index: u32, params: &SubdivisionPara
     let mut stack = vec![(*patch, Window::FULL, 0u32)];
     while let Some((sub, window, depth)) = stack.pop() {
         let diag = sub.bounds().diagonal().length();
-        let flat = sub.bilinear_deviation() <= params.flatness * diag;
+        let deviation = sub.bilinear_deviation();
+        let flat = deviation <= params.flatness * diag;
         let small = diag <= params.max_size * scale;
         if depth >= params.max_depth || (flat && small) {
             leaves.push(PatchLeaf {
@@ -177,6 +182,7 @@ pub fn subdivide(patch: &BezierPatch, patch_index: u32, params: &SubdivisionPara
                 bounds: sub.bounds().padded(BOUNDS_PAD * scale.max(f64::MIN_POSITIVE)),
                 sub_patch: sub,
                 scale,
+                deviation,
                 normals: NormalCone::of(&sub),
             });
         } else {
@@ -316,6 +322,9 @@ struct Problem {
     /// Whether any root in range will do (shadow rays): the search ends at the first one
     /// instead of ruling out nearer ones.
     any: bool,
+    /// The largest distance of the prepared leaf's control points from the bilinear patch
+    /// through its corners ([`PatchLeaf::deviation`]; infinite when not known).
+    deviation: f64,
 }
 
 /// Bounds of the ray-space control points: `(lo, hi)`.
@@ -331,6 +340,16 @@ impl Problem {
     fn may_hit(&self, (lo, hi): (DVec3, DVec3), t_max: f64) -> bool {
         let pad = self.tolerance;
         lo.x <= pad && hi.x >= -pad && lo.y <= pad && hi.y >= -pad && hi.z > self.t_min && lo.z < t_max
+    }
+
+    /// A bound on the deviation of the sub-patch solved at `depth` from its corners' bilinear
+    /// patch: the leaf's own at the leaf's depth, none below.
+    fn deviation_at(&self, depth: u32) -> f64 {
+        if depth == LEAF_FALLBACK_DEPTH {
+            self.deviation
+        } else {
+            f64::INFINITY
+        }
     }
 
     fn t_max(&self, t_max: f64) -> f64 {
@@ -353,7 +372,7 @@ impl Problem {
         let t_max = self.t_max(t_max);
         let root = match known {
             Some(root) => Some(root),
-            None if beside(p, self.tolerance) => return,
+            None if beside(p, self.tolerance, self.deviation_at(depth)) => return,
             None => newton(p, self.tolerance, bilinear_start(p)),
         };
         self.budget = self.budget.saturating_sub(1);
@@ -514,6 +533,7 @@ fn search_leaf(leaf: &PatchLeaf, frame: &RayFrame, t_min: f64, t_max: f64, any: 
         tolerance: tolerance(leaf.scale, &p),
         best: None,
         any,
+        deviation: leaf.deviation,
     };
     if problem.may_hit(hull(&p), t_max) {
         // In ray space the Jacobian is n·d too; its interval test sometimes proves the sign
@@ -574,6 +594,7 @@ pub fn intersect_per_ray(
             tolerance: tolerance(scale, &p),
             best: None,
             any: false,
+            deviation: f64::INFINITY,
         };
         problem.run(&p, window, LEAF_FALLBACK_DEPTH, best.map_or(t_max, |h| h.t));
         if let Some(hit) = problem.best {

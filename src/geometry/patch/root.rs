@@ -71,7 +71,7 @@ pub(super) fn bilinear_start(p: &BezierPatch) -> (f64, f64) {
 /// nearly flat sub-patch the quadrilateral is much tighter than the box of the control
 /// points: this one test replaces the Newton solves and splits that find no root where the
 /// ray passes beside a sub-patch (its root lies in a neighbour, or it misses).
-pub(super) fn beside(p: &BezierPatch, tolerance: f64) -> bool {
+pub(super) fn beside(p: &BezierPatch, tolerance: f64, deviation: f64) -> bool {
     let corner = |k: usize| p.points[k].truncate();
     // Counter-clockwise or clockwise; the orientation comes from the first corner's turn.
     let quad = [corner(0), corner(12), corner(15), corner(3)];
@@ -104,6 +104,12 @@ pub(super) fn beside(p: &BezierPatch, tolerance: f64) -> bool {
     if outside <= tolerance {
         return false;
     }
+    // A bound on the deviation the caller knows (the leaf's, in space: its projection is no
+    // larger) may settle it before the sixteen points are measured.
+    let margin = outside - tolerance;
+    if margin > deviation {
+        return true;
+    }
     let (p00, e, f, g) = (
         quad[0],
         edges[0],
@@ -119,7 +125,6 @@ pub(super) fn beside(p: &BezierPatch, tolerance: f64) -> bool {
             deviation2 = deviation2.max((corner(4 * i + j) - bilinear).length_squared());
         }
     }
-    let margin = outside - tolerance;
     margin * margin > deviation2
 }
 
