@@ -45,12 +45,14 @@ impl NormalCone {
                 along_v[3 * j + i] = p(j, i + 1) - p(j, i);
             }
         }
-        let scale = along_u
+        // A product's length is of the order of the longest difference squared; one much
+        // shorter may be rounding noise of a vanishing normal.
+        let longest2 = along_u
             .iter()
             .chain(&along_v)
             .map(|d| d.length_squared())
             .fold(0.0, f64::max);
-        let tiny = 1e-12 * scale;
+        let tiny = 1e-12 * longest2;
         // The products' directions.
         let mut directions = [DVec3::ZERO; 144];
         let mut sum = DVec3::ZERO;

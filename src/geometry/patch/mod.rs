@@ -522,7 +522,7 @@ fn search_leaf(leaf: &PatchLeaf, frame: &RayFrame, t_min: f64, t_max: f64, any: 
             let d = leaf.sub_patch.eval_with_derivs(s, t);
             d.dp_du.cross(d.dp_dv).dot(frame.dir)
         };
-        if sign.is_some() && departure((s, t), sign, at) == Departure::Only {
+        if departure((s, t), sign, at) == Departure::Only {
             return None;
         }
     }
