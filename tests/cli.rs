@@ -382,6 +382,59 @@ fn memory_bench_prints_its_samples() {
     assert_eq!(rows, 3, "passes 1, 2 and 4 sampled: {t}");
 }
 
+/// `bench ppm|whitted --repeat N`: every thread count is run N times, interleaved; each
+/// reports its runs, its best (the least) and median seconds, and speed-ups from both.
+#[test]
+fn scaling_benches_repeat_each_thread_count_and_report_best_and_median() {
+    let cases: [(&str, Vec<&str>); 2] = [
+        ("ppm", vec!["--photons", "2000", "--passes", "1"]),
+        ("whitted", vec!["scenes/leaf.toml", "--width", "16"]),
+    ];
+    for (bench, args) in cases {
+        let mut all = vec!["bench", bench, "--json", "--threads", "1,2", "--repeat", "3"];
+        all.extend(&args);
+        let out = caustic(&all);
+        assert!(out.status.success(), "{bench}: {}", text(&out));
+        let doc: serde_json::Value =
+            serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{bench}: {e}: {}", text(&out)));
+        assert_eq!(doc["repeat"], 3, "{doc}");
+        let runs = doc["runs"].as_array().expect("runs");
+        assert_eq!(runs.len(), 2, "{doc}");
+        for (run, threads) in runs.iter().zip([1, 2]) {
+            assert_eq!(run["threads"], threads, "{doc}");
+            let all: Vec<f64> = run["all_seconds"]
+                .as_array()
+                .expect("all_seconds")
+                .iter()
+                .map(|s| s.as_f64().expect("seconds"))
+                .collect();
+            assert_eq!(all.len(), 3, "{doc}");
+            let mut sorted = all.clone();
+            sorted.sort_by(f64::total_cmp);
+            assert_eq!(run["seconds"].as_f64(), Some(sorted[0]), "{doc}");
+            assert_eq!(run["median_seconds"].as_f64(), Some(sorted[1]), "{doc}");
+        }
+        let first = &runs[0];
+        assert_eq!(first["speedup"].as_f64(), Some(1.0), "{doc}");
+        let best = |r: &serde_json::Value| r["seconds"].as_f64().expect("seconds");
+        let speedup = runs[1]["speedup"].as_f64().expect("speedup");
+        assert!((speedup - best(first) / best(&runs[1])).abs() < 1e-9, "{doc}");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(stderr.contains("3 interleaved runs per thread count"), "{stderr}");
+        assert!(stderr.contains("median s"), "{stderr}");
+
+        let mut zero = vec!["bench", bench, "--repeat", "0"];
+        zero.extend(&args);
+        let out = caustic(&zero);
+        assert!(!out.status.success(), "{bench} --repeat 0 succeeded");
+        assert!(
+            text(&out).contains("--repeat must be at least 1"),
+            "{}",
+            text(&out)
+        );
+    }
+}
+
 /// Every bench prints one JSON document on stdout with `--json` (its text goes to stderr).
 #[test]
 fn every_bench_has_a_json_summary() {

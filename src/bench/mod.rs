@@ -7,6 +7,7 @@ pub mod edit;
 pub mod error_curves;
 pub mod plot;
 pub mod reference;
+pub mod timings;
 
 use std::borrow::Cow;
 use std::time::Instant;

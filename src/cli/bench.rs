@@ -1,18 +1,13 @@
 //! `caustic bench`: measurement commands that print figures (nothing is asserted): ray/patch
-//! intersection, the ray tracer, photon throughput and error against time.
-
-use std::path::{Path, PathBuf};
+//! intersection, the ray tracer, photon throughput and error against time. Each bench beyond
+//! `intersect` lives in a file of its own (`bench_*.rs`, `memory.rs`, `tessellation.rs`).
 
 use anyhow::{bail, Result};
 use clap::{Subcommand, ValueEnum};
 
 use super::bench_output::BenchOutput;
-use super::{load_scene, ppm_stats, render_session};
 use caustic::bench::{teapot_geometry, teapot_view, time_intersect};
 use caustic::geometry::{PatchMethod, SubdivisionParams};
-use caustic::render::render_whitted;
-use caustic::render::session::SessionOptions;
-use caustic::scene::RendererKind;
 
 #[derive(Subcommand)]
 pub enum BenchCommand {
@@ -41,24 +36,7 @@ pub enum BenchCommand {
         max_depth: u32,
     },
     /// Photon mapping: photon paths per core-second at the given thread counts.
-    Ppm {
-        /// Scene file; smallppm's scene (built in) when omitted.
-        scene: Option<PathBuf>,
-        /// Photons per pass.
-        #[arg(long, default_value_t = 500_000)]
-        photons: u64,
-        /// Passes per measurement.
-        #[arg(long, default_value_t = 3)]
-        passes: u32,
-        /// Thread counts to measure.
-        #[arg(long, value_delimiter = ',', default_value = "1,2")]
-        threads: Vec<usize>,
-        /// The indirect estimate's radius scale (default: the scene's, automatic unless it
-        /// says otherwise); 1 gathers every photon in one estimate, as smallppm does, so the
-        /// paths per second compare with smallppm's.
-        #[arg(long, value_name = "K")]
-        indirect_radius_scale: Option<f64>,
-    },
+    Ppm(super::bench_scaling::PpmArgs),
     /// Photon mapping: error against wall time for several configurations (old and new
     /// defaults, α, initial radius, index) against a long reference render, cached on disk.
     /// Prints a table; writes a CSV and a log-log plot on request.
@@ -78,16 +56,7 @@ pub enum BenchCommand {
     /// against the exact render (CSV and a log-log plot on request).
     Tessellation(super::tessellation::TessellationArgs),
     /// Whitted ray tracer: rays per second on a scene, at the given thread counts.
-    Whitted {
-        /// Scene file; the built-in scene when omitted.
-        scene: Option<PathBuf>,
-        /// Image width (height follows the scene's aspect).
-        #[arg(long, default_value_t = 640)]
-        width: u32,
-        /// Thread counts to measure.
-        #[arg(long, value_delimiter = ',', default_value = "1,2")]
-        threads: Vec<usize>,
-    },
+    Whitted(super::bench_scaling::WhittedArgs),
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -116,12 +85,12 @@ impl BenchCommand {
 pub fn bench(what: BenchCommand, json: bool) -> Result<()> {
     let name = match &what {
         BenchCommand::Intersect { .. } => "intersect",
-        BenchCommand::Ppm { .. } => "ppm",
+        BenchCommand::Ppm(_) => "ppm",
         BenchCommand::Convergence(_) => "convergence",
         BenchCommand::Edit(_) => "edit",
         BenchCommand::Memory(_) => "memory",
         BenchCommand::Shards(_) => "shards",
-        BenchCommand::Whitted { .. } => "whitted",
+        BenchCommand::Whitted(_) => "whitted",
         BenchCommand::Tessellation(_) => "tessellation",
     };
     let mut out = BenchOutput::new(json, name);
@@ -142,154 +111,15 @@ pub fn bench(what: BenchCommand, json: bool) -> Result<()> {
             };
             bench_intersect(size, repeat, method, per_ray_depth, params, &mut out)
         }
-        BenchCommand::Whitted {
-            scene,
-            width,
-            threads,
-        } => bench_whitted(scene.as_deref(), width, &threads, &mut out),
+        BenchCommand::Whitted(args) => super::bench_scaling::bench_whitted(args, &mut out),
         BenchCommand::Memory(args) => super::memory::bench_memory(args, &mut out),
         BenchCommand::Shards(args) => super::bench_shards::bench_shards(args, &mut out),
         BenchCommand::Tessellation(args) => super::tessellation::bench_tessellation(args, &mut out),
-        BenchCommand::Ppm {
-            scene,
-            photons,
-            passes,
-            threads,
-            indirect_radius_scale,
-        } => {
-            let run = PpmRun {
-                photons,
-                passes,
-                indirect_radius_scale,
-            };
-            bench_ppm(scene.as_deref(), run, &threads, &mut out)
-        }
+        BenchCommand::Ppm(args) => super::bench_scaling::bench_ppm(args, &mut out),
         BenchCommand::Convergence(args) => super::bench_convergence::bench_convergence(args, &mut out),
         BenchCommand::Edit(args) => super::bench_edit::bench_edit(args, &mut out),
     }?;
     out.finish();
-    Ok(())
-}
-
-/// What one `bench ppm` measurement renders.
-struct PpmRun {
-    photons: u64,
-    passes: u32,
-    indirect_radius_scale: Option<f64>,
-}
-
-fn bench_ppm(scene_path: Option<&Path>, run: PpmRun, threads: &[usize], out: &mut BenchOutput) -> Result<()> {
-    let PpmRun { photons, passes, .. } = run;
-    if photons == 0 || passes == 0 {
-        bail!("--photons and --passes must be at least 1");
-    }
-    let mut scene = super::photon_scene(scene_path)?;
-    scene.params.photons_per_pass = photons;
-    if let Some(k) = run.indirect_radius_scale {
-        scene.params.indirect_radius_scale = Some(k);
-        scene
-            .params
-            .validate()
-            .map_err(|e| anyhow::anyhow!("--indirect-radius-scale: {e}"))?;
-    }
-    let (w, h) = (scene.camera.width, scene.camera.height);
-    out.say(format!(
-        "Photon mapping on {}, {w}x{h}, {passes} passes of {photons} photons",
-        scene.source.display()
-    ));
-    out.set("scene", scene.source.display().to_string());
-    out.set("size", [w, h]);
-    out.set("passes", passes);
-    out.set("photons_per_pass", photons);
-    out.set("indirect_radius_scale", scene.params.indirect_radius_scale);
-    out.say(match scene.params.indirect_radius_scale {
-        Some(k) if k <= 1.0 => "one estimate for all photons (as smallppm gathers)".to_owned(),
-        Some(k) => format!("indirect photons gathered over {k}x the radius"),
-        None => "indirect radius automatic (--indirect-radius-scale 1 gathers as smallppm does)".to_owned(),
-    });
-    out.say(format!(
-        "{:>8} {:>12} {:>16} {:>22} {:>10}",
-        "threads", "photon s", "photon paths/s", "paths per core-second", "scaling"
-    ));
-    scene.params.renderer = RendererKind::Ppm;
-    let mut base = None;
-    for &n in threads {
-        if n == 0 {
-            bail!("--threads values must be at least 1");
-        }
-        let session = SessionOptions {
-            max_passes: Some(passes),
-            threads: Some(n),
-            ..Default::default()
-        };
-        let frame = render_session(scene.clone(), session, |_| {})?;
-        let stats = ppm_stats(&frame)?;
-        let rate = stats.photons as f64 / stats.photon_secs;
-        let scaling = base.map_or(1.0, |b: f64| rate / b);
-        base.get_or_insert(rate);
-        out.say(format!(
-            "{n:>8} {:>12.3} {rate:>16.0} {:>22.0} {scaling:>9.2}x",
-            stats.photon_secs,
-            rate / n as f64
-        ));
-        out.push(
-            "runs",
-            serde_json::json!({
-                "threads": n,
-                "photon_seconds": stats.photon_secs,
-                "photon_paths_per_second": rate,
-                "paths_per_core_second": rate / n as f64,
-                "scaling": scaling,
-            }),
-        );
-    }
-    Ok(())
-}
-
-fn bench_whitted(
-    scene_path: Option<&Path>,
-    width: u32,
-    threads: &[usize],
-    out: &mut BenchOutput,
-) -> Result<()> {
-    let mut scene = load_scene(scene_path)?;
-    scene.camera.resize(Some(width.clamp(1, 16384)), None);
-    out.say(format!(
-        "Whitted ray tracer on {}, {}x{}",
-        scene.source.display(),
-        scene.camera.width,
-        scene.camera.height
-    ));
-    out.set("scene", scene.source.display().to_string());
-    out.set("size", [scene.camera.width, scene.camera.height]);
-    out.say(format!(
-        "{:>8} {:>10} {:>14} {:>12}",
-        "threads", "seconds", "camera rays/s", "speed-up"
-    ));
-    let mut base = None;
-    for &n in threads {
-        if n == 0 {
-            bail!("--threads values must be at least 1");
-        }
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(n).build()?;
-        let (_, stats) = pool.install(|| render_whitted(&scene, &|_| {}));
-        let rate = stats.camera_rays as f64 / stats.elapsed_secs;
-        let speedup = base.map_or(1.0, |b: f64| stats.elapsed_secs.recip() * b);
-        base.get_or_insert(stats.elapsed_secs);
-        out.say(format!(
-            "{n:>8} {:>10.3} {rate:>14.0} {speedup:>11.2}x",
-            stats.elapsed_secs
-        ));
-        out.push(
-            "runs",
-            serde_json::json!({
-                "threads": n,
-                "seconds": stats.elapsed_secs,
-                "camera_rays_per_second": rate,
-                "speedup": speedup,
-            }),
-        );
-    }
     Ok(())
 }
 

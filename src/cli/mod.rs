@@ -5,6 +5,7 @@ mod bench;
 mod bench_convergence;
 mod bench_edit;
 mod bench_output;
+mod bench_scaling;
 mod bench_shards;
 mod export;
 mod farm;
