@@ -442,7 +442,8 @@ const PREVIEW_REFERENCE_PASSES: u32 = 100;
 /// the viewer had before them; medians of 3 runs each, in the viewer's kind of render session
 /// without the window.
 fn drag_preview_error(viewer: &Viewer) -> Result<String, String> {
-    use crate::bench::edit::{measure_edit, median, EditPlan, ON_SCREEN_AFTER};
+    use crate::bench::edit::{measure_edit, EditPlan, ON_SCREEN_AFTER};
+    use crate::bench::timings::median;
     let edited = viewer.edited_scene();
     let position = edited.geometry.patches()[DRAG_POINT.patch].0.points[DRAG_POINT.index];
     let mut before = edited.clone();

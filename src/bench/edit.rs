@@ -103,9 +103,3 @@ pub fn measure_edit(scene: Scene, plan: &EditPlan, reference: &[[f32; 3]]) -> Re
         on_screen: on_screen.unwrap_or(last),
     })
 }
-
-/// The median of `values` (NaN for none).
-pub fn median(mut values: Vec<f64>) -> f64 {
-    values.sort_by(f64::total_cmp);
-    values.get(values.len() / 2).copied().unwrap_or(f64::NAN)
-}

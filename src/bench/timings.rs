@@ -27,18 +27,17 @@ impl Timings {
         self.seconds.iter().copied().reduce(f64::min).unwrap_or(f64::NAN)
     }
 
-    /// The median of the runs: the middle one, or the mean of the two middle ones (NaN when
-    /// there were none).
+    /// The median of the runs ([`median`]).
     pub fn median(&self) -> f64 {
-        let mut sorted = self.seconds.clone();
-        sorted.sort_by(f64::total_cmp);
-        let n = sorted.len();
-        match n {
-            0 => f64::NAN,
-            _ if n % 2 == 1 => sorted[n / 2],
-            _ => 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]),
-        }
+        median(self.seconds.clone())
     }
+}
+
+/// The median of `values`: the middle one, for an even count the upper of the two middle ones
+/// (always a value that was measured); NaN for none.
+pub fn median(mut values: Vec<f64>) -> f64 {
+    values.sort_by(f64::total_cmp);
+    values.get(values.len() / 2).copied().unwrap_or(f64::NAN)
 }
 
 /// Runs `measure` for every one of `configurations` in turn, `rounds` times over (round by
@@ -75,7 +74,7 @@ mod tests {
         assert_eq!(t.median(), 2.0);
         let even = of(&[4.0, 1.0, 3.0, 2.0]);
         assert_eq!(even.best(), 1.0);
-        assert_eq!(even.median(), 2.5);
+        assert_eq!(even.median(), 3.0);
         assert_eq!(even.seconds(), &[4.0, 1.0, 3.0, 2.0]);
         assert!(Timings::default().best().is_nan());
         assert!(Timings::default().median().is_nan());

@@ -12,7 +12,8 @@ use glam::DVec3;
 
 use super::bench_output::BenchOutput;
 use super::shared_args::Threads;
-use caustic::bench::edit::{measure_edit, median, EditPlan, EditRun, ON_SCREEN_AFTER};
+use caustic::bench::edit::{measure_edit, EditPlan, EditRun, ON_SCREEN_AFTER};
+use caustic::bench::timings::median;
 use caustic::render::session::Command;
 use caustic::scene::{RendererKind, Scene};
 
