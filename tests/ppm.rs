@@ -145,26 +145,29 @@ radius = 1.0
 material = "black"
 "#;
     let scene = Scene::from_str(text, Path::new("box.toml"), None).expect("scene");
-    let source = PhotonSource::new(&scene, false);
-    let mut counts = PhotonCounts::default();
-    let mut total = DVec3::ZERO;
-    let mut through_glass = 0u64;
-    let n = 200_000u64;
-    for i in 0..n {
-        let mut rng = stream_rng(7, 99, i);
-        let before = counts.bounces;
-        source.trace(&mut rng, &mut counts, &mut |_, _, flux, _| total += flux);
-        through_glass += u64::from(counts.bounces - before > 1);
+    // Directions at random, and stratified (Sobol's sequence, digitally shifted).
+    for shift in [None, Some(0x5eed_cafe_f00d_u64)] {
+        let source = PhotonSource::new(&scene, false).with_stratified(shift);
+        let mut counts = PhotonCounts::default();
+        let mut total = DVec3::ZERO;
+        let mut through_glass = 0u64;
+        let n = 200_000u64;
+        for i in 0..n {
+            let mut rng = stream_rng(7, 99, i);
+            let before = counts.bounces;
+            source.trace(i, &mut rng, &mut counts, &mut |_, _, flux, _| total += flux);
+            through_glass += u64::from(counts.bounces - before > 1);
+        }
+        let ratio = total.x / (100.0 * n as f64);
+        assert!(
+            through_glass > n / 10,
+            "{shift:?}: few photons met the glass: {through_glass}"
+        );
+        assert!(
+            ratio > 0.998 && ratio < 1.0 + 1e-9,
+            "{shift:?}: gathered flux / power = {ratio}"
+        );
     }
-    let ratio = total.x / (100.0 * n as f64);
-    assert!(
-        through_glass > n / 10,
-        "few photons met the glass: {through_glass}"
-    );
-    assert!(
-        ratio > 0.998 && ratio < 1.0 + 1e-9,
-        "gathered flux / power = {ratio}"
-    );
 }
 
 fn cornell_small(aperture: f64) -> Scene {
@@ -195,8 +198,8 @@ fn ppm_is_identical_for_one_and_two_threads() {
         let scene = cornell_small(aperture);
         // Its quad light is sampled at the visible points (the default) as well as photon mapped.
         assert!(scene.params.direct_light);
-        // Its photons are guided (the default), learned from earlier passes.
-        assert!(scene.params.guided_emission);
+        // Its photons are guided (the default), learned from earlier passes, and stratified.
+        assert!(scene.params.guided_emission && scene.params.stratified_photons);
         let a = one.install(|| render_passes(&scene, PpmOptions::default(), 3));
         let b = two.install(|| render_passes(&scene, PpmOptions::default(), 3));
         assert_eq!(a, b, "aperture {aperture}");
@@ -408,22 +411,18 @@ fn pause_and_resume_lose_nothing() {
     assert_eq!(&f.radiance[..], &reference[..], "pass {}", f.pass);
 }
 
-#[test]
-fn direct_light_option_keeps_caustics() {
-    // A light above a glass ball above a floor: under the ball all light is caustic (the
-    // shadow ray is blocked), so computing direct light by light sampling must not lose it —
-    // for a point light and for area lights alike.
-    let template = r#"
+/// A light (`light`: the body of its `[[lights]]` table) above a glass ball of radius 1
+/// centred `height` above a grey floor, seen by `camera` (the body of the `[camera]` table),
+/// `photons` photons a pass, no anti-aliasing.
+fn glass_ball(camera: &str, height: f64, photons: u32, light: &str) -> Scene {
+    let text = format!(
+        r#"
 [camera]
-position = [2.5, 0.4, 0.0]
-look_at = [0, 0, 0]
-fov = 12
-width = 32
-height = 24
+{camera}
 
 [render]
 antialias = false
-photons_per_pass = 40000
+photons_per_pass = {photons}
 max_depth = 12
 
 [materials.floor]
@@ -436,11 +435,11 @@ color = [1, 1, 1]
 ior = 1.5
 
 [[lights]]
-LIGHT
+{light}
 
 [[objects]]
 type = "sphere"
-center = [0, 2.2, 0]
+center = [0, {height}, 0]
 radius = 1.0
 material = "glass"
 
@@ -449,15 +448,28 @@ type = "plane"
 point = [0, 0, 0]
 normal = [0, 1, 0]
 material = "floor"
-"#;
+"#
+    );
+    Scene::from_str(&text, Path::new("glass_ball.toml"), None).expect("scene")
+}
+
+#[test]
+fn direct_light_option_keeps_caustics() {
+    // A light above a glass ball above a floor: under the ball all light is caustic (the
+    // shadow ray is blocked), so computing direct light by light sampling must not lose it —
+    // for a point light and for area lights alike.
     let lights = [
         "type = \"point\"\nposition = [0, 6, 0]\npower = 500",
         "type = \"sphere\"\ncenter = [0, 6, 0]\nradius = 0.3\npower = 500",
         "type = \"quad\"\ncorner = [-0.3, 6, -0.3]\nedge_u = [0.6, 0, 0]\nedge_v = [0, 0, 0.6]\npower = 500",
     ];
     for light in lights {
-        let text = template.replace("LIGHT", light);
-        let scene = Scene::from_str(&text, Path::new("caustic.toml"), None).expect("scene");
+        let scene = glass_ball(
+            "position = [2.5, 0.4, 0.0]\nlook_at = [0, 0, 0]\nfov = 12\nwidth = 32\nheight = 24",
+            2.2,
+            40_000,
+            light,
+        );
         let mean = |direct_light: bool| {
             let mut scene = scene.clone();
             scene.params.direct_light = direct_light;
@@ -472,6 +484,50 @@ material = "floor"
             "direct light by light sampling changes the caustic of {light}: ratio {ratio}"
         );
     }
+}
+
+/// Stratified photons (the default): a point light above a glass ball throws a broad caustic
+/// on the floor (the floor lies well before the focus), all the light there coming through the
+/// ball, carried by photons. With each photon's direction taken from Sobol's sequence over the
+/// render's photons, the passes' photons cover the ball evenly, so after 32 passes the image
+/// is closer to a long render than with directions drawn at random: over eight seeds, each
+/// pair of renders sharing everything else, the squared error is 0.82 of random photons'
+/// (asserted below 0.9). The image converges to the same result (a long render with random
+/// photons has the same mean), and it is the same for one and two threads.
+#[test]
+fn stratified_photons_settle_a_caustic_sooner_and_keep_the_image() {
+    let base = glass_ball(
+        "position = [0.0, 2.6, 0.01]\nlook_at = [0, 0, 0]\nfov = 40\nwidth = 32\nheight = 32",
+        1.15,
+        1000,
+        "type = \"point\"\nposition = [0, 6, 0]\npower = 500",
+    );
+    assert!(base.params.stratified_photons);
+    let scene = |stratified: bool, seed: u64| {
+        let mut scene = base.clone();
+        scene.params.stratified_photons = stratified;
+        scene.params.seed = seed;
+        scene
+    };
+    let reference = render_passes(&scene(true, 99), PpmOptions::default(), 1000);
+    let random_long = render_passes(&scene(false, 98), PpmOptions::default(), 1000);
+    assert_means_within_1_percent(&reference, [("random photons, 1000 passes", &random_long)]);
+    let (mut stratified_sq, mut random_sq) = (0.0, 0.0);
+    for seed in 1..=8 {
+        let [stratified, random] =
+            [true, false].map(|on| render_passes(&scene(on, seed), PpmOptions::default(), 32));
+        stratified_sq += rms_red(&stratified, &reference).powi(2);
+        random_sq += rms_red(&random, &reference).powi(2);
+    }
+    let ratio = stratified_sq / random_sq;
+    eprintln!("squared error after 32 passes, stratified / random photons: {ratio}");
+    assert!(
+        ratio < 0.9,
+        "squared error after 32 passes, stratified / random photons: {ratio}"
+    );
+    let [one, two] = [1, 2]
+        .map(|threads| pool(threads).install(|| render_passes(&scene(true, 5), PpmOptions::default(), 4)));
+    assert_eq!(one, two, "stratified photons with one and two threads");
 }
 
 #[test]
@@ -825,19 +881,20 @@ fn light_sampling_agrees_with_photons_and_the_closed_form_for_every_light() {
 /// Emission guided by what the camera sees: the camera looks at a small part of an infinite
 /// plane, so most of a point light's photons land where it does not look. Guided, many times
 /// more of them reach a visible point, the image still converges to the closed form (the
-/// weights keep it unbiased) with no more error than unguided emission after as many passes,
-/// and it is the same for one and two threads.
+/// weights keep it unbiased) with no more error than unguided emission after as many passes
+/// (photons' directions at random, so that only the guide differs), and it is the same for
+/// one and two threads. With stratified photons (the default) the guided image keeps the
+/// closed form and its error falls several times (measured 3.6×: RMS relative error 0.0086
+/// against 0.031; unguided emission, whose photons follow the sequence unwarped, falls to
+/// 0.0067).
 #[test]
 fn guided_emission_sends_photons_where_the_camera_looks_and_keeps_the_image() {
     let mut scene = Scene::from_str(PLANE, Path::new("plane.toml"), None).expect("scene");
     let expected = expected_plane(&scene);
-    let mut render = |guided: bool, threads: usize| {
+    let mut render = |guided: bool, stratified: bool, threads: usize| {
         scene.params.guided_emission = guided;
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .expect("pool");
-        pool.install(|| {
+        scene.params.stratified_photons = stratified;
+        pool(threads).install(|| {
             let mut ppm = Ppm::new(&scene, PpmOptions::default());
             for _ in 0..40 {
                 ppm.run_pass(&scene, &mut |_| Control::Continue);
@@ -845,8 +902,8 @@ fn guided_emission_sends_photons_where_the_camera_looks_and_keeps_the_image() {
             (ppm.radiance(), ppm.stats().clone())
         })
     };
-    let (unguided, u) = render(false, 2);
-    let (guided, g) = render(true, 2);
+    let (unguided, u) = render(false, false, 2);
+    let (guided, g) = render(true, false, 2);
     let share = |s: &caustic::render::ppm::PpmStats| s.useful_paths as f64 / s.photons as f64;
     assert!(
         share(&g) > 3.0 * share(&u),
@@ -866,8 +923,18 @@ fn guided_emission_sends_photons_where_the_camera_looks_and_keeps_the_image() {
         rms_g < 1.25 * rms_u,
         "RMS relative error guided {rms_g}, unguided {rms_u}"
     );
-    let (one_thread, _) = render(true, 1);
+    let (one_thread, _) = render(true, false, 1);
     assert_eq!(guided, one_thread, "guided emission with one and two threads");
+    let (stratified, _) = render(true, true, 2);
+    let (mean_s, rms_s) = relative_errors(&stratified, &expected);
+    assert!(
+        (mean_s - 1.0).abs() < 0.01,
+        "guided, stratified mean / closed form {mean_s}"
+    );
+    assert!(
+        rms_s < 0.5 * rms_g,
+        "RMS relative error guided with stratified photons {rms_s}, with random ones {rms_g}"
+    );
 }
 
 /// Adaptive radius (the default): where the first pass found photons dense, a point restarts

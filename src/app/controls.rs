@@ -380,8 +380,13 @@ fn photon_mapping_section_ui(p: &mut PanelParams, ranges: Ranges, ui: &mut egui:
             .on_hover_text("Direct light from every light by shadow rays at the visible points (area lights: one sample per pass); photons carry only caustics and indirect light. Off: photons carry everything. Restarts.");
         ui.checkbox(&mut p.render.guided_emission, "Photons where the camera looks")
             .on_hover_text("Each light learns which of its photons reach what the camera sees and sends more there (weighted: the image converges to the same result). Off: lights emit as they shine. Restarts.");
-        ui.checkbox(&mut p.render.stratified_eye_rays, "Stratified eye rays")
-            .on_hover_text("When eye rays are jittered (anti-aliasing, depth of field), place each pixel's rays over passes by low-discrepancy sequences: the outlines of lights and the lens blur settle sooner. Off: independent random jitter. Restarts.");
+        ui.horizontal(|ui| {
+            ui.label("Stratified");
+            ui.checkbox(&mut p.render.stratified_eye_rays, "eye rays")
+                .on_hover_text("When eye rays are jittered (anti-aliasing, depth of field), place each pixel's rays over passes by low-discrepancy sequences: the outlines of lights and the lens blur settle sooner. Off: independent random jitter. Restarts.");
+            ui.checkbox(&mut p.render.stratified_photons, "photons")
+                .on_hover_text("Choose photons' directions by a low-discrepancy sequence over the render's photons, so each pass covers the light's directions evenly: caustics and light carried by photons are less noisy. Off: independent random directions. Restarts.");
+        });
         ui.checkbox(&mut p.render.supersample_light_seen, "Supersampled lamp outlines")
             .on_hover_text("Where the light a pixel sees directly changes within it (a lamp's outline, its images in mirrors and glass), the pixel traces 16 more eye rays a pass for that light (at most a quarter more eye rays in all): outlines settle about 16 times sooner. Off: one eye ray per pixel a pass. Restarts.");
         schedule_and_index_ui(p, ui);

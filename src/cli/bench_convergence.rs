@@ -24,17 +24,20 @@ use caustic::settings::{IndexKind, RadiusSchedule};
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum Config {
     /// The defaults before light sampling, balanced passes, guided emission, stratified eye
-    /// rays, supersampled outlines and the wider indirect estimate: photons carry all light in one estimate, lights
-    /// emit as they shine, a pass traces exactly the scene's photons per pass and eye rays are
-    /// jittered independently (the baseline).
+    /// rays and photons, supersampled outlines and the wider indirect estimate: photons carry
+    /// all light in one estimate, lights emit as they shine at random, a pass traces exactly
+    /// the scene's photons per pass and eye rays are jittered independently (the baseline).
     PhotonsOnly,
-    /// The defaults: direct light by light sampling, guided emission, stratified eye rays,
-    /// an automatic wider radius for indirect light, α 0.7, automatic radius, hash grid.
+    /// The defaults: direct light by light sampling, guided emission, stratified eye rays and
+    /// photons, an automatic wider radius for indirect light, α 0.7, automatic radius, hash grid.
     Default,
     /// The defaults with lights emitting as they shine (no guided emission).
     Unguided,
     /// The defaults with eye rays jittered independently (no stratification over passes).
     Unstratified,
+    /// The defaults with photons' directions drawn independently at random (no Sobol
+    /// sequence over the render's photons).
+    UnstratifiedPhotons,
     /// The defaults with one eye ray per pixel a pass for the light seen directly (no
     /// supersampled lamp outlines).
     Unsupersampled,
@@ -73,6 +76,7 @@ impl Config {
             Config::Default => "new defaults",
             Config::Unguided => "default without guided emission",
             Config::Unstratified => "default without stratified eye rays",
+            Config::UnstratifiedPhotons => "default without stratified photons",
             Config::Unsupersampled => "default without supersampled outlines",
             Config::OneEstimate => "default with one estimate for all photons",
             Config::FixedRadius => "default without adaptive radius",
@@ -93,6 +97,7 @@ impl Config {
             direct_light: true,
             guided_emission: true,
             stratified_eye_rays: true,
+            stratified_photons: true,
             supersample_light_seen: true,
             indirect_radius_scale: None,
             adaptive_radius: true,
@@ -104,6 +109,7 @@ impl Config {
                 p.guided_emission = false;
                 p.min_photons_per_pixel = 0.0;
                 p.stratified_eye_rays = false;
+                p.stratified_photons = false;
                 p.supersample_light_seen = false;
                 p.indirect_radius_scale = Some(1.0);
                 p.adaptive_radius = false;
@@ -111,6 +117,7 @@ impl Config {
             Config::Default => {}
             Config::Unguided => p.guided_emission = false,
             Config::Unstratified => p.stratified_eye_rays = false,
+            Config::UnstratifiedPhotons => p.stratified_photons = false,
             Config::Unsupersampled => p.supersample_light_seen = false,
             Config::OneEstimate => p.indirect_radius_scale = Some(1.0),
             Config::FixedRadius => p.adaptive_radius = false,
@@ -156,7 +163,7 @@ pub struct ConvergenceArgs {
         long,
         value_enum,
         value_delimiter = ',',
-        default_value = "photons-only,default,unguided,unstratified,unsupersampled,one-estimate,fixed-radius,alpha-0.5,alpha-0.667,alpha-0.9,radius-x4"
+        default_value = "photons-only,default,unguided,unstratified,unstratified-photons,unsupersampled,one-estimate,fixed-radius,alpha-0.5,alpha-0.667,alpha-0.9,radius-x4"
     )]
     configs: Vec<Config>,
     /// Rows (configuration, pass, seconds, RMSE, relMSE) and the plot of RMSE against seconds.

@@ -121,6 +121,12 @@ pub struct PpmArgs {
     #[arg(long, value_name = "on|off", action = clap::ArgAction::Set,
           value_parser = clap::builder::BoolishValueParser::new())]
     stratified_eye_rays: Option<bool>,
+    /// Photon mapping: choose photons' directions by Sobol's low-discrepancy sequence over the
+    /// render's photons rather than independently at random (default: the scene's
+    /// `stratified_photons`, on unless it says otherwise).
+    #[arg(long, value_name = "on|off", action = clap::ArgAction::Set,
+          value_parser = clap::builder::BoolishValueParser::new())]
+    stratified_photons: Option<bool>,
     /// Photon mapping: where the light a pixel sees directly changes within it (a lamp's
     /// outline, its images in mirrors and glass), trace 16 more eye rays a pass there for that
     /// light, when eye rays are jittered (default: the scene's `supersample_light_seen`, on
@@ -175,6 +181,9 @@ impl PpmArgs {
         }
         if let Some(on) = self.stratified_eye_rays {
             params.stratified_eye_rays = on;
+        }
+        if let Some(on) = self.stratified_photons {
+            params.stratified_photons = on;
         }
         if let Some(on) = self.supersample_light_seen {
             params.supersample_light_seen = on;

@@ -19,6 +19,14 @@
 //! independent over ℚ (their fields have degrees 5 and 2), so those Kronecker coordinates are
 //! jointly equidistributed, and a hybrid of a digital (0,2)-sequence and a Kronecker sequence
 //! is equidistributed too.
+//!
+//! Photons are stratified the same way over the whole render rather than per pixel: photon
+//! `n` (counted over all passes) takes point `n` of Sobol's pair, digitally shifted by a value
+//! fixed for the render, for the two numbers that choose where its light sends it ([`sobol_any`];
+//! quasi-Monte Carlo progressive photon mapping, Keller, Grünschloß & Droske 2012). Each pass's
+//! photons are then a stratified share of the light's directions and the passes together
+//! keep filling the gaps, so a caustic's density, estimated from photons spread evenly rather
+//! than at random, is less noisy. The photon's later choices stay random.
 
 use glam::DVec2;
 
@@ -67,6 +75,21 @@ pub fn sobol(n: u64, shift: u64) -> DVec2 {
     }
     let unit = |v: u32| v as f64 * 2f64.powi(-32);
     DVec2::new(unit(x ^ shift as u32), unit(y ^ (shift >> 32) as u32))
+}
+
+/// Point `n` of Sobol's first two dimensions for any 64-bit `n`: [`sobol`] within each block
+/// of 2³² points, the block `n >> 32` digitally shifted by `shift` mixed with its number
+/// (block 0 by `shift` itself). So an index past 2³² — or one whose high bits name a stream,
+/// as the global radius schedule's passes do — starts another independent randomisation of
+/// the sequence instead of repeating its points.
+pub fn sobol_any(n: u64, shift: u64) -> DVec2 {
+    let block = n >> 32;
+    let shift = if block == 0 {
+        shift
+    } else {
+        shift ^ crate::render::rng::mix64(block)
+    };
+    sobol(n, shift)
 }
 
 /// The R4 sequence's point `n` in the unit 4-cube, as two pairs: the first for the lens, the
@@ -153,6 +176,26 @@ mod tests {
         assert!(rotated(DVec2::splat(0.5), DVec2::splat(0.5 - 1e-17))
             .cmplt(DVec2::ONE)
             .all());
+    }
+
+    #[test]
+    fn sobol_any_is_sobol_in_the_first_block_and_shifts_each_later_block_anew() {
+        let shift = 0x0123_4567_89ab_cdef;
+        for n in [0, 1, 77, (1 << 32) - 1] {
+            assert_eq!(sobol_any(n, shift), sobol(n, shift));
+        }
+        // Blocks 1 and 2 hold the same unshifted points, each with a shift of its own.
+        let (a, b) = (sobol_any((1 << 32) + 5, shift), sobol_any((2 << 32) + 5, shift));
+        assert_ne!(a, sobol(5, shift));
+        assert_ne!(a, b);
+        // Still a (0,2)-sequence within a block: 16 points fill the 4×4 boxes once.
+        let mut seen = [0; 16];
+        for n in 0..16u64 {
+            let p = sobol_any((7 << 32) + 32 + n, shift);
+            assert!(p.cmpge(DVec2::ZERO).all() && p.cmplt(DVec2::ONE).all());
+            seen[(p.x * 4.0) as usize * 4 + (p.y * 4.0) as usize] += 1;
+        }
+        assert_eq!(seen, [1; 16]);
     }
 
     #[test]

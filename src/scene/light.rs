@@ -369,6 +369,16 @@ impl Light {
             if (center - *position).length_squared() > radius * radius * 1.0001)
     }
 
+    /// Which pair of [`Light::emit`]'s four numbers chooses the photon's direction (0: the
+    /// first two; a sphere light picks its direction first, a quad light its point first):
+    /// the pair photon mapping guides and stratifies.
+    pub fn direction_pair(&self) -> usize {
+        match self {
+            Light::Point { .. } | Light::Spot { .. } | Light::Sphere { .. } => 0,
+            Light::Quad { .. } => 1,
+        }
+    }
+
     /// Samples a photon leaving the light from four uniform numbers. `target`, the bounding
     /// sphere `(centre, radius)` of the scene, lets a point light outside it aim its photons at
     /// the scene instead of wasting them (the weight then carries the cone's share of 4π).

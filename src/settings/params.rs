@@ -77,6 +77,12 @@ pub struct RenderParams {
     /// default; matters only when the eye pass is traced every pass (anti-aliasing, depth of
     /// field).
     pub stratified_eye_rays: bool,
+    /// Photon mapping: the numbers that choose each photon's direction come from Sobol's
+    /// low-discrepancy sequence over the render's photons (`render::sequence`, randomised by
+    /// the seed) instead of independently at random (quasi-Monte Carlo photon mapping, Keller,
+    /// Grünschloß & Droske 2012), so each pass's photons cover the light's directions evenly
+    /// and caustics are less noisy. On by default.
+    pub stratified_photons: bool,
     /// Photon mapping: where the light a pixel sees directly changes within the pixel (a
     /// lamp's outline, its images in mirrors and glass), that pixel traces 16 more eye rays a
     /// pass that only look for that light (`ppm::seen`), so the outline converges as if it had
@@ -114,6 +120,7 @@ impl Default for RenderParams {
             direct_light: true,
             guided_emission: true,
             stratified_eye_rays: true,
+            stratified_photons: true,
             supersample_light_seen: true,
             index: IndexKind::HashGrid,
             radius_schedule: RadiusSchedule::PerPoint,

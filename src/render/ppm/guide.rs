@@ -23,7 +23,6 @@
 //! Determinism: the map changes only between passes, from integer counts summed over the
 //! pass's chunks, so it is the same for any number of threads.
 
-use crate::scene::light::Light;
 use crate::scene::Scene;
 
 /// Bins along each of the two guided random numbers.
@@ -103,14 +102,6 @@ struct LightGuide {
     density: Option<Density2D>,
 }
 
-/// The pair of random numbers that decides where a light's photons go.
-fn guided_pair(light: &Light) -> usize {
-    match light {
-        Light::Point { .. } | Light::Spot { .. } | Light::Sphere { .. } => 0,
-        Light::Quad { .. } => 1,
-    }
-}
-
 impl EmissionGuide {
     /// A uniform guide for the scene's lights (nothing learned yet); `pick` is the chance
     /// that a photon comes from each light.
@@ -121,7 +112,7 @@ impl EmissionGuide {
                 .lights
                 .iter()
                 .map(|l| LightGuide {
-                    pair: guided_pair(l),
+                    pair: l.direction_pair(),
                     emitted: vec![0; BINS],
                     useful: vec![0; BINS],
                     density: None,

@@ -18,7 +18,8 @@
 //! adaptive radius: in the spirit of classic photon mapping's k-nearest-neighbour radius,
 //! Jensen 2001, chosen once and then shrunk by the paper's rule).
 //!
-//! Determinism: photon `i` of the render uses the random stream `(seed, photon, i)`, pixels
+//! Determinism: photon `i` of the render uses the random stream `(seed, photon, i)` (and, when
+//! photons are stratified, point `i` of Sobol's sequence under a shift drawn from the seed), pixels
 //! `(seed, pass, pixel)`; photons are traced in fixed chunks, their hits sorted by cell
 //! with ties in photon order and handed in fixed groups whose deposits are applied in group
 //! order (`deposit.rs`), so the image is bit-identical for any number of threads.
@@ -47,12 +48,14 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use glam::{DVec3, Vec3};
+use rand::Rng;
 
 use guide::EmissionGuide;
 pub use hash_grid::HashGrid;
 pub use kd_tree::KdTree;
 use points::VisiblePoints;
 
+use crate::render::rng::stream_rng;
 use crate::render::shard::{PassSums, Shard};
 use crate::scene::Scene;
 use crate::settings::{IndexKind, RadiusSchedule};
@@ -76,6 +79,8 @@ mod streams {
     pub const SEEN: u64 = 14;
     /// Each such pixel's fixed offsets of its extra rays' sequences.
     pub const SEEN_OFFSETS: u64 = 15;
+    /// The digital shift of stratified photons' sequence.
+    pub const PHOTON_SHIFT: u64 = 16;
 }
 
 /// How photon mapping runs, beyond the scene's render parameters (which hold every setting
@@ -137,6 +142,9 @@ pub struct Ppm {
     stochastic: bool,
     /// Eye rays placed by low-discrepancy sequences over passes (from the render parameters).
     stratified_eye_rays: bool,
+    /// With stratified photons (from the render parameters): the digital shift of the Sobol
+    /// points that choose their directions, drawn from the seed.
+    photon_shift: Option<u64>,
     /// How the indirect estimate's radius is chosen (from the render parameters).
     indirect_scale: IndirectScale,
     /// Narrow the primary radius where the first pass found photons dense (from the render
@@ -237,6 +245,10 @@ impl Ppm {
             index: scene.params.index,
             stochastic,
             stratified_eye_rays: scene.params.stratified_eye_rays,
+            photon_shift: scene
+                .params
+                .stratified_photons
+                .then(|| stream_rng(scene.params.seed, streams::PHOTON_SHIFT, 0).random()),
             indirect_scale: match scene.params.indirect_radius_scale {
                 None => IndirectScale::Automatic,
                 Some(k) if k > 1.0 => IndirectScale::Fixed(k),

@@ -3,13 +3,15 @@
 //! chooses reflection or refraction), and at every diffuse surface hand their flux to the
 //! visible points whose search sphere holds them — on the same side of the surface — before
 //! continuing diffusely under Russian roulette with the surface's albedo as the survival
-//! probability.
+//! probability. A stratified photon's direction comes from a low-discrepancy sequence over
+//! the render's photons ([`crate::render::sequence`]; Keller, Grünschloß & Droske 2012).
 
 use glam::{DVec2, DVec3};
 use rand::Rng;
 use rand_pcg::Pcg64Mcg;
 
 use super::guide::EmissionGuide;
+use crate::render::sequence;
 use crate::scene::light::cosine_hemisphere;
 use crate::scene::material::{dielectric, reflect};
 use crate::scene::{MaterialKind, Scene};
@@ -56,6 +58,9 @@ pub struct PhotonSource<'a> {
     pub skip_direct: bool,
     /// The learned emission density, when photons are guided to where the camera looks.
     pub guide: Option<&'a EmissionGuide>,
+    /// When photons are stratified: the digital shift of the Sobol points that choose their
+    /// directions ([`sequence::sobol_any`]); `None`, every number is random.
+    pub stratified: Option<u64>,
 }
 
 /// The chance that a photon comes from each of the scene's lights: in proportion to power.
@@ -94,6 +99,7 @@ impl<'a> PhotonSource<'a> {
             target: scene.geometry.bounding_sphere(),
             skip_direct: direct_light,
             guide: None,
+            stratified: None,
         }
     }
 
@@ -102,7 +108,17 @@ impl<'a> PhotonSource<'a> {
         Self { guide, ..self }
     }
 
-    /// Traces one photon path with `rng`. At every diffuse hit whose flux should be gathered
+    /// The same source choosing photon `n`'s direction by point `n` of Sobol's sequence,
+    /// digitally shifted by `shift`, when that is given (see [`PhotonSource::stratified`]).
+    pub fn with_stratified(self, shift: Option<u64>) -> Self {
+        Self {
+            stratified: shift,
+            ..self
+        }
+    }
+
+    /// Traces photon number `n` (counted over the render; it places a stratified photon in
+    /// its sequence) with `rng`. At every diffuse hit whose flux should be gathered
     /// (all but direct hits when direct light is computed by light sampling),
     /// calls `gather(point, normal facing the photon, flux, indirect)`, `indirect` telling
     /// whether the photon has bounced off a diffuse surface before (indirect light) or came
@@ -110,6 +126,7 @@ impl<'a> PhotonSource<'a> {
     /// Returns where the photon came from.
     pub fn trace(
         &self,
+        n: u64,
         rng: &mut Pcg64Mcg,
         counts: &mut PhotonCounts,
         gather: &mut impl FnMut(DVec3, DVec3, DVec3, bool),
@@ -123,6 +140,11 @@ impl<'a> PhotonSource<'a> {
             .unwrap_or(self.cdf.len() - 1);
         let light = &scene.lights[light_index];
         let mut u = [rng.random(), rng.random(), rng.random(), rng.random()];
+        if let Some(shift) = self.stratified {
+            let k = 2 * light.direction_pair();
+            let q = sequence::sobol_any(n, shift);
+            (u[k], u[k + 1]) = (q.x, q.y);
+        }
         let (pdf, bin) = self.guide.map_or((1.0, 0), |g| g.warp(light_index, &mut u));
         let emitted = Emitted {
             light: light_index,

@@ -43,7 +43,9 @@ impl Ppm {
         radius: [f64; 2],
         control: &mut dyn FnMut(&mut f64) -> Control,
     ) -> Option<Gathered> {
-        let source = PhotonSource::new(scene, self.direct_light).with_guide(self.guide.as_ref());
+        let source = PhotonSource::new(scene, self.direct_light)
+            .with_guide(self.guide.as_ref())
+            .with_stratified(self.photon_shift);
         let estimates = self.estimates();
         let mut out = Gathered::new(
             self.slots.len(),
@@ -142,11 +144,16 @@ impl Ppm {
             let mut rng = stream_rng(self.seed, streams::PHOTON, first_photon + i);
             let photon = first + (i - start) as u32;
             let mut nth = 0;
-            from.push(source.trace(&mut rng, &mut counts, &mut |p, n, flux, indirect| {
-                let key = index.sort_key(p);
-                hits.push(Hit::new(key, p, n, flux, (photon, nth), indirect && split));
-                nth += 1;
-            }));
+            from.push(source.trace(
+                first_photon + i,
+                &mut rng,
+                &mut counts,
+                &mut |p, n, flux, indirect| {
+                    let key = index.sort_key(p);
+                    hits.push(Hit::new(key, p, n, flux, (photon, nth), indirect && split));
+                    nth += 1;
+                },
+            ));
         }
         Traced { hits, from, counts }
     }
