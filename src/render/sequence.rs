@@ -79,17 +79,11 @@ pub fn sobol(n: u64, shift: u64) -> DVec2 {
 
 /// Point `n` of Sobol's first two dimensions for any 64-bit `n`: [`sobol`] within each block
 /// of 2³² points, the block `n >> 32` digitally shifted by `shift` mixed with its number
-/// (block 0 by `shift` itself). So an index past 2³² — or one whose high bits name a stream,
-/// as the global radius schedule's passes do — starts another independent randomisation of
-/// the sequence instead of repeating its points.
+/// (block 0 by `shift` itself, as the mix of 0 is 0). So an index past 2³² — or one whose high
+/// bits name a stream, as the global radius schedule's passes do — starts another independent
+/// randomisation of the sequence instead of repeating its points.
 pub fn sobol_any(n: u64, shift: u64) -> DVec2 {
-    let block = n >> 32;
-    let shift = if block == 0 {
-        shift
-    } else {
-        shift ^ crate::render::rng::mix64(block)
-    };
-    sobol(n, shift)
+    sobol(n, shift ^ crate::render::rng::mix64(n >> 32))
 }
 
 /// The R4 sequence's point `n` in the unit 4-cube, as two pairs: the first for the lens, the

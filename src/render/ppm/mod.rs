@@ -206,6 +206,34 @@ pub struct Ppm {
     seen: seen::SeenLight,
 }
 
+/// What a render of `scene` skips because the scene does not need it, in words (the render's
+/// statistics list it); `stochastic`: whether the eye pass is traced anew every pass.
+fn skipped_work(scene: &Scene, stochastic: bool) -> Vec<String> {
+    let features = scene.features();
+    let mut skipped = Vec::new();
+    if !stochastic {
+        skipped.push("eye pass traced once and reused (pinhole camera, no anti-aliasing)".to_owned());
+    }
+    if !features.patches {
+        skipped.push("no Bézier patches: no patch intersection set up".to_owned());
+    }
+    if !features.glass {
+        skipped.push("no glass: no refraction paths".to_owned());
+    }
+    if !features.textures {
+        skipped.push("no textures: constant colours, no lookups".to_owned());
+    }
+    if scene.params.direct_light {
+        skipped.push("photons' first diffuse bounce: direct light by light sampling".to_owned());
+    }
+    if let Some(target) = scene.geometry.bounding_sphere() {
+        if scene.lights.iter().any(|l| l.aims_at(target)) {
+            skipped.push("photons from point lights outside the scene aimed at its bounds".to_owned());
+        }
+    }
+    skipped
+}
+
 /// Asked often during a pass (from any thread); returning true abandons the pass. The render
 /// session sets one that turns true when a restart is waiting.
 pub type Interrupt = Arc<dyn Fn() -> bool + Send + Sync>;
@@ -216,28 +244,7 @@ impl Ppm {
     pub fn new(scene: &Scene, options: PpmOptions) -> Self {
         let cam = &scene.camera;
         let stochastic = options.force_stochastic || cam.aperture > 0.0 || scene.params.antialias;
-        let features = scene.features();
-        let mut skipped = Vec::new();
-        if !stochastic {
-            skipped.push("eye pass traced once and reused (pinhole camera, no anti-aliasing)".to_owned());
-        }
-        if !features.patches {
-            skipped.push("no Bézier patches: no patch intersection set up".to_owned());
-        }
-        if !features.glass {
-            skipped.push("no glass: no refraction paths".to_owned());
-        }
-        if !features.textures {
-            skipped.push("no textures: constant colours, no lookups".to_owned());
-        }
-        if scene.params.direct_light {
-            skipped.push("photons' first diffuse bounce: direct light by light sampling".to_owned());
-        }
-        if let Some(target) = scene.geometry.bounding_sphere() {
-            if scene.lights.iter().any(|l| l.aims_at(target)) {
-                skipped.push("photons from point lights outside the scene aimed at its bounds".to_owned());
-            }
-        }
+        let skipped = skipped_work(scene, stochastic);
         let pixels = cam.width as usize * cam.height as usize;
         Self {
             options,

@@ -141,19 +141,17 @@ impl Ppm {
         let mut hits = Vec::with_capacity(2 * (end - start) as usize);
         let mut from = Vec::with_capacity((end - start) as usize);
         for i in start..end {
-            let mut rng = stream_rng(self.seed, streams::PHOTON, first_photon + i);
+            let n = first_photon + i;
+            let mut rng = stream_rng(self.seed, streams::PHOTON, n);
             let photon = first + (i - start) as u32;
             let mut nth = 0;
-            from.push(source.trace(
-                first_photon + i,
-                &mut rng,
-                &mut counts,
-                &mut |p, n, flux, indirect| {
+            from.push(
+                source.trace(n, &mut rng, &mut counts, &mut |p, normal, flux, indirect| {
                     let key = index.sort_key(p);
-                    hits.push(Hit::new(key, p, n, flux, (photon, nth), indirect && split));
+                    hits.push(Hit::new(key, p, normal, flux, (photon, nth), indirect && split));
                     nth += 1;
-                },
-            ));
+                }),
+            );
         }
         Traced { hits, from, counts }
     }
