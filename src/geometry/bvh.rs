@@ -28,12 +28,18 @@ pub struct Bvh {
     pub nodes: Vec<BvhNode>,
     /// Primitive indices, grouped by leaf.
     pub order: Vec<u32>,
+    /// Depth of the deepest leaf: a traversal's stack holds fewer entries than this.
+    levels: usize,
 }
 
 const BINS: usize = 16;
 const MAX_LEAF: usize = 4;
 /// Cost of a node traversal relative to one primitive test, for the SAH.
 const TRAVERSAL_COST: f64 = 0.5;
+/// Stack entries a traversal of a tree this deep or less keeps in arrays on the thread's stack.
+const SHORT_STACK: usize = 32;
+/// The same for deeper trees (deeper still, the stack is on the heap).
+const LONG_STACK: usize = 64;
 
 struct BuildItem {
     bounds: Aabb,
@@ -56,10 +62,12 @@ impl Bvh {
         let mut bvh = Bvh {
             nodes: Vec::with_capacity(2 * bounds.len()),
             order: Vec::with_capacity(bounds.len()),
+            levels: 0,
         };
         if !items.is_empty() {
             bvh.build_node(&mut items);
         }
+        bvh.levels = bvh.measure_depth();
         bvh
     }
 
@@ -158,18 +166,67 @@ impl Bvh {
     /// `visit(primitive, t_max)` returns the distance of a nearer hit, which then bounds the
     /// rest of the traversal. Returns the final `t_max`.
     #[inline]
-    pub fn traverse(&self, ray: &Ray, mut t_max: f64, mut visit: impl FnMut(u32, f64) -> Option<f64>) -> f64 {
-        let Some(root) = self.nodes.first() else {
-            return t_max;
-        };
+    pub fn traverse(&self, ray: &Ray, t_max: f64, visit: impl FnMut(u32, f64) -> Option<f64>) -> f64 {
         let inv_dir = safe_inverse(ray.dir);
-        if root.bounds.hit_interval(ray.origin, inv_dir, t_max).is_none() {
-            return t_max;
+        match self.nodes.first() {
+            Some(root) if root.bounds.hit_interval(ray.origin, inv_dir, t_max).is_some() => {}
+            _ => return t_max,
         }
-        // Entries are nodes whose box the ray enters at the stored distance. Two plain arrays
-        // (not an array of pairs, whose padding makes the start-up zeroing a scalar loop).
-        let mut stack_node = [0u32; 64];
-        let mut stack_enter = [0.0f64; 64];
+        // Stack entries are nodes whose box the ray enters at the stored distance: a node's
+        // ancestors' other children, fewer than the tree's depth. Two plain arrays (not an
+        // array of pairs, whose padding makes the start-up zeroing a scalar loop). Zeroing is
+        // a measurable part of a short traversal, so the arrays are sized to the tree.
+        if self.levels <= SHORT_STACK {
+            self.walk(
+                ray,
+                inv_dir,
+                t_max,
+                visit,
+                &mut [0; SHORT_STACK],
+                &mut [0.0; SHORT_STACK],
+            )
+        } else if self.levels <= LONG_STACK {
+            self.walk(
+                ray,
+                inv_dir,
+                t_max,
+                visit,
+                &mut [0; LONG_STACK],
+                &mut [0.0; LONG_STACK],
+            )
+        } else {
+            self.traverse_deep(ray, inv_dir, t_max, visit)
+        }
+    }
+
+    /// [`Bvh::traverse`] for a degenerate tree, deeper than the inline stacks: primitives
+    /// spread so unevenly (say, exponentially along a line) that the SAH splits off a few at a
+    /// time.
+    #[cold]
+    #[inline(never)]
+    fn traverse_deep(
+        &self,
+        ray: &Ray,
+        inv_dir: DVec3,
+        t_max: f64,
+        visit: impl FnMut(u32, f64) -> Option<f64>,
+    ) -> f64 {
+        let (mut nodes, mut enter) = (vec![0; self.levels], vec![0.0; self.levels]);
+        self.walk(ray, inv_dir, t_max, visit, &mut nodes, &mut enter)
+    }
+
+    /// [`Bvh::traverse`] past the root's box (which the ray enters), with a stack of at least
+    /// [`Bvh::depth`] entries.
+    #[inline]
+    fn walk(
+        &self,
+        ray: &Ray,
+        inv_dir: DVec3,
+        mut t_max: f64,
+        mut visit: impl FnMut(u32, f64) -> Option<f64>,
+        stack_node: &mut [u32],
+        stack_enter: &mut [f64],
+    ) -> f64 {
         let mut top = 0usize;
         let mut node = 0usize;
         loop {
@@ -256,6 +313,11 @@ impl Bvh {
 
     /// Depth of the deepest leaf (for statistics and the stack-size guarantee).
     pub fn depth(&self) -> usize {
+        self.levels
+    }
+
+    /// Walks the tree for [`Bvh::depth`].
+    fn measure_depth(&self) -> usize {
         fn walk(bvh: &Bvh, node: usize) -> usize {
             let n = &bvh.nodes[node];
             if n.count > 0 {
@@ -314,6 +376,44 @@ mod tests {
             let brute = boxes.iter().filter_map(entry).fold(f64::INFINITY, f64::min);
             let found = bvh.traverse(&ray, f64::INFINITY, |p, _| entry(&boxes[p as usize]));
             assert_eq!(brute, found);
+        }
+    }
+
+    #[test]
+    fn trees_deeper_than_the_inline_stacks_are_traversed_in_full() {
+        // Boxes at exponentially growing distances along x: the binned SAH splits off a few
+        // at a time, so the tree is far deeper than a balanced one. A ray along the line from
+        // beyond the farthest box passes through every one of them. (Before the stack was
+        // sized to the tree, the deeper one overflowed a fixed stack of 64 and panicked.)
+        for (growth, depths) in [
+            (1.05f64, SHORT_STACK + 1..=LONG_STACK),
+            (1.1, LONG_STACK + 1..=usize::MAX),
+        ] {
+            let boxes: Vec<Aabb> = (0..3000)
+                .map(|k| {
+                    let x = growth.powi(k);
+                    Aabb::new(DVec3::new(x, 0.0, 0.0), DVec3::new(x * 1.0001 + 1.0, 1.0, 1.0))
+                })
+                .collect();
+            let bvh = Bvh::build(&boxes);
+            assert!(
+                depths.contains(&bvh.depth()),
+                "growth {growth}: depth {}",
+                bvh.depth()
+            );
+            let ray = Ray::new(DVec3::new(1e130, 0.5, 0.5), DVec3::new(-1.0, 0.0, 0.0));
+            let inv = safe_inverse(ray.dir);
+            let entry = |b: &Aabb| b.hit_interval(ray.origin, inv, f64::INFINITY).map(|(t0, _)| t0);
+            let mut visited = 0;
+            let found = bvh.traverse(&ray, f64::INFINITY, |p, _| {
+                visited += 1;
+                entry(&boxes[p as usize]).map(|_| f64::INFINITY)
+            });
+            assert_eq!(found, f64::INFINITY);
+            assert_eq!(visited, boxes.len(), "growth {growth}");
+            let nearest = bvh.traverse(&ray, f64::INFINITY, |p, _| entry(&boxes[p as usize]));
+            let brute = boxes.iter().filter_map(entry).fold(f64::INFINITY, f64::min);
+            assert_eq!(nearest, brute, "growth {growth}");
         }
     }
 
