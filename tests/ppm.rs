@@ -937,6 +937,51 @@ fn guided_emission_sends_photons_where_the_camera_looks_and_keeps_the_image() {
     );
 }
 
+/// Stratified photons from two lights: the Sobol point's first coordinate picks the light and,
+/// rescaled within that light's share, places the photon, so each light's photons are a
+/// stratified share of the sequence rather than a random subset of it. A plane lit by two
+/// point lights of unequal power (photons only, unguided so that only the numbers differ)
+/// keeps the closed form, its error falls to well under half that of random photons
+/// (measured 0.0081 against 0.034; picking the light at random, as before, 0.024), and
+/// one and two threads agree.
+#[test]
+fn stratified_photons_stay_stratified_over_several_lights() {
+    let two_lights = "type = \"point\"\nposition = [0.5, 3.0, 0.2]\npower = 300\n\n[[lights]]\n\
+                      type = \"point\"\nposition = [-0.8, 2.0, -0.4]\npower = 100";
+    let mut scene = plane_lit_by(two_lights, false);
+    assert_eq!(scene.lights.len(), 2);
+    scene.params.guided_emission = false;
+    let expected = closed_form(&scene);
+    let mut render = |stratified: bool, threads: usize| {
+        scene.params.stratified_photons = stratified;
+        pool(threads).install(|| {
+            let mut ppm = Ppm::new(&scene, PpmOptions::default());
+            for _ in 0..40 {
+                ppm.run_pass(&scene, &mut |_| Control::Continue);
+            }
+            ppm.radiance()
+        })
+    };
+    let (stratified, random) = (render(true, 2), render(false, 2));
+    let (mean_s, rms_s) = relative_errors(&stratified, &expected);
+    let (mean_r, rms_r) = relative_errors(&random, &expected);
+    eprintln!("two lights, RMS relative error: stratified {rms_s}, random {rms_r}");
+    assert!(
+        (mean_s - 1.0).abs() < 0.01,
+        "stratified mean / closed form {mean_s}"
+    );
+    assert!((mean_r - 1.0).abs() < 0.01, "random mean / closed form {mean_r}");
+    assert!(
+        rms_s < 0.4 * rms_r,
+        "RMS relative error with stratified photons {rms_s}, with random ones {rms_r}"
+    );
+    assert_eq!(
+        stratified,
+        render(true, 1),
+        "stratified photons with one and two threads"
+    );
+}
+
 /// Adaptive radius (the default): where the first pass found photons dense, a point restarts
 /// its estimate with a narrower radius at the second pass and the first pass's photons no
 /// longer count for it — the image stays normalised (a plane lit by a point light, every

@@ -26,7 +26,10 @@
 //! quasi-Monte Carlo progressive photon mapping, Keller, Grünschloß & Droske 2012). Each pass's
 //! photons are then a stratified share of the light's directions and the passes together
 //! keep filling the gaps, so a caustic's density, estimated from photons spread evenly rather
-//! than at random, is less noisy. The photon's later choices stay random.
+//! than at random, is less noisy. With several lights the first number picks the light as
+//! well and, rescaled within the light's share of the power, still places the photon, so each
+//! light's photons are stratified rather than a random subset of the points. The photon's
+//! later choices stay random.
 
 use glam::DVec2;
 

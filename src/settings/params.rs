@@ -81,7 +81,8 @@ pub struct RenderParams {
     /// low-discrepancy sequence over the render's photons (`render::sequence`, randomised by
     /// the seed) instead of independently at random (quasi-Monte Carlo photon mapping, Keller,
     /// Grünschloß & Droske 2012), so each pass's photons cover the light's directions evenly
-    /// and caustics are less noisy. On by default.
+    /// and caustics are less noisy; with several lights the sequence picks the light too. On
+    /// by default.
     pub stratified_photons: bool,
     /// Photon mapping: where the light a pixel sees directly changes within the pixel (a
     /// lamp's outline, its images in mirrors and glass), that pixel traces 16 more eye rays a

@@ -69,18 +69,18 @@ pub fn quad_irradiance(x: DVec3, n: DVec3, corner: DVec3, eu: DVec3, ev: DVec3, 
     l * 0.5 * sum.abs()
 }
 
-/// The closed form of the direct light the plane reflects to each pixel.
+/// The closed form of the direct light the plane reflects to each pixel, from all its lights.
 pub fn closed_form(scene: &Scene) -> Vec<DVec3> {
     use caustic::scene::light::spot_falloff;
     use caustic::scene::Light;
     let rho = DVec3::new(0.8, 0.6, 0.4);
     let n = DVec3::Y;
-    let irradiance = |p: DVec3| -> DVec3 {
+    let irradiance_from = |light: &Light, p: DVec3| -> DVec3 {
         let point_like = |position: DVec3, intensity: DVec3, falloff: f64| {
             let d = position - p;
             intensity * falloff * n.dot(d.normalize()) / d.length_squared()
         };
-        match scene.lights[0] {
+        match *light {
             Light::Point { position, intensity } => point_like(position, intensity, 1.0),
             // Seen whole from every receiver: a point light of equal power (I = L·πR²).
             Light::Sphere {
@@ -110,6 +110,7 @@ pub fn closed_form(scene: &Scene) -> Vec<DVec3> {
             } => quad_irradiance(p, n, corner, edge_u, edge_v, radiance),
         }
     };
+    let irradiance = |p: DVec3| -> DVec3 { scene.lights.iter().map(|l| irradiance_from(l, p)).sum() };
     let (w, h) = (scene.camera.width, scene.camera.height);
     (0..h)
         .flat_map(|y| (0..w).map(move |x| (x, y)))

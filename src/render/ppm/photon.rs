@@ -59,7 +59,7 @@ pub struct PhotonSource<'a> {
     /// The learned emission density, when photons are guided to where the camera looks.
     pub guide: Option<&'a EmissionGuide>,
     /// When photons are stratified: the digital shift of the Sobol points that choose their
-    /// directions ([`sequence::sobol_any`]); `None`, every number is random.
+    /// lights and directions ([`sequence::sobol_any`]); `None`, every number is random.
     pub stratified: Option<u64>,
 }
 
@@ -108,13 +108,26 @@ impl<'a> PhotonSource<'a> {
         Self { guide, ..self }
     }
 
-    /// The same source choosing photon `n`'s direction by point `n` of Sobol's sequence,
-    /// digitally shifted by `shift`, when that is given (see [`PhotonSource::stratified`]).
+    /// The same source choosing photon `n`'s light and direction by point `n` of Sobol's
+    /// sequence, digitally shifted by `shift`, when that is given (see
+    /// [`PhotonSource::stratified`]).
     pub fn with_stratified(self, shift: Option<u64>) -> Self {
         Self {
             stratified: shift,
             ..self
         }
+    }
+
+    /// The light that `x` in [0, 1) picks (the power share it falls in) and `x` rescaled to
+    /// [0, 1) within that share, which is uniform again and free to be used once more (the
+    /// remapped sample of pbrt-v4's `SampleDiscrete`). With one light, `x` itself.
+    fn pick(&self, x: f64) -> (usize, f64) {
+        let last = self.cdf.len() - 1;
+        let light = self.cdf.iter().position(|&c| x < c).unwrap_or(last);
+        let below = if light == 0 { 0.0 } else { self.cdf[light - 1] };
+        let share = self.cdf[light] - below;
+        let rescaled = if share > 0.0 { (x - below) / share } else { 0.5 };
+        (light, rescaled.clamp(0.0, 1.0 - f64::EPSILON / 2.0))
     }
 
     /// Traces photon number `n` (counted over the render; it places a stratified photon in
@@ -133,16 +146,22 @@ impl<'a> PhotonSource<'a> {
     ) -> Emitted {
         let scene = self.scene;
         let pick: f64 = rng.random();
-        let light_index = self
-            .cdf
-            .iter()
-            .position(|&c| pick < c)
-            .unwrap_or(self.cdf.len() - 1);
+        // A stratified photon's Sobol point picks the light by its first coordinate, which,
+        // rescaled within that light's share, then places the photon with the second: each
+        // light's photons are a stratified share of the sequence, not a random subset of it.
+        // (The random pick is still drawn, so the photon's other numbers stay the same.)
+        let (light_index, point) = match self.stratified {
+            Some(shift) => {
+                let q = sequence::sobol_any(n, shift);
+                let (light, x) = self.pick(q.x);
+                (light, Some(DVec2::new(x, q.y)))
+            }
+            None => (self.pick(pick).0, None),
+        };
         let light = &scene.lights[light_index];
         let mut u = [rng.random(), rng.random(), rng.random(), rng.random()];
-        if let Some(shift) = self.stratified {
+        if let Some(q) = point {
             let k = 2 * light.direction_pair();
-            let q = sequence::sobol_any(n, shift);
             (u[k], u[k + 1]) = (q.x, q.y);
         }
         let (pdf, bin) = self.guide.map_or((1.0, 0), |g| g.warp(light_index, &mut u));
