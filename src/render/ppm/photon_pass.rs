@@ -119,12 +119,13 @@ impl Ppm {
         }
     }
 
-    /// This pass's photons: `photons_per_pass` divided by the guide's gain (as many useful
-    /// photons, fewer lost ones; see [`guide`]), but not below one chunk (or all of them).
+    /// This pass's photons: `photons_per_pass` divided by the square root of the guide's gain
+    /// (more useful photons, fewer lost ones; see [`guide`]), but not below one chunk (or all
+    /// of them).
     pub(super) fn guided_pass_photons(&self) -> u64 {
         match &self.guide {
             Some(g) => {
-                let reduced = (self.photons_per_pass as f64 / g.gain()).ceil() as u64;
+                let reduced = (self.photons_per_pass as f64 / g.gain().sqrt()).ceil() as u64;
                 reduced.max(self.photons_per_pass.min(CHUNK))
             }
             None => self.photons_per_pass,
