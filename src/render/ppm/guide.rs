@@ -14,16 +14,21 @@
 //! density. A photon's flux is divided by the density of its random numbers, so the estimate
 //! stays unbiased, whatever the scene — infinite planes included — and whatever was learned.
 //!
-//! Fewer photons, more light: photon mapping's radius, and so its bias, shrinks per *pass*
-//! (Hachisuka et al. 2008, eq. 9), so a pass should be cheap, but every pass also traces the
-//! eye pass again, so it should not be too cheap either. A guided pass therefore emits the
-//! photons per pass divided by the square root of the guide's *gain* — how many times more of
-//! its photons reach a visible point than uniform emission's would — so it lands √gain times
-//! as many useful photons as an unguided pass while tracing 1/√gain as many. Measured on
-//! `scenes/glass_teapot.toml` (320×240, 20 s, gain about 4–6, 2 and 4 runs): RMSE 3.81e-3 and
-//! 3.85e-3 dividing by the gain (about 200 passes, half their time in the eye pass),
-//! 3.36e-3–3.51e-3 dividing by its square root (111–126 passes), 3.53e-3–3.91e-3 not
-//! dividing (44–56 passes).
+//! Fewer photons, as much light or more: photon mapping's radius, and so its bias, shrinks per
+//! *pass* (Hachisuka et al. 2008, eq. 9), so early passes should be cheap. An epoch's first
+//! [`GAIN_DIVIDED_PASSES`] guided passes therefore emit the photons per pass divided by the
+//! guide's *gain* — how many times more of its photons reach a visible point than uniform
+//! emission's would — so they land about as many useful photons as unguided passes, without
+//! tracing the ones that would have been lost. Later passes, whose error is mostly the photon
+//! estimate's noise, divide by the gain's square root: √gain times as many useful photons as
+//! an unguided pass, fewer passes, less of the time in eye passes. Measured on
+//! `scenes/glass_teapot.toml` (320×240, 20 s each, gain about 4–6): RMSE 3.81e-3–3.95e-3 (4
+//! runs) dividing by the gain throughout (about 200 passes, half their time in eye passes),
+//! 3.57e-3–3.61e-3 (4 runs) with this rule, 3.36e-3–3.52e-3 (6 runs) dividing by the square
+//! root throughout, 3.53e-3–3.91e-3 (4 runs) not dividing; but after an edit
+//! (`caustic bench edit`, `scenes/inline_patch.toml`, a few passes) the square root throughout
+//! took the warm restart to relative MSE 1e-2 in 0.65–0.69 s against 0.42–0.44 s, which this
+//! rule keeps.
 //!
 //! Determinism: the map changes only between passes, from integer counts summed over the
 //! pass's chunks, so it is the same for any number of threads.
@@ -45,8 +50,11 @@ const FULL_SHARE: f64 = 0.1;
 const PRIOR_PHOTONS: f64 = 16.0;
 /// Photons a light must have emitted before its map is used (a few per bin).
 const MIN_PHOTONS: u64 = 4 * BINS as u64;
-/// The largest gain (whose square root the photons per pass are divided by).
+/// The largest gain the photons per pass are divided by.
 pub const MAX_GAIN: f64 = 64.0;
+/// Guided passes of an epoch (or of the global schedule) that divide the photons per pass by
+/// the whole gain; later ones divide by its square root.
+pub const GAIN_DIVIDED_PASSES: u64 = 32;
 /// A light's learned density is used only when it gains at least this much: below, as in a
 /// closed room where nearly every photon lands in view, reshaping the emission buys little and
 /// costs time (guided photons reach more points, each a deposit). Measured in the Cornell box

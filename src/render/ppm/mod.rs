@@ -174,8 +174,8 @@ pub struct Ppm {
     /// Where photons are sent, learned from completed passes (`None`: uniformly, as the
     /// lights emit).
     guide: Option<EmissionGuide>,
-    /// Photons emitted by the pass in progress: `photons_per_pass`, divided by the square root
-    /// of the guide's gain when emission is guided.
+    /// Photons emitted by the pass in progress: `photons_per_pass`, divided by the guide's gain
+    /// (or, after an epoch's first passes, its square root) when emission is guided.
     pass_photons: u64,
     stats: PpmStats,
     width: u32,

@@ -8,7 +8,7 @@ use rayon::prelude::*;
 
 use super::deposit::{Gather, Hit, Window, WINDOW_PHOTONS};
 use super::gathered::Gathered;
-use super::guide::EmissionGuide;
+use super::guide::{EmissionGuide, GAIN_DIVIDED_PASSES};
 use super::photon::{Emitted, PhotonCounts, PhotonSource};
 
 use super::radius::IndirectScale;
@@ -119,16 +119,30 @@ impl Ppm {
         }
     }
 
-    /// This pass's photons: `photons_per_pass` divided by the square root of the guide's gain
-    /// (more useful photons, fewer lost ones; see [`guide`]), but not below one chunk (or all
-    /// of them).
+    /// This pass's photons: `photons_per_pass` divided by the guide's gain for an epoch's
+    /// first [`GAIN_DIVIDED_PASSES`] passes, by its square root after them (see [`guide`]),
+    /// but not below one chunk (or all of them).
     pub(super) fn guided_pass_photons(&self) -> u64 {
         match &self.guide {
             Some(g) => {
-                let reduced = (self.photons_per_pass as f64 / g.gain().sqrt()).ceil() as u64;
+                let divisor = if self.epoch_pass() < GAIN_DIVIDED_PASSES {
+                    g.gain()
+                } else {
+                    g.gain().sqrt()
+                };
+                let reduced = (self.photons_per_pass as f64 / divisor).ceil() as u64;
                 reduced.max(self.photons_per_pass.min(CHUNK))
             }
             None => self.photons_per_pass,
+        }
+    }
+
+    /// The pass in progress, counted from 0: in this epoch, or in the global schedule (where
+    /// it depends on the pass alone, whichever process renders it).
+    fn epoch_pass(&self) -> u64 {
+        match &self.global {
+            Some(g) => g.stream_pass().saturating_sub(1),
+            None => u64::from(self.stats.passes),
         }
     }
 
