@@ -24,11 +24,11 @@
 //! an unguided pass, fewer passes, less of the time in eye passes. Measured on
 //! `scenes/glass_teapot.toml` (320×240, 20 s each, gain about 4–6): RMSE 3.81e-3–3.95e-3 (4
 //! runs) dividing by the gain throughout (about 200 passes, half their time in eye passes),
-//! 3.57e-3–3.61e-3 (4 runs) with this rule, 3.36e-3–3.52e-3 (6 runs) dividing by the square
+//! 3.42e-3–3.61e-3 (4 runs) with this rule, 3.36e-3–3.52e-3 (6 runs) dividing by the square
 //! root throughout, 3.53e-3–3.91e-3 (4 runs) not dividing; but after an edit
 //! (`caustic bench edit`, `scenes/inline_patch.toml`, a few passes) the square root throughout
-//! took the warm restart to relative MSE 1e-2 in 0.65–0.69 s against 0.42–0.44 s, which this
-//! rule keeps.
+//! took the warm restart to relative MSE 1e-2 in 0.65–0.84 s against 0.43–0.65 s dividing by
+//! the gain (4 sets, interleaved), and this rule in 0.57–0.71 s (3 sets).
 //!
 //! Determinism: the map changes only between passes, from integer counts summed over the
 //! pass's chunks, so it is the same for any number of threads.
