@@ -884,9 +884,9 @@ fn light_sampling_agrees_with_photons_and_the_closed_form_for_every_light() {
 /// weights keep it unbiased) with no more error than unguided emission after as many passes
 /// (photons' directions at random, so that only the guide differs; measured 0.030 against
 /// 0.034), and it is the same for one and two threads. Its first 32 passes trace the photons
-/// per pass divided by the gain, later ones divided by the gain's square root. With stratified photons (the default)
-/// the guided image keeps the closed form and its error falls several times (measured 3.8×:
-/// RMS relative error 0.0078 against 0.030).
+/// per pass divided by the gain, later ones divided by the gain's square root. With
+/// stratified photons (the default) the guided image keeps the closed form and its error
+/// falls several times (measured 3.8×: RMS relative error 0.0078 against 0.030).
 #[test]
 fn guided_emission_sends_photons_where_the_camera_looks_and_keeps_the_image() {
     let mut scene = Scene::from_str(PLANE, Path::new("plane.toml"), None).expect("scene");
@@ -966,13 +966,7 @@ fn stratified_photons_stay_stratified_over_several_lights() {
     let expected = closed_form(&scene);
     let mut render = |stratified: bool, threads: usize| {
         scene.params.stratified_photons = stratified;
-        pool(threads).install(|| {
-            let mut ppm = Ppm::new(&scene, PpmOptions::default());
-            for _ in 0..40 {
-                ppm.run_pass(&scene, &mut |_| Control::Continue);
-            }
-            ppm.radiance()
-        })
+        pool(threads).install(|| render_passes(&scene, PpmOptions::default(), 40))
     };
     let (stratified, random) = (render(true, 2), render(false, 2));
     let (mean_s, rms_s) = relative_errors(&stratified, &expected);

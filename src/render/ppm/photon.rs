@@ -11,6 +11,7 @@ use rand::Rng;
 use rand_pcg::Pcg64Mcg;
 
 use super::guide::EmissionGuide;
+use crate::geometry::Ray;
 use crate::render::sequence;
 use crate::scene::light::cosine_hemisphere;
 use crate::scene::material::{dielectric, reflect};
@@ -130,6 +131,38 @@ impl<'a> PhotonSource<'a> {
         (light, rescaled.clamp(0.0, 1.0 - f64::EPSILON / 2.0))
     }
 
+    /// Emits photon number `n`: picks its light and its random numbers (from the sequence
+    /// when photons are stratified), warps them by the guide, and returns where the photon
+    /// came from, its flux (weighted by the guide's density) and its first ray.
+    fn emit(&self, n: u64, rng: &mut Pcg64Mcg) -> (Emitted, DVec3, Ray) {
+        let pick: f64 = rng.random();
+        // A stratified photon's Sobol point picks the light by its first coordinate, which,
+        // rescaled within that light's share, then places the photon with the second: each
+        // light's photons are a stratified share of the sequence, not a random subset of it.
+        // (The random pick is still drawn, so the photon's other numbers stay the same.)
+        let (light_index, point) = match self.stratified {
+            Some(shift) => {
+                let q = sequence::sobol_any(n, shift);
+                let (light, x) = self.pick(q.x);
+                (light, Some(DVec2::new(x, q.y)))
+            }
+            None => (self.pick(pick).0, None),
+        };
+        let light = &self.scene.lights[light_index];
+        let mut u = [rng.random(), rng.random(), rng.random(), rng.random()];
+        if let Some(q) = point {
+            let k = 2 * light.direction_pair();
+            (u[k], u[k + 1]) = (q.x, q.y);
+        }
+        let (pdf, bin) = self.guide.map_or((1.0, 0), |g| g.warp(light_index, &mut u));
+        let emitted = Emitted {
+            light: light_index,
+            bin,
+        };
+        let e = light.emit(u, self.target);
+        (emitted, self.flux[light_index] * (e.weight / pdf), e.ray())
+    }
+
     /// Traces photon number `n` (counted over the render; it places a stratified photon in
     /// its sequence) with `rng`. At every diffuse hit whose flux should be gathered
     /// (all but direct hits when direct light is computed by light sampling),
@@ -145,33 +178,7 @@ impl<'a> PhotonSource<'a> {
         gather: &mut impl FnMut(DVec3, DVec3, DVec3, bool),
     ) -> Emitted {
         let scene = self.scene;
-        let pick: f64 = rng.random();
-        // A stratified photon's Sobol point picks the light by its first coordinate, which,
-        // rescaled within that light's share, then places the photon with the second: each
-        // light's photons are a stratified share of the sequence, not a random subset of it.
-        // (The random pick is still drawn, so the photon's other numbers stay the same.)
-        let (light_index, point) = match self.stratified {
-            Some(shift) => {
-                let q = sequence::sobol_any(n, shift);
-                let (light, x) = self.pick(q.x);
-                (light, Some(DVec2::new(x, q.y)))
-            }
-            None => (self.pick(pick).0, None),
-        };
-        let light = &scene.lights[light_index];
-        let mut u = [rng.random(), rng.random(), rng.random(), rng.random()];
-        if let Some(q) = point {
-            let k = 2 * light.direction_pair();
-            (u[k], u[k + 1]) = (q.x, q.y);
-        }
-        let (pdf, bin) = self.guide.map_or((1.0, 0), |g| g.warp(light_index, &mut u));
-        let emitted = Emitted {
-            light: light_index,
-            bin,
-        };
-        let e = light.emit(u, self.target);
-        let mut flux = self.flux[light_index] * (e.weight / pdf);
-        let mut ray = e.ray();
+        let (emitted, mut flux, mut ray) = self.emit(n, rng);
         let skip_first = self.skip_direct;
         counts.paths += 1;
         let mut first_interaction = true;
