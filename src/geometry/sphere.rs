@@ -26,13 +26,19 @@ impl Sphere {
     pub fn intersect(&self, ray: &Ray, t_min: f64, t_max: f64) -> Option<f64> {
         let f = ray.origin - self.center;
         let b = -f.dot(ray.dir);
+        let c = f.length_squared() - self.radius * self.radius;
+        // From outside (c > 0), a sphere behind the ray (b ≤ 0) has both roots at t ≤ 0:
+        // nothing to find in (t_min, t_max) for t_min ≥ 0, without the square root and the
+        // division (a photon in smallppm's room has half its walls behind it).
+        if c > 0.0 && b <= 0.0 && t_min >= 0.0 {
+            return None;
+        }
         // r² − |f − (f·d)d|², robust for rays far from large spheres.
         let l = f + b * ray.dir;
         let disc = self.radius * self.radius - l.length_squared();
         if disc < 0.0 {
             return None;
         }
-        let c = f.length_squared() - self.radius * self.radius;
         let q = b + b.signum() * disc.sqrt();
         let (mut t0, mut t1) = if q == 0.0 { (0.0, 0.0) } else { (c / q, q) };
         if t0 > t1 {
@@ -75,6 +81,53 @@ mod tests {
         let inside = Ray::new(DVec3::ZERO, DVec3::X);
         assert_eq!(s.intersect(&inside, 0.0, f64::INFINITY), Some(2.0));
         assert_eq!(s.intersect(&out, 0.0, 2.5), None);
+    }
+
+    #[test]
+    fn spheres_behind_the_ray_are_missed_and_nothing_in_front_is() {
+        let s = Sphere {
+            center: DVec3::new(1.0, -2.0, 0.5),
+            radius: 1.5,
+        };
+        // From outside, looking away (or tangentially away): no hit, for any range from 0.
+        let away = Ray::new(DVec3::new(1.0, -2.0, 4.0), DVec3::Z);
+        assert_eq!(s.intersect(&away, 0.0, f64::INFINITY), None);
+        // Random rays from inside and outside against the textbook quadratic, far from
+        // tangency: the early rejection must not lose a hit in front of the ray.
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let (mut hits, mut misses) = (0, 0);
+        for _ in 0..20_000 {
+            let origin = s.center + DVec3::new(next(), next(), next()) * 4.0;
+            let dir = DVec3::new(next(), next(), next());
+            if dir.length() < 1e-3 {
+                continue;
+            }
+            let ray = Ray::new(origin, dir.normalize());
+            let f = ray.origin - s.center;
+            let (b, c) = (-f.dot(ray.dir), f.length_squared() - s.radius * s.radius);
+            let disc = b * b - c;
+            if disc.abs() < 1e-6 || c.abs() < 1e-6 {
+                continue;
+            }
+            let textbook = (disc > 0.0)
+                .then(|| [b - disc.sqrt(), b + disc.sqrt()])
+                .and_then(|roots| roots.into_iter().find(|&t| t > 0.0));
+            match (s.intersect(&ray, 0.0, f64::INFINITY), textbook) {
+                (Some(t), Some(expected)) => {
+                    assert!((t - expected).abs() < 1e-9, "{ray:?}: {t} against {expected}");
+                    hits += 1;
+                }
+                (None, None) => misses += 1,
+                (got, expected) => panic!("{ray:?}: {got:?} against {expected:?}"),
+            }
+        }
+        assert!(hits > 1000 && misses > 3000, "{hits} hits, {misses} misses");
     }
 
     #[test]
