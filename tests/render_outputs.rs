@@ -206,3 +206,37 @@ fn tev_receives_every_pass_and_a_refused_connection_is_a_warning() {
         "{summary}"
     );
 }
+
+/// `--time-limit` without `--passes` renders passes until the limit, not the default 16;
+/// with `--passes` as well, whichever ends first ends the render.
+#[test]
+fn a_time_limit_alone_renders_passes_until_it() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("timed.png");
+    let render = |extra: &[&str]| {
+        let mut args = vec![
+            "render",
+            "scenes/cornell.toml",
+            "--renderer",
+            "ppm",
+            "--width",
+            "16",
+            "--height",
+            "12",
+            "--photons",
+            "1000",
+            "--json",
+            "--force",
+            "--out",
+            out.to_str().expect("utf-8 path"),
+        ];
+        args.extend_from_slice(extra);
+        let doc = json(&caustic(&args));
+        doc["photon_mapping"]["passes"]
+            .as_u64()
+            .unwrap_or_else(|| panic!("no pass count in {doc}"))
+    };
+    let timed = render(&["--time-limit", "2"]);
+    assert!(timed > 16, "{timed} passes in 2 s of a 16x12 image");
+    assert_eq!(render(&["--time-limit", "30", "--passes", "3"]), 3);
+}

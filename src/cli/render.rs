@@ -81,11 +81,13 @@ pub struct RenderArgs {
 /// Photon-mapping flags of `render`.
 #[derive(clap::Args, Clone, Debug)]
 pub struct PpmArgs {
-    /// Photon mapping: passes to run (default 16, or what --from records); with --shard,
-    /// the passes of the whole render, of which the shard renders its own.
+    /// Photon mapping: passes to run (default 16, or what --from records; with --time-limit
+    /// alone, as many as fit in it); with --shard, the passes of the whole render, of which the
+    /// shard renders its own.
     #[arg(long)]
     passes: Option<u32>,
-    /// Photon mapping: stop after this many seconds even if passes remain.
+    /// Photon mapping: stop after this many seconds even if passes remain; without --passes
+    /// (and not --from an image that records them), render passes until then.
     #[arg(long, allow_negative_numbers = true)]
     time_limit: Option<f64>,
     /// Photon mapping: photons per pass (default: the scene's).
@@ -259,12 +261,14 @@ pub fn render(args: RenderArgs) -> Result<()> {
         report: &mut report,
     };
     let passes = if scene.params.renderer.progressive() {
-        args.ppm
-            .passes
-            .or(recorded.as_ref().and_then(|r| r.passes))
-            .unwrap_or(16)
+        let asked = args.ppm.passes.or(recorded.as_ref().and_then(|r| r.passes));
+        match (asked, args.ppm.time_limit) {
+            (Some(n), _) => Passes::Count(n),
+            (None, Some(_)) => Passes::UntilTimeLimit,
+            (None, None) => Passes::Count(16),
+        }
     } else {
-        1
+        Passes::Count(1)
     };
     let rendered = render_passes(&mut scene, passes, &args.ppm, &mut output)?;
     let layers: Vec<Layer> = rendered
@@ -350,9 +354,18 @@ struct Rendered {
     stats: FrameStats,
 }
 
-/// Renders `passes` passes (one frame for a renderer that makes one) on a headless session.
-fn render_passes(scene: &mut Scene, passes: u32, args: &PpmArgs, output: &mut Output) -> Result<Rendered> {
-    if passes == 0 {
+/// How many passes `render` runs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Passes {
+    /// This many (or fewer, when a time limit ends the render first).
+    Count(u32),
+    /// As many as the time limit allows.
+    UntilTimeLimit,
+}
+
+/// Renders `passes` (one frame for a renderer that makes one) on a headless session.
+fn render_passes(scene: &mut Scene, passes: Passes, args: &PpmArgs, output: &mut Output) -> Result<Rendered> {
+    if passes == Passes::Count(0) {
         bail!("--passes must be at least 1");
     }
     if let Some(t) = args.time_limit {
@@ -364,25 +377,45 @@ fn render_passes(scene: &mut Scene, passes: u32, args: &PpmArgs, output: &mut Ou
     let (w, h) = (scene.camera.width, scene.camera.height);
     let kind = scene.params.renderer;
     let what = format!("{} {w}x{h}", kind.label().to_lowercase());
-    let bar = output.report.bar(
-        passes as u64,
-        "{msg} [{bar:40}] pass {pos}/{len}, {elapsed} (eta {eta})",
-        what.clone(),
-    );
+    // Progress in passes, or, rendering until the time limit, in tenths of a second of it.
+    let (length, template, max_passes) = match (passes, args.time_limit) {
+        (Passes::Count(n), _) => (
+            n as u64,
+            "{msg} [{bar:40}] pass {pos}/{len}, {elapsed} (eta {eta})",
+            Some(n),
+        ),
+        (Passes::UntilTimeLimit, limit) => {
+            let tenths = (limit.unwrap_or(0.0) * 10.0).ceil().max(1.0) as u64;
+            (
+                tenths,
+                "{msg} [{bar:40}] {elapsed} of the time limit (eta {eta})",
+                None,
+            )
+        }
+    };
+    let bar = output.report.bar(length, template, what.clone());
     output.report.set_bar(Some(bar.clone()));
     let session = SessionOptions {
-        max_passes: Some(passes),
+        max_passes,
         time_limit: args.time_limit.map(Duration::from_secs_f64),
         ..Default::default()
     };
     let mut previous: Option<Frame> = None;
     let mut last: Option<Frame> = None;
     let frame = render_session(scene.clone(), session, |f| {
+        let progress = match passes {
+            Passes::Count(_) => f.pass as u64,
+            Passes::UntilTimeLimit => (f.elapsed_secs * 10.0) as u64,
+        };
         if let Some(s) = f.stats.photon_mapping() {
             let rate = s.photons as f64 / s.photon_secs.max(1e-9) / 1e6;
-            bar.set_message(format!("{what}, {rate:.2} M photons/s"));
+            let pass = match passes {
+                Passes::Count(_) => String::new(),
+                Passes::UntilTimeLimit => format!("pass {}, ", f.pass),
+            };
+            bar.set_message(format!("{what}, {pass}{rate:.2} M photons/s"));
         }
-        bar.set_position(f.pass as u64);
+        bar.set_position(progress);
         let image = frame_image(f);
         output.pass(f.pass, f.elapsed_secs, &image, &frame_layers(f));
         previous = last.replace(f.clone());
