@@ -15,7 +15,8 @@ use crate::settings::RenderParams;
 pub struct ReferenceRecord {
     /// `caustic <version>`.
     pub program: String,
-    /// The scene's file (for people reading the record).
+    /// The scene's file, canonical (the same file named from another folder or by another
+    /// path finds the same reference; the scene's relative asset names resolve against it).
     pub scene: String,
     /// The scene's TOML text.
     pub scene_text: String,
@@ -39,7 +40,10 @@ impl ReferenceRecord {
     pub fn new(scene: &Scene, passes: u32) -> Self {
         Self {
             program: format!("caustic {}", env!("CARGO_PKG_VERSION")),
-            scene: scene.source.display().to_string(),
+            scene: std::fs::canonicalize(&scene.source)
+                .unwrap_or_else(|_| scene.source.clone())
+                .display()
+                .to_string(),
             scene_text: scene.text.to_string(),
             width: scene.camera.width,
             height: scene.camera.height,
@@ -136,5 +140,27 @@ mod tests {
         assert_ne!(other.path_in(&dir), path);
         assert_eq!(other.load(&dir), None, "another seed is another reference");
         let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn a_scene_named_by_another_path_finds_the_same_reference() {
+        let dir = std::env::temp_dir();
+        let relative = Scene::load(Path::new("scenes/leaf.toml")).expect("scene");
+        let roundabout = Scene::load(Path::new("scenes/../scenes/./leaf.toml")).expect("scene");
+        let absolute =
+            Scene::load(&std::fs::canonicalize("scenes/leaf.toml").expect("exists")).expect("scene");
+        let path = ReferenceRecord::new(&relative, 5).path_in(&dir);
+        for scene in [&roundabout, &absolute] {
+            assert_eq!(
+                ReferenceRecord::new(scene, 5).path_in(&dir),
+                path,
+                "{}",
+                scene.source.display()
+            );
+        }
+        assert!(
+            Path::new(&ReferenceRecord::new(&relative, 5).scene).is_absolute(),
+            "the record names the file canonically"
+        );
     }
 }
