@@ -264,7 +264,7 @@ pub fn render(args: RenderArgs) -> Result<()> {
         let asked = args.ppm.passes.or(recorded.as_ref().and_then(|r| r.passes));
         match (asked, args.ppm.time_limit) {
             (Some(n), _) => Passes::Count(n),
-            (None, Some(_)) => Passes::UntilTimeLimit,
+            (None, Some(limit)) => Passes::UntilTimeLimit(limit),
             (None, None) => Passes::Count(16),
         }
     } else {
@@ -359,8 +359,8 @@ struct Rendered {
 enum Passes {
     /// This many (or fewer, when a time limit ends the render first).
     Count(u32),
-    /// As many as the time limit allows.
-    UntilTimeLimit,
+    /// As many as the time limit, this many seconds, allows.
+    UntilTimeLimit(f64),
 }
 
 /// Renders `passes` (one frame for a renderer that makes one) on a headless session.
@@ -378,20 +378,17 @@ fn render_passes(scene: &mut Scene, passes: Passes, args: &PpmArgs, output: &mut
     let kind = scene.params.renderer;
     let what = format!("{} {w}x{h}", kind.label().to_lowercase());
     // Progress in passes, or, rendering until the time limit, in tenths of a second of it.
-    let (length, template, max_passes) = match (passes, args.time_limit) {
-        (Passes::Count(n), _) => (
+    let (length, template, max_passes) = match passes {
+        Passes::Count(n) => (
             n as u64,
             "{msg} [{bar:40}] pass {pos}/{len}, {elapsed} (eta {eta})",
             Some(n),
         ),
-        (Passes::UntilTimeLimit, limit) => {
-            let tenths = (limit.unwrap_or(0.0) * 10.0).ceil().max(1.0) as u64;
-            (
-                tenths,
-                "{msg} [{bar:40}] {elapsed} of the time limit (eta {eta})",
-                None,
-            )
-        }
+        Passes::UntilTimeLimit(limit) => (
+            (limit * 10.0).ceil().max(1.0) as u64,
+            "{msg} [{bar:40}] {elapsed} of the time limit (eta {eta})",
+            None,
+        ),
     };
     let bar = output.report.bar(length, template, what.clone());
     output.report.set_bar(Some(bar.clone()));
@@ -403,16 +400,13 @@ fn render_passes(scene: &mut Scene, passes: Passes, args: &PpmArgs, output: &mut
     let mut previous: Option<Frame> = None;
     let mut last: Option<Frame> = None;
     let frame = render_session(scene.clone(), session, |f| {
-        let progress = match passes {
-            Passes::Count(_) => f.pass as u64,
-            Passes::UntilTimeLimit => (f.elapsed_secs * 10.0) as u64,
+        // The bar counts passes, or tenths of a second and then the message names the pass.
+        let (progress, pass) = match passes {
+            Passes::Count(_) => (f.pass as u64, String::new()),
+            Passes::UntilTimeLimit(_) => ((f.elapsed_secs * 10.0) as u64, format!("pass {}, ", f.pass)),
         };
         if let Some(s) = f.stats.photon_mapping() {
             let rate = s.photons as f64 / s.photon_secs.max(1e-9) / 1e6;
-            let pass = match passes {
-                Passes::Count(_) => String::new(),
-                Passes::UntilTimeLimit => format!("pass {}, ", f.pass),
-            };
             bar.set_message(format!("{what}, {pass}{rate:.2} M photons/s"));
         }
         bar.set_position(progress);
