@@ -24,13 +24,25 @@ fn json(out: &std::process::Output) -> serde_json::Value {
     serde_json::from_slice(&out.stdout).expect("stdout is one JSON document")
 }
 
-/// A small photon-mapped render of the Cornell box with the flags `extra`.
-fn small_render(out: &Path, extra: &[&str]) -> std::process::Output {
+/// A photon-mapped render of the Cornell box to `out` with the flags `extra`.
+fn cornell_render(out: &Path, extra: &[&str]) -> std::process::Output {
     let mut args = vec![
         "render",
         "scenes/cornell.toml",
         "--renderer",
         "ppm",
+        "--seed",
+        "5",
+        "--out",
+        out.to_str().expect("utf-8 path"),
+    ];
+    args.extend_from_slice(extra);
+    caustic(&args)
+}
+
+/// A small photon-mapped render of the Cornell box with the flags `extra`.
+fn small_render(out: &Path, extra: &[&str]) -> std::process::Output {
+    let size = [
         "--width",
         "48",
         "--height",
@@ -39,13 +51,8 @@ fn small_render(out: &Path, extra: &[&str]) -> std::process::Output {
         "3",
         "--photons",
         "8000",
-        "--seed",
-        "5",
-        "--out",
-        out.to_str().expect("utf-8 path"),
     ];
-    args.extend_from_slice(extra);
-    caustic(&args)
+    cornell_render(out, &[&size[..], extra].concat())
 }
 
 #[test]
@@ -214,11 +221,7 @@ fn a_time_limit_alone_renders_passes_until_it() {
     let dir = tempfile::tempdir().expect("temp dir");
     let out = dir.path().join("timed.png");
     let render = |extra: &[&str]| {
-        let mut args = vec![
-            "render",
-            "scenes/cornell.toml",
-            "--renderer",
-            "ppm",
+        let size = [
             "--width",
             "16",
             "--height",
@@ -227,11 +230,8 @@ fn a_time_limit_alone_renders_passes_until_it() {
             "1000",
             "--json",
             "--force",
-            "--out",
-            out.to_str().expect("utf-8 path"),
         ];
-        args.extend_from_slice(extra);
-        let doc = json(&caustic(&args));
+        let doc = json(&cornell_render(&out, &[&size[..], extra].concat()));
         doc["photon_mapping"]["passes"]
             .as_u64()
             .unwrap_or_else(|| panic!("no pass count in {doc}"))

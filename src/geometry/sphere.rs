@@ -94,13 +94,8 @@ mod tests {
         assert_eq!(s.intersect(&away, 0.0, f64::INFINITY), None);
         // Random rays from inside and outside against the textbook quadratic, far from
         // tangency: the early rejection must not lose a hit in front of the ray.
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = move || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
+        let mut rng = crate::render::rng::stream_rng(3, 0, 0);
+        let mut next = || rand::Rng::random::<f64>(&mut rng) * 2.0 - 1.0;
         let (mut hits, mut misses) = (0, 0);
         for _ in 0..20_000 {
             let origin = s.center + DVec3::new(next(), next(), next()) * 4.0;
