@@ -215,6 +215,24 @@ fn bad_input_gives_clear_errors() {
             vec!["export-obj", "scenes/smallppm.toml", "--out", out_s],
             "has no Bézier patches to export",
         ),
+        // A seed past TOML's integers could not be recorded in the image's scene (this
+        // panicked while writing it).
+        (
+            vec![
+                "render",
+                "scenes/leaf.toml",
+                "--out",
+                out_s,
+                "--seed",
+                "18446744073709551615",
+            ],
+            "--seed must be between 0 and 9223372036854775807",
+        ),
+        // Depth 12 asked for 4^12 leaves a patch (hundreds of GB) and never came back.
+        (
+            vec!["bench", "intersect", "--size", "4", "--max-depth", "9"],
+            "--max-depth must be at most 8",
+        ),
     ];
     for (args, expected) in cases {
         let out = caustic(&args);

@@ -109,6 +109,55 @@ fn from_renders_the_same_pixels_and_the_exr_has_its_layers() {
     assert!(text(&refused).contains("plain.png") && text(&refused).contains("caustic:scene_text"));
 }
 
+/// The largest seed a scene file can hold renders, and the image records it so that `--from`
+/// reads it back (one past it is refused: `tests/cli.rs`).
+#[test]
+fn the_largest_seed_renders_and_is_recorded() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let (a, b) = (dir.path().join("a.exr"), dir.path().join("b.exr"));
+    let largest = i64::MAX.to_string();
+    let size = [
+        "--width",
+        "16",
+        "--height",
+        "12",
+        "--passes",
+        "1",
+        "--photons",
+        "2000",
+    ];
+    let out = caustic(
+        &[
+            &[
+                "render",
+                "scenes/cornell.toml",
+                "--renderer",
+                "ppm",
+                "--seed",
+                &largest,
+            ][..],
+            &size,
+            &["--out", a.to_str().expect("utf-8 path")],
+        ]
+        .concat(),
+    );
+    assert!(out.status.success(), "{}", text(&out));
+    let again = caustic(&[
+        "render",
+        "--from",
+        a.to_str().expect("utf-8 path"),
+        "--out",
+        b.to_str().expect("utf-8 path"),
+        "--json",
+    ]);
+    assert_eq!(json(&again)["seed"], i64::MAX);
+    assert_eq!(
+        pixels(&a),
+        pixels(&b),
+        "--from renders the recorded seed's pixels"
+    );
+}
+
 #[test]
 fn reference_errors_itself_an_offset_and_a_size_mismatch() {
     let dir = tempfile::tempdir().expect("temp dir");

@@ -44,7 +44,7 @@ pub struct RenderArgs {
     /// --width is given too).
     #[arg(long)]
     height: Option<u32>,
-    /// Override the scene's seed.
+    /// Override the scene's seed (0 to 9223372036854775807, what a scene file can hold).
     #[arg(long)]
     seed: Option<u64>,
     /// Override the scene's renderer.
@@ -315,7 +315,7 @@ fn scene_to_render(args: &RenderArgs, report: &mut Report) -> Result<(Scene, Opt
     }
     scene.camera.resize(args.width, args.height);
     if let Some(s) = args.seed {
-        scene.params.seed = s;
+        scene.params.seed = flag_check("--seed", limits::seed(s))?;
     }
     if let Some(kind) = args.renderer {
         scene.params.renderer = kind;

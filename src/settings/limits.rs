@@ -18,6 +18,9 @@ pub const PHOTONS_PER_PIXEL: RangeInclusive<f64> = 0.0..=1000.0;
 pub const RADIUS_SCALE: RangeInclusive<f64> = 1.0..=100.0;
 /// Image width and height in pixels.
 pub const IMAGE_SIDE: RangeInclusive<u32> = 1..=16384;
+/// Seeds: what a scene file can hold, whose integers are TOML's (signed 64-bit), so that every
+/// render's scene can be saved and recorded in its image.
+pub const SEED: RangeInclusive<u64> = 0..=i64::MAX as u64;
 
 /// A setting's value outside its range: the end of the message.
 pub type Invalid = String;
@@ -54,6 +57,11 @@ pub fn samples(n: u32) -> Result<u32, Invalid> {
 /// Image width or height.
 pub fn image_side(n: u32) -> Result<u32, Invalid> {
     within(n, IMAGE_SIDE, " pixels")
+}
+
+/// The seed of every random number.
+pub fn seed(s: u64) -> Result<u64, Invalid> {
+    within(s, SEED, " (a scene file's integers are signed 64-bit)")
 }
 
 /// A PPM initial search radius.
@@ -123,6 +131,12 @@ mod tests {
         assert_eq!(
             image_side(0).expect_err("0 is out"),
             "must be between 1 and 16384 pixels, got 0"
+        );
+        assert_eq!(seed(i64::MAX as u64), Ok(i64::MAX as u64));
+        assert_eq!(
+            seed(u64::MAX).expect_err("past TOML's integers"),
+            "must be between 0 and 9223372036854775807 (a scene file's integers are signed \
+             64-bit), got 18446744073709551615"
         );
         assert!(photons_per_pass(0).is_err() && photons_per_pass(1_000_000_001).is_err());
         assert!(radius(f64::INFINITY).is_err() && radius(-1.0).is_err() && radius(1e-9).is_ok());

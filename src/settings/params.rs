@@ -162,6 +162,7 @@ impl RenderParams {
             check("indirect_radius_scale", limits::radius_scale(k).map(drop))?;
         }
         check("max_depth", limits::max_depth(self.max_depth).map(drop))?;
+        check("seed", limits::seed(self.seed).map(drop))?;
         check("dof_samples", limits::samples(self.dof_samples).map(drop))?;
         check("light_samples", limits::samples(self.light_samples).map(drop))?;
         let ambient = self.ambient;
