@@ -530,6 +530,26 @@ fn stratified_photons_settle_a_caustic_sooner_and_keep_the_image() {
     assert_eq!(one, two, "stratified photons with one and two threads");
 }
 
+/// The statistics' mean radius is the radius in use even while no point has gathered a photon
+/// into the estimate it measures: under light sampling that estimate holds caustics only, a
+/// plane under a point light has none, and the photons bouncing off it leave the scene (the
+/// mean was 0 then).
+#[test]
+fn the_mean_radius_is_the_radius_in_use_before_any_photon_arrives() {
+    let text = PLANE.replace("direct_light = false", "direct_light = true");
+    let mut scene = Scene::from_str(&text, Path::new("plane.toml"), None).expect("scene");
+    scene.params.initial_radius = Some(0.05);
+    let mut ppm = Ppm::new(&scene, PpmOptions::default());
+    ppm.run_pass(&scene, &mut |_| Control::Continue);
+    let stats = ppm.stats();
+    assert_eq!(stats.useful_paths, 0, "no photon reaches a point");
+    assert!(
+        (stats.mean_radius - 0.05).abs() < 1e-6,
+        "mean radius {}",
+        stats.mean_radius
+    );
+}
+
 #[test]
 fn automatic_radius_ignores_a_floor_reaching_the_horizon() {
     // The showcase's table is an infinite plane: a bounding-box rule would give a radius of

@@ -194,13 +194,21 @@ impl Ppm {
         self.stats.deposits += gathered.counts.deposits;
         self.stats.useful_paths += gathered.counts.useful;
         self.stats.visible_points = self.points.len();
-        let (sum, count) = self
-            .slots
-            .iter()
-            .filter(|s| s.primary.n > 0.0)
-            .fold((0.0, 0usize), |(sum, count), s| {
-                (sum + s.primary.radius2().sqrt(), count + 1)
-            });
-        self.stats.mean_radius = sum / count.max(1) as f64;
+        // Over the slots that have gathered photons; while none has (this estimate holds
+        // caustics only when direct light is sampled, and a scene may have none), over every
+        // slot with a radius: the radius in use, not 0.
+        let mean = |keep: fn(&Slot) -> bool| {
+            let (sum, count) = self
+                .slots
+                .iter()
+                .filter(|s| keep(s))
+                .fold((0.0, 0usize), |(sum, count), s| {
+                    (sum + s.primary.radius2().sqrt(), count + 1)
+                });
+            (count > 0).then(|| sum / count as f64)
+        };
+        self.stats.mean_radius = mean(|s| s.primary.n > 0.0)
+            .or_else(|| mean(|s| s.primary.radius2() > 0.0))
+            .unwrap_or(0.0);
     }
 }

@@ -16,7 +16,8 @@ pub struct PpmStats {
     pub useful_paths: u64,
     /// Visible points in the last pass.
     pub visible_points: usize,
-    /// Mean search radius over slots that have gathered photons (scene units).
+    /// Mean search radius over slots that have gathered photons (scene units); before any
+    /// has, over every slot with a radius.
     pub mean_radius: f64,
     /// The indirect estimate's initial radius over the primary's (1: one estimate for all
     /// photons; chosen after the first pass when automatic).
