@@ -13,6 +13,11 @@ pub const TEAPOT_BPT: &str = include_str!("../assets/teapot.bpt");
 /// as `scenes/smallppm.toml`.
 pub const SMALLPPM_SCENE: &str = include_str!("../scenes/smallppm.toml");
 
+/// One inline Bézier patch of glass over a floor (the README's first picture): the default
+/// scene of `caustic bench edit`, so it runs from any directory. The same text as
+/// `scenes/inline_patch.toml`, which names no other file.
+pub const INLINE_PATCH_SCENE: &str = include_str!("../scenes/inline_patch.toml");
+
 /// The Utah teapot's 32 patches.
 pub fn teapot() -> Vec<BezierPatch> {
     parse_bpt(TEAPOT_BPT, Path::new("assets/teapot.bpt")).expect("the built-in teapot parses")

@@ -278,6 +278,40 @@ fn photon_benches_run_from_any_directory_on_the_built_in_scene() {
     assert!(t.contains("<built-in smallppm>, 1024x768"), "{t}");
 }
 
+/// `bench edit` without a scene measures its built-in one, from any directory (it read
+/// `scenes/inline_patch.toml` relative to the working folder, so only ran in the repository).
+#[test]
+fn edit_bench_runs_from_any_directory_on_its_built_in_scene() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let refs = dir.path().join("references");
+    let out = Command::new(env!("CARGO_BIN_EXE_caustic"))
+        .args([
+            "bench",
+            "edit",
+            "--runs",
+            "1",
+            "--before-passes",
+            "1",
+            "--reference-passes",
+            "2",
+            "--target",
+            "0.5",
+            "--limit",
+            "20",
+            "--threads",
+            "2",
+            "--reference-dir",
+            refs.to_str().expect("utf-8"),
+        ])
+        .current_dir(dir.path())
+        .output()
+        .expect("run caustic");
+    let t = text(&out);
+    assert!(out.status.success(), "{t}");
+    assert!(t.contains("Edit of <built-in inline_patch>"), "{t}");
+    assert!(t.contains("edit to relative MSE 5e-1: warm"), "{t}");
+}
+
 /// `bench convergence` on a tiny configuration: a table, a CSV with the expected columns, a
 /// readable PNG plot, and a cached reference reused on the second run.
 #[test]

@@ -3,7 +3,7 @@
 //! the edit to relative MSE 1e-2 against a (cached) reference of the edited scene is measured
 //! with the new epoch started warm and cold, runs interleaved, medians printed.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use anyhow::{bail, Result};
@@ -20,7 +20,7 @@ use caustic::scene::{RendererKind, Scene};
 /// `caustic bench edit`.
 #[derive(Parser)]
 pub struct EditArgs {
-    /// Scene file with Bézier patches (default: scenes/inline_patch.toml).
+    /// Scene file with Bézier patches (default: scenes/inline_patch.toml, built in).
     pub scene: Option<PathBuf>,
     /// The patch whose control point moves.
     #[arg(long, default_value_t = 0)]
@@ -63,18 +63,21 @@ struct Edit {
 
 /// Runs the measurement.
 pub fn bench_edit(args: EditArgs, out: &mut BenchOutput) -> Result<()> {
-    let path = args
-        .scene
-        .clone()
-        .unwrap_or_else(|| PathBuf::from("scenes/inline_patch.toml"));
-    let mut scene = Scene::load(&path)?;
-    scene.params.renderer = RendererKind::Ppm;
     if args.runs == 0 || args.before_passes == 0 {
         bail!("--runs and --before-passes must be at least 1");
     }
     if !(args.target > 0.0 && args.limit > 0.0 && args.distance.is_finite()) {
         bail!("--target and --limit must be positive, --distance finite");
     }
+    let mut scene = match &args.scene {
+        Some(path) => Scene::load(path)?,
+        None => Scene::from_str(
+            caustic::assets::INLINE_PATCH_SCENE,
+            Path::new("<built-in inline_patch>"),
+            None,
+        )?,
+    };
+    scene.params.renderer = RendererKind::Ppm;
     let edit = edit(&scene, &args)?;
     let mut edited = scene.clone();
     edited
@@ -92,7 +95,7 @@ pub fn bench_edit(args: EditArgs, out: &mut BenchOutput) -> Result<()> {
     )?;
     out.say(format!(
         "Edit of {}: control point {} of patch {} moved by {} % of the patch's size; {} passes before the edit, {}x{}",
-        path.display(),
+        scene.source.display(),
         edit.index,
         edit.patch,
         100.0 * args.distance,
