@@ -123,7 +123,7 @@ fn the_slurm_script_is_a_job_array_and_a_dependent_merge() {
 
 #[test]
 fn farm_flags_are_checked() {
-    let cases: [(&[&str], &str); 4] = [
+    let cases: [(&[&str], &str); 6] = [
         (
             &[
                 "slurm",
@@ -175,6 +175,41 @@ fn farm_flags_are_checked() {
                 "/data/o",
             ],
             "--image is required",
+        ),
+        // Render flags are checked before the job goes to the queue, not by each task.
+        (
+            &[
+                "slurm",
+                "scenes/cornell.toml",
+                "--shards",
+                "2",
+                "--passes",
+                "4",
+                "--out",
+                "x",
+                "--",
+                "--widht",
+                "1920",
+            ],
+            "unexpected argument '--widht'",
+        ),
+        (
+            &[
+                "kubernetes",
+                "/data/a.toml",
+                "--shards",
+                "2",
+                "--passes",
+                "4",
+                "--out",
+                "/data/o",
+                "--image",
+                "caustic:1",
+                "--",
+                "--passes",
+                "8",
+            ],
+            "'--passes <PASSES>' cannot be used multiple times",
         ),
     ];
     for (args, message) in cases {

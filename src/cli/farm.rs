@@ -76,6 +76,14 @@ struct Job {
     render_args: Vec<String>,
 }
 
+/// A shard's `caustic render` command line, parsed as that command parses it
+/// ([`Job::check_render_args`]).
+#[derive(clap::Parser)]
+struct ShardLine {
+    #[command(flatten)]
+    render: super::render::RenderArgs,
+}
+
 /// Prints the script or manifest.
 pub fn farm(args: FarmArgs) -> Result<()> {
     let text = match args.system {
@@ -110,7 +118,46 @@ impl Job {
         if self.threads == 0 || self.threads > 4096 {
             bail!("--threads must be between 1 and 4096, got {}", self.threads);
         }
-        Ok(())
+        self.check_render_args()
+    }
+
+    /// Parses the first shard's command line as `caustic render` will, so that a misspelt or
+    /// repeated flag after `--` is reported here rather than by every task of the job.
+    fn check_render_args(&self) -> Result<()> {
+        let (shard, passes, threads) = (
+            format!("0/{}", self.shards),
+            self.passes.to_string(),
+            self.threads.to_string(),
+        );
+        let fixed = [
+            "caustic render".as_ref(),
+            self.scene.as_os_str(),
+            "--shard".as_ref(),
+            shard.as_ref(),
+            "--passes".as_ref(),
+            passes.as_ref(),
+            "--threads".as_ref(),
+            threads.as_ref(),
+            "--out".as_ref(),
+            "part_0.exr".as_ref(),
+            "--force".as_ref(),
+        ];
+        let line = fixed
+            .into_iter()
+            .chain(self.render_args.iter().map(|a| a.as_ref()));
+        match <ShardLine as clap::Parser>::try_parse_from(line) {
+            Ok(_) => Ok(()),
+            Err(e) => {
+                // clap's message without its "error: " and its pointer to `farm --help`.
+                let message = e.to_string();
+                let message = message.split("\n\nFor more information").next().unwrap_or("");
+                bail!(
+                    "the flags after `--` do not make a shard's `caustic render` command line: {} \
+                     (see `caustic render --help`)",
+                    message.trim_start_matches("error: ").trim_end()
+                )
+            }
+        }
     }
 
     /// Paths made absolute and the program defaulted, as Slurm tasks need them.
