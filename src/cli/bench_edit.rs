@@ -3,7 +3,7 @@
 //! the edit to relative MSE 1e-2 against a (cached) reference of the edited scene is measured
 //! with the new epoch started warm and cold, runs interleaved, medians printed.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Duration;
 
 use anyhow::{bail, Result};
@@ -69,14 +69,11 @@ pub fn bench_edit(args: EditArgs, out: &mut BenchOutput) -> Result<()> {
     if !(args.target > 0.0 && args.limit > 0.0 && args.distance.is_finite()) {
         bail!("--target and --limit must be positive, --distance finite");
     }
-    let mut scene = match &args.scene {
-        Some(path) => Scene::load(path)?,
-        None => Scene::from_str(
-            caustic::assets::INLINE_PATCH_SCENE,
-            Path::new("<built-in inline_patch>"),
-            None,
-        )?,
-    };
+    let mut scene = super::scene_or_built_in(
+        args.scene.as_deref(),
+        caustic::assets::INLINE_PATCH_SCENE,
+        "inline_patch",
+    )?;
     scene.params.renderer = RendererKind::Ppm;
     let edit = edit(&scene, &args)?;
     let mut edited = scene.clone();

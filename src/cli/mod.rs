@@ -112,13 +112,15 @@ fn progress_bar(len: u64, template: &str, message: String) -> Result<indicatif::
 
 /// The scene a photon-mapping bench measures: the file, or smallppm's built-in scene.
 fn photon_scene(path: Option<&Path>) -> Result<Scene> {
+    scene_or_built_in(path, caustic::assets::SMALLPPM_SCENE, "smallppm")
+}
+
+/// The scene file at `path`, or when none is given the scene text `built_in` (a bench's
+/// default, built into the binary so it runs from any directory), named `<built-in name>`.
+fn scene_or_built_in(path: Option<&Path>, built_in: &str, name: &str) -> Result<Scene> {
     Ok(match path {
         Some(p) => Scene::load(p)?,
-        None => Scene::from_str(
-            caustic::assets::SMALLPPM_SCENE,
-            Path::new("<built-in smallppm>"),
-            None,
-        )?,
+        None => Scene::from_str(built_in, Path::new(&format!("<built-in {name}>")), None)?,
     })
 }
 
