@@ -36,6 +36,10 @@ const BINS: usize = 16;
 const MAX_LEAF: usize = 4;
 /// Cost of a node traversal relative to one primitive test, for the SAH.
 const TRAVERSAL_COST: f64 = 0.5;
+/// Primitives a tree may hold for [`Bvh::traverse`] to test them all rather than walk it: in
+/// smallppm's room (nine spheres, six of them walls whose boxes hold the whole room) nearly
+/// every ray reaches nearly every leaf, and the box tests only add to the sphere tests.
+pub const FLAT_PRIMITIVES: usize = 16;
 /// Stack entries a traversal of a tree this deep or less keeps in arrays on the thread's stack.
 const SHORT_STACK: usize = 32;
 /// The same for deeper trees (deeper still, the stack is on the heap).
@@ -162,11 +166,20 @@ impl Bvh {
         node
     }
 
-    /// Visits, front to back, every primitive whose leaf the ray reaches before `t_max`.
+    /// Visits, front to back, every primitive whose leaf the ray reaches before `t_max`
+    /// (in a tree of at most [`FLAT_PRIMITIVES`], every primitive, in the tree's order).
     /// `visit(primitive, t_max)` returns the distance of a nearer hit, which then bounds the
     /// rest of the traversal. Returns the final `t_max`.
     #[inline]
-    pub fn traverse(&self, ray: &Ray, t_max: f64, visit: impl FnMut(u32, f64) -> Option<f64>) -> f64 {
+    pub fn traverse(&self, ray: &Ray, mut t_max: f64, mut visit: impl FnMut(u32, f64) -> Option<f64>) -> f64 {
+        if self.order.len() <= FLAT_PRIMITIVES {
+            for &prim in &self.order {
+                if let Some(t) = visit(prim, t_max) {
+                    t_max = t_max.min(t);
+                }
+            }
+            return t_max;
+        }
         let inv_dir = safe_inverse(ray.dir);
         match self.nodes.first() {
             Some(root) if root.bounds.hit_interval(ray.origin, inv_dir, t_max).is_some() => {}
@@ -365,17 +378,42 @@ mod tests {
             let c = DVec3::new(next(), next(), next()) * 10.0;
             boxes.push(Aabb::new(c, c + 0.2));
         }
-        let bvh = Bvh::build(&boxes);
-        assert!(bvh.depth() < 64);
-        for _ in 0..500 {
-            let o = DVec3::new(next(), next(), next()) * 14.0 - 2.0;
-            let d = DVec3::new(next() - 0.5, next() - 0.5, next() - 0.5);
-            let ray = Ray::new(o, d);
-            let inv = safe_inverse(ray.dir);
-            let entry = |b: &Aabb| b.hit_interval(ray.origin, inv, f64::INFINITY).map(|(t0, _)| t0);
-            let brute = boxes.iter().filter_map(entry).fold(f64::INFINITY, f64::min);
-            let found = bvh.traverse(&ray, f64::INFINITY, |p, _| entry(&boxes[p as usize]));
-            assert_eq!(brute, found);
+        // A tree walked, small trees tested in full (the first FLAT_PRIMITIVES boxes, larger
+        // so that rays meet several) and the smallest tree that is walked.
+        for n in [2000, FLAT_PRIMITIVES, FLAT_PRIMITIVES + 1] {
+            let boxes: Vec<Aabb> = if n == 2000 {
+                boxes.clone()
+            } else {
+                boxes[..n]
+                    .iter()
+                    .map(|b| Aabb::new(b.min - 2.0, b.max + 2.0))
+                    .collect()
+            };
+            let bvh = Bvh::build(&boxes);
+            assert!(bvh.depth() < 64);
+            let mut hits = 0;
+            for _ in 0..500 {
+                let o = DVec3::new(next(), next(), next()) * 14.0 - 2.0;
+                let d = DVec3::new(next() - 0.5, next() - 0.5, next() - 0.5);
+                let ray = Ray::new(o, d);
+                let inv = safe_inverse(ray.dir);
+                let entry = |b: &Aabb| b.hit_interval(ray.origin, inv, f64::INFINITY).map(|(t0, _)| t0);
+                let brute = boxes.iter().filter_map(entry).fold(f64::INFINITY, f64::min);
+                let found = bvh.traverse(&ray, f64::INFINITY, |p, _| entry(&boxes[p as usize]));
+                assert_eq!(brute, found, "{n} boxes");
+                let any = bvh.any(&ray, f64::INFINITY, |p| entry(&boxes[p as usize]).is_some());
+                assert_eq!(any, brute.is_finite(), "{n} boxes");
+                hits += brute.is_finite() as usize;
+                if n <= FLAT_PRIMITIVES {
+                    let mut visits = 0;
+                    bvh.traverse(&ray, f64::INFINITY, |_, _| {
+                        visits += 1;
+                        None
+                    });
+                    assert_eq!(visits, n, "a small tree's primitives are all tested");
+                }
+            }
+            assert!(hits > 100, "{n} boxes: {hits} of 500 rays hit");
         }
     }
 
