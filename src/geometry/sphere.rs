@@ -94,7 +94,7 @@ mod tests {
         assert_eq!(s.intersect(&away, 0.0, f64::INFINITY), None);
         // Random rays from inside and outside against the textbook quadratic, far from
         // tangency: the early rejection must not lose a hit in front of the ray.
-        let mut rng = crate::render::rng::stream_rng(3, 0, 0);
+        let mut rng = <rand_pcg::Pcg64Mcg as rand::SeedableRng>::seed_from_u64(3);
         let mut next = || rand::Rng::random::<f64>(&mut rng) * 2.0 - 1.0;
         let (mut hits, mut misses) = (0, 0);
         for _ in 0..20_000 {
