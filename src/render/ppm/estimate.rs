@@ -133,6 +133,11 @@ pub enum Restart {
 }
 
 impl Slot {
+    /// Whether its primary estimate has a search radius (its radii are set).
+    pub(super) fn has_radius(&self) -> bool {
+        self.primary.radius2() > 0.0
+    }
+
     /// An empty slot of `pixel` (its radii are set before the first pass).
     pub(super) fn new(pixel: u32) -> Self {
         Self {
@@ -197,18 +202,20 @@ impl Ppm {
         // Over the slots that have gathered photons; while none has (this estimate holds
         // caustics only when direct light is sampled, and a scene may have none), over every
         // slot with a radius: the radius in use, not 0.
-        let mean = |keep: fn(&Slot) -> bool| {
-            let (sum, count) = self
-                .slots
-                .iter()
-                .filter(|s| keep(s))
-                .fold((0.0, 0usize), |(sum, count), s| {
-                    (sum + s.primary.radius2().sqrt(), count + 1)
-                });
-            (count > 0).then(|| sum / count as f64)
-        };
-        self.stats.mean_radius = mean(|s| s.primary.n > 0.0)
-            .or_else(|| mean(|s| s.primary.radius2() > 0.0))
+        self.stats.mean_radius = mean_primary_radius(&self.slots, |s| s.primary.n > 0.0)
+            .or_else(|| mean_primary_radius(&self.slots, Slot::has_radius))
             .unwrap_or(0.0);
     }
+}
+
+/// The mean primary search radius of the slots `keep` picks, for the statistics; `None` when
+/// it picks none.
+pub(super) fn mean_primary_radius(slots: &[Slot], keep: impl Fn(&Slot) -> bool) -> Option<f64> {
+    let (sum, count) = slots
+        .iter()
+        .filter(|s| keep(s))
+        .fold((0.0, 0usize), |(sum, count), s| {
+            (sum + s.primary.radius2().sqrt(), count + 1)
+        });
+    (count > 0).then(|| sum / count as f64)
 }

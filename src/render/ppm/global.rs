@@ -18,6 +18,7 @@ use std::time::Instant;
 
 use glam::DVec3;
 
+use super::estimate::{mean_primary_radius, Slot};
 use super::gathered::Gathered;
 use super::radius::IndirectScale;
 use super::{Control, Estimate, PassOutcome, Ppm, Restart};
@@ -169,11 +170,7 @@ impl Ppm {
         s.deposits += counts.deposits;
         s.useful_paths += counts.useful;
         s.visible_points = self.points.len();
-        let radii = self.slots.iter().filter(|s| s.primary.radius2() > 0.0);
-        let (sum, n) = radii.fold((0.0, 0usize), |(sum, n), s| {
-            (sum + s.primary.radius2().sqrt(), n + 1)
-        });
-        s.mean_radius = sum / n.max(1) as f64;
+        s.mean_radius = mean_primary_radius(&self.slots, Slot::has_radius).unwrap_or(0.0);
     }
 
     /// After the pilot pass: each slot's `r_1` (the initial radius, narrowed where the pilot
