@@ -128,13 +128,12 @@ pub fn bench(what: BenchCommand, json: bool) -> Result<()> {
 /// 4^8 leaves each (2.1 million, 1.6 GB and 6 s measured).
 const MAX_LEAF_DEPTH: u32 = 8;
 
-fn bench_intersect(
+/// `bench intersect`'s flags, checked before anything is prepared.
+fn check_intersect_args(
     size: usize,
     repeat: usize,
-    method: MethodChoice,
     per_ray_depth: u32,
-    params: SubdivisionParams,
-    out: &mut BenchOutput,
+    params: &SubdivisionParams,
 ) -> Result<()> {
     if size == 0 || size > 8192 {
         bail!("--size must be between 1 and 8192, got {size}");
@@ -159,6 +158,18 @@ fn bench_intersect(
             params.max_depth
         );
     }
+    Ok(())
+}
+
+fn bench_intersect(
+    size: usize,
+    repeat: usize,
+    method: MethodChoice,
+    per_ray_depth: u32,
+    params: SubdivisionParams,
+    out: &mut BenchOutput,
+) -> Result<()> {
+    check_intersect_args(size, repeat, per_ray_depth, &params)?;
     let rays = teapot_view(size, size);
     out.say(format!(
         "Utah teapot (32 patches), {size}x{size} primary rays, 1 thread, {repeat} repeats"
