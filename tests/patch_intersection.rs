@@ -73,6 +73,15 @@ fn round_trip_hits_the_aimed_point() {
                 "patch {k} ({u},{v}) dir {dir} n {n}: hit {on_surface:e} off the surface at {}",
                 hit.uv()
             );
+            // The normal is the patch's at the hit, however the intersector came by it.
+            let expected = patch
+                .normal(hit.uv().x, hit.uv().y)
+                .expect("teapot normals exist");
+            assert!(
+                (hit.normal - expected).length() < 1e-9,
+                "patch {k} ({u},{v}): normal {} against the patch's {expected}",
+                hit.normal
+            );
             // The patch may fold in front of the target (never by more than rounding otherwise).
             if hit.t < distance - 1e-9 * diag {
                 continue;
@@ -210,6 +219,19 @@ fn prepared_agrees_with_brute_force_reference() {
             (Some(p), Some(r)) => {
                 hits += 1;
                 assert_finite(p);
+                // Both normals are the patch's own at the hit, whichever intersector found it.
+                for hit in [p, r] {
+                    let ShapeRef::Patch(k) = hit.shape else {
+                        panic!("only patches here: {hit:?}")
+                    };
+                    // The teapot's patches span their whole (u,v) domain.
+                    let uv = hit.uv();
+                    let expected = patches[k as usize].normal(uv.x, uv.y).expect("teapot normals");
+                    assert!(
+                        (hit.normal - expected).length() < 1e-9,
+                        "{hit:?} against {expected}"
+                    );
+                }
                 if (p.t - r.t).abs() > 1e-6 * diag {
                     nearest += 1;
                 }

@@ -141,6 +141,28 @@ impl BezierPatch {
         [position, dp_du, dp_dv]
     }
 
+    /// The third coordinate of `P(u,v)`, `∂P/∂u` and `∂P/∂v`: what a root finder in ray space
+    /// adds at the root to [`BezierPatch::eval_xy_with_derivs`]'s two (the distance along the
+    /// ray and the normal's missing components). The same arithmetic as
+    /// [`BezierPatch::eval_with_derivs`] on that coordinate, so the same bits.
+    #[inline]
+    pub fn eval_z_with_derivs(&self, u: f64, v: f64) -> [f64; 3] {
+        let bu = bernstein(u);
+        let bv = bernstein(v);
+        let du = bernstein_deriv(u);
+        let dv = bernstein_deriv(v);
+        let (mut position, mut dp_du, mut dp_dv) = (0.0, 0.0, 0.0);
+        for i in 0..4 {
+            let r = |j: usize| self.points[4 * i + j].z;
+            let row = bv[0] * r(0) + bv[1] * r(1) + bv[2] * r(2) + bv[3] * r(3);
+            let row_dv = dv[0] * r(0) + dv[1] * r(1) + dv[2] * r(2) + dv[3] * r(3);
+            position += bu[i] * row;
+            dp_du += du[i] * row;
+            dp_dv += bu[i] * row_dv;
+        }
+        [position, dp_du, dp_dv]
+    }
+
     /// The unit normal `∂P/∂u × ∂P/∂v` at `(u,v)`.
     ///
     /// Where that cross product vanishes (a collapsed edge such as the poles of the Utah
@@ -345,6 +367,26 @@ mod tests {
             assert!((sp.dp_du - fu).length() < 1e-7, "{:?} vs {:?}", sp.dp_du, fu);
             assert!((sp.dp_dv - fv).length() < 1e-7);
             assert!((sp.position - p.eval(u, v)).length() < 1e-14);
+        }
+    }
+
+    #[test]
+    fn partial_evaluations_give_the_full_evaluations_bits() {
+        let p = wavy();
+        for &(u, v) in &[
+            (0.3, 0.7),
+            (0.0, 0.5),
+            (0.91, 0.12),
+            (-0.2, 1.3),
+            (1.0 / 3.0, 0.1),
+        ] {
+            let full = p.eval_with_derivs(u, v);
+            let [xy, xy_du, xy_dv] = p.eval_xy_with_derivs(u, v);
+            let [z, z_du, z_dv] = p.eval_z_with_derivs(u, v);
+            assert_eq!(xy.extend(z), full.position);
+            assert_eq!(xy_du.extend(z_du), full.dp_du);
+            assert_eq!(xy_dv.extend(z_dv), full.dp_dv);
+            assert_eq!(z, p.eval(u, v).z);
         }
     }
 

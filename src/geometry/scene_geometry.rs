@@ -20,7 +20,7 @@ use super::bezier::BezierPatch;
 use super::bvh::Bvh;
 use super::mesh::TriangleMesh;
 use super::patch::{
-    intersect_leaf, intersect_per_ray, leaf_occludes, subdivide, PatchLeaf, PatchPoint, RayFrame,
+    intersect_leaf, intersect_per_ray, leaf_occludes, subdivide, PatchHit, PatchLeaf, PatchPoint, RayFrame,
     SubdivisionParams, Window,
 };
 use super::quad::{Plane, Quad};
@@ -282,6 +282,8 @@ struct Candidate {
     primitive: Primitive,
     /// Shape-specific parameters: patch `(u,v)`, quad `(a,b)`, triangle barycentrics.
     param: DVec2,
+    /// A patch's unit normal where its root finder knew it ([`PatchHit::normal`]).
+    normal: Option<DVec3>,
 }
 
 impl SceneGeometry {
@@ -494,7 +496,16 @@ impl SceneGeometry {
         frame: &Option<RayFrame>,
         t_max: f64,
     ) -> Option<Candidate> {
-        let hit = |t: f64, param: DVec2| Candidate { t, primitive, param };
+        let hit = |t: f64, param: DVec2| Candidate {
+            t,
+            primitive,
+            param,
+            normal: None,
+        };
+        let patch_hit = |h: PatchHit| Candidate {
+            normal: h.normal,
+            ..hit(h.t, h.uv)
+        };
         match primitive {
             Primitive::Sphere(i) => self.spheres[i as usize]
                 .0
@@ -510,7 +521,7 @@ impl SceneGeometry {
                 .map(|h| hit(h.t, h.barycentric)),
             Primitive::PatchLeaf(i) => {
                 let frame = frame.as_ref()?;
-                intersect_leaf(&self.leaves[i as usize], frame, 0.0, t_max).map(|h| hit(h.t, h.uv))
+                intersect_leaf(&self.leaves[i as usize], frame, 0.0, t_max).map(patch_hit)
             }
             Primitive::Patch(i) => {
                 let depth = match self.patch_method {
@@ -525,7 +536,7 @@ impl SceneGeometry {
                     t_max,
                     depth,
                 )
-                .map(|h| hit(h.t, h.uv))
+                .map(patch_hit)
             }
             Primitive::Plane(i) => self.planes[i as usize]
                 .0
@@ -594,9 +605,9 @@ impl SceneGeometry {
             }
             Primitive::PatchLeaf(i) => {
                 let leaf = &self.leaves[i as usize];
-                self.patch_surface(leaf.patch, c.param, Some(leaf.scale))
+                self.patch_surface(leaf.patch, c.param, c.normal, Some(leaf.scale))
             }
-            Primitive::Patch(patch) => self.patch_surface(patch, c.param, None),
+            Primitive::Patch(patch) => self.patch_surface(patch, c.param, c.normal, None),
         };
         Some(Hit {
             t: c.t,
@@ -610,18 +621,21 @@ impl SceneGeometry {
         })
     }
 
-    /// A patch hit's normals, surface `(u,v)`, object and shape; `scale`, the patch's bounds'
-    /// diagonal, when a prepared leaf knows it.
+    /// A patch hit's normals, surface `(u,v)`, object and shape: the normal the root finder
+    /// found (`known`), or the patch's limit normal where it had none; `scale`, the patch's
+    /// bounds' diagonal, when a prepared leaf knows it.
     fn patch_surface(
         &self,
         patch: u32,
         uv: DVec2,
+        known: Option<DVec3>,
         scale: Option<f64>,
     ) -> (DVec3, DVec3, DVec2, u32, ShapeRef) {
         let (p, obj) = &self.patches[patch as usize];
-        let n = match scale {
-            Some(scale) => p.normal_at_scale(uv.x, uv.y, scale),
-            None => p.normal(uv.x, uv.y),
+        let n = match (known, scale) {
+            (Some(n), _) => Some(n),
+            (None, Some(scale)) => p.normal_at_scale(uv.x, uv.y, scale),
+            (None, None) => p.normal(uv.x, uv.y),
         };
         // A patch degenerate everywhere has no normal; any unit vector keeps shading finite.
         let n = n.unwrap_or(DVec3::Z);

@@ -54,7 +54,7 @@ mod root;
 
 pub use cone::NormalCone;
 
-use root::{beside, bilinear_start, jacobian_at, jacobian_sign, newton};
+use root::{beside, bilinear_start, jacobian_at, jacobian_sign, newton, Root};
 
 /// A rectangle `[u0,u1] × [v0,v1]` of a patch's parameter domain.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -261,13 +261,28 @@ fn departure((s, t): (f64, f64), sign: Option<f64>, at_departure: impl FnOnce() 
     }
 }
 
-/// A ray/patch intersection: distance along the ray and the original patch's `(u,v)`.
+/// A ray/patch intersection: distance along the ray, the original patch's `(u,v)` and the
+/// normal there.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PatchHit {
     /// Distance along the ray.
     pub t: f64,
     /// Parameters in the original patch, within `[0,1]²`.
     pub uv: DVec2,
+    /// The unit normal `∂P/∂u × ∂P/∂v` at `uv`, from the root finder's own derivatives (equal
+    /// to [`BezierPatch::normal`]'s within rounding). `None` where the cross product vanishes
+    /// (a collapsed edge, such as the Utah teapot's poles) or the search settled without a
+    /// Newton root: the caller takes the limit normal ([`BezierPatch::normal_at_scale`]).
+    pub normal: Option<DVec3>,
+}
+
+/// [`PatchHit`] while a search runs: the normal still in ray space.
+#[derive(Clone, Copy, Debug)]
+struct Found {
+    t: f64,
+    uv: DVec2,
+    /// `∂P/∂s × ∂P/∂t` of the sub-patch in ray space, where it is not rounding noise.
+    normal: Option<DVec3>,
 }
 
 /// The frame of a ray: `n1`, `n2`, `dir` orthonormal; and the patch point it leaves, if any.
@@ -290,6 +305,20 @@ impl RayFrame {
             n2,
             dir: ray.dir,
             leaving: ray.leaving,
+        }
+    }
+
+    /// A search's hit with its normal turned from ray space back to world space and
+    /// normalised. `(n1, n2, dir)` is a right-handed orthonormal basis (Duff et al. 2017,
+    /// "Building an orthonormal basis, revisited", which glam's `any_orthonormal_pair`
+    /// implements), so cross products carry over unchanged.
+    fn hit(&self, found: Found) -> PatchHit {
+        PatchHit {
+            t: found.t,
+            uv: found.uv,
+            normal: found
+                .normal
+                .map(|n| (n.x * self.n1 + n.y * self.n2 + n.z * self.dir).normalize()),
         }
     }
 
@@ -318,7 +347,12 @@ struct Problem {
     budget: u32,
     t_min: f64,
     tolerance: f64,
-    best: Option<PatchHit>,
+    /// Diagonal of the original patch's bounds (as [`PatchLeaf::scale`]): the scale below
+    /// which a normal is rounding noise.
+    scale: f64,
+    /// A bound on the rounding of each ray-space coordinate ([`rounding`]).
+    rounding: f64,
+    best: Option<Found>,
     /// Whether any root in range will do (shadow rays): the search ends at the first one
     /// instead of ruling out nearer ones.
     any: bool,
@@ -356,19 +390,29 @@ impl Problem {
         self.best.map_or(t_max, |h| h.t)
     }
 
+    /// The normal `∂P/∂s × ∂P/∂t` of `root` (a root of the sub-patch over `window`), in ray
+    /// space, where its direction is known to [`NORMAL_TURN`]: the ray-space coordinates'
+    /// rounding (`ε`) turns it by up to about `ε (|∂P/∂s| + |∂P/∂t|) / |∂P/∂s × ∂P/∂t|`. That
+    /// rules out the nearly vanishing normals of a collapsed edge (a pole) and of the tiny
+    /// sub-patches that splitting reaches, whose limit normal the caller takes instead
+    /// ([`BezierPatch::normal_at_scale`]). [`BezierPatch::normal_at_scale`]'s own threshold,
+    /// `1e-12 · scale²` for the original patch's normal, which the sub-patch's scales by the
+    /// window's area, holds too.
+    fn normal(&self, root: &Root, window: Window) -> Option<DVec3> {
+        let n = root.ds.cross(root.dt);
+        let length = n.length();
+        let area = (window.u1 - window.u0) * (window.v1 - window.v0);
+        let tiny = 1e-12 * self.scale * self.scale * area;
+        let turn = self.rounding * (root.ds.length() + root.dt.length());
+        (length > tiny && turn < NORMAL_TURN * length).then_some(n)
+    }
+
     /// Finds the nearest root of the ray-space patch `p` over `window` (whose hull the caller
     /// has checked with [`Problem::may_hit`]), splitting up to `depth` more times where Newton
-    /// fails or a second, nearer root cannot be ruled out. `known` is a root `(s, t, distance)`
-    /// of `p` already found in the sub-patch this one was split from: it stands for the
-    /// Newton solve, which would only find it again.
-    fn solve(
-        &mut self,
-        p: &BezierPatch,
-        window: Window,
-        depth: u32,
-        t_max: f64,
-        known: Option<(f64, f64, f64)>,
-    ) {
+    /// fails or a second, nearer root cannot be ruled out. `known` is a root of `p` already
+    /// found in the sub-patch this one was split from: it stands for the Newton solve, which
+    /// would only find it again.
+    fn solve(&mut self, p: &BezierPatch, window: Window, depth: u32, t_max: f64, known: Option<Root>) {
         let t_max = self.t_max(t_max);
         let root = match known {
             Some(root) => Some(root),
@@ -376,11 +420,17 @@ impl Problem {
             None => newton(p, self.tolerance, bilinear_start(p)),
         };
         self.budget = self.budget.saturating_sub(1);
-        if let Some((s, t, dist)) = root {
+        if let Some(root) = root {
+            let (s, t, dist) = (root.s, root.t, root.dist);
             let inside = |x: f64| (-WINDOW_MARGIN..=1.0 + WINDOW_MARGIN).contains(&x);
             if inside(s) && inside(t) && dist > self.t_min && dist < t_max {
                 let uv = window.map(s.clamp(0.0, 1.0), t.clamp(0.0, 1.0));
-                self.best = Some(PatchHit { t: dist, uv });
+                // A root just outside the window (on a seam, within the margin) is moved onto
+                // it, away from where its derivatives were taken; shadow rays need no normal.
+                let normal = (in_window(s, t) && !self.any)
+                    .then(|| self.normal(&root, window))
+                    .flatten();
+                self.best = Some(Found { t: dist, uv, normal });
                 if self.any {
                     return;
                 }
@@ -418,9 +468,10 @@ impl Problem {
             .unwrap_or((0, 0.0, 0.0));
         let dist = p.points[k].z;
         if dist > self.t_min && dist < t_max {
-            self.best = Some(PatchHit {
+            self.best = Some(Found {
                 t: dist,
                 uv: window.map(s, t),
+                normal: None,
             });
         }
     }
@@ -435,7 +486,7 @@ impl Problem {
         window: Window,
         depth: u32,
         t_max: f64,
-        root: Option<(f64, f64, f64)>,
+        root: Option<Root>,
     ) {
         let t_max = self.t_max(t_max);
         let children = p.split_quad();
@@ -462,9 +513,16 @@ impl Problem {
             if near < self.t_max(t_max) - self.tolerance {
                 // The root found here, in the quarter's own parameters, if it lies there.
                 let (ds, dt) = QUARTER_OFFSETS[k];
-                let inherited = root.and_then(|(s, t, dist)| {
-                    let (s, t) = (2.0 * s - ds, 2.0 * t - dt);
-                    ((0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&t)).then_some((s, t, dist))
+                // The quarter's derivatives are half its parent's (exactly: a power of 2).
+                let inherited = root.and_then(|r| {
+                    let (s, t) = (2.0 * r.s - ds, 2.0 * r.t - dt);
+                    ((0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&t)).then_some(Root {
+                        s,
+                        t,
+                        dist: r.dist,
+                        ds: 0.5 * r.ds,
+                        dt: 0.5 * r.dt,
+                    })
                 });
                 self.solve(&children[k], windows[k], depth - 1, t_max, inherited);
             }
@@ -489,15 +547,26 @@ const SPLIT_BUDGET: u32 = 256;
 /// How many more times a prepared leaf may be split when Newton fails in it.
 const LEAF_FALLBACK_DEPTH: u32 = 24;
 
-/// Tolerance for a patch of size `scale` seen from a ray whose origin is `depth` away: the
-/// relative target, or the rounding of the ray-space projection if that is larger.
+/// How far rounding may turn a normal from the root finder's derivatives before the
+/// intersector leaves the normal to [`BezierPatch::normal_at_scale`] ([`Problem::normal`]).
+const NORMAL_TURN: f64 = 1e-10;
+
+/// A bound on the rounding of the ray-space sub-patch `p`'s coordinates (the projection's and
+/// the splits'), from its two opposite corners' distance from the ray's origin.
 #[inline]
-fn tolerance(scale: f64, p: &BezierPatch) -> f64 {
+fn rounding(p: &BezierPatch) -> f64 {
     let far = p.points[0]
         .abs()
         .max_element()
         .max(p.points[15].abs().max_element());
-    (RELATIVE_TOLERANCE * scale).max(16.0 * f64::EPSILON * far)
+    16.0 * f64::EPSILON * far
+}
+
+/// Tolerance for a patch of size `scale` whose ray-space coordinates round by `rounding`: the
+/// relative target, or the rounding if that is larger.
+#[inline]
+fn tolerance(scale: f64, rounding: f64) -> f64 {
+    (RELATIVE_TOLERANCE * scale).max(rounding)
 }
 
 /// Intersects `ray` with a prepared leaf: the nearest hit in `(t_min, t_max)`.
@@ -527,10 +596,13 @@ fn search_leaf(leaf: &PatchLeaf, frame: &RayFrame, t_min: f64, t_max: f64, any: 
         }
     }
     let p = frame.project(&leaf.sub_patch);
+    let rounding = rounding(&p);
     let mut problem = Problem {
         budget: SPLIT_BUDGET,
         t_min,
-        tolerance: tolerance(leaf.scale, &p),
+        tolerance: tolerance(leaf.scale, rounding),
+        scale: leaf.scale,
+        rounding,
         best: None,
         any,
         deviation: leaf.deviation,
@@ -541,12 +613,12 @@ fn search_leaf(leaf: &PatchLeaf, frame: &RayFrame, t_min: f64, t_max: f64, any: 
         let known = match from.map(|st| departure(st, jacobian_sign(&p), || jacobian_at(&p, st.0, st.1))) {
             Some(Departure::Only) => return None,
             // The departure stands for the root Newton would find there (behind the ray).
-            Some(Departure::Inside(s, t)) => Some((s, t, f64::NEG_INFINITY)),
+            Some(Departure::Inside(s, t)) => Some(Root::without_derivatives(s, t, f64::NEG_INFINITY)),
             _ => None,
         };
         problem.solve(&p, leaf.window, LEAF_FALLBACK_DEPTH, t_max, known);
     }
-    problem.best
+    problem.best.map(|found| frame.hit(found))
 }
 
 /// The seed's per-ray intersector: a queue of quarters culled by their bounding boxes down to
@@ -588,17 +660,20 @@ pub fn intersect_per_ray(
     let mut best: Option<PatchHit> = None;
     for (sub, window) in survivors {
         let p = frame.project(&sub);
+        let rounding = rounding(&p);
         let mut problem = Problem {
             budget: SPLIT_BUDGET,
             t_min,
-            tolerance: tolerance(scale, &p),
+            tolerance: tolerance(scale, rounding),
+            scale,
+            rounding,
             best: None,
             any: false,
             deviation: f64::INFINITY,
         };
         problem.run(&p, window, LEAF_FALLBACK_DEPTH, best.map_or(t_max, |h| h.t));
-        if let Some(hit) = problem.best {
-            best = Some(hit);
+        if let Some(found) = problem.best {
+            best = Some(frame.hit(found));
         }
     }
     best
@@ -641,5 +716,36 @@ mod tests {
             assert!((prepared.t - reference.t).abs() < 1e-9 * scale);
             assert!((prepared.uv - DVec2::new(u, v)).length() < 1e-8);
         }
+    }
+
+    #[test]
+    fn the_solves_normal_is_the_patchs_normal_from_either_side() {
+        let patch = dome();
+        let leaves = subdivide(&patch, 0, &SubdivisionParams::default());
+        let mut checked = 0;
+        for k in 0..200 {
+            // Points off the leaves' seams, where a root may lie a rounding outside the leaf.
+            let (u, v) = ((k as f64 * 0.618034) % 1.0, (k as f64 * 0.414214 + 0.01) % 1.0);
+            let target = patch.eval(u, v);
+            // From above and from below: ray frames with the direction's z of either sign, whose
+            // bases glam builds with opposite signs.
+            for offset in [DVec3::new(0.3, -0.2, 3.0), DVec3::new(-0.4, 0.1, -2.0)] {
+                let ray = Ray::new(target + offset, -offset);
+                let frame = RayFrame::new(&ray);
+                let hit = leaves
+                    .iter()
+                    .filter_map(|l| intersect_leaf(l, &frame, 0.0, f64::INFINITY))
+                    .min_by(|a, b| a.t.total_cmp(&b.t))
+                    .expect("prepared hit");
+                let solved = hit.normal.expect("a regular point's normal comes from the solve");
+                let expected = patch.normal(hit.uv.x, hit.uv.y).expect("the dome is regular");
+                assert!((solved - expected).length() < 1e-12, "{solved} vs {expected}");
+                let per_ray = intersect_per_ray(&patch, 1.0, &ray, 0.0, f64::INFINITY, 5).expect("hit");
+                let per_ray = per_ray.normal.expect("per-ray normal");
+                assert!((per_ray - expected).length() < 1e-12, "{per_ray} vs {expected}");
+                checked += 1;
+            }
+        }
+        assert_eq!(checked, 400);
     }
 }

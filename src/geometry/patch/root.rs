@@ -4,7 +4,7 @@
 //! Jacobian is near singular), and the test that proves a root unique (the Jacobian's sign
 //! fixed over the sub-patch).
 
-use glam::DVec2;
+use glam::{DVec2, DVec3};
 
 use crate::geometry::bezier::BezierPatch;
 
@@ -128,23 +128,61 @@ pub(super) fn beside(p: &BezierPatch, tolerance: f64, deviation: f64) -> bool {
     margin * margin > deviation2
 }
 
+/// A root of a ray-space sub-patch: where the ray meets it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Root {
+    /// The sub-patch's parameters.
+    pub s: f64,
+    /// The sub-patch's second parameter.
+    pub t: f64,
+    /// Distance along the ray (the third ray-space coordinate there).
+    pub dist: f64,
+    /// `∂P/∂s` there, in ray space (zero where it is not known).
+    pub ds: DVec3,
+    /// `∂P/∂t` there, in ray space (zero where it is not known).
+    pub dt: DVec3,
+}
+
+impl Root {
+    /// A root whose derivatives are not known (a departure point, which is never a hit).
+    pub fn without_derivatives(s: f64, t: f64, dist: f64) -> Self {
+        Self {
+            s,
+            t,
+            dist,
+            ds: DVec3::ZERO,
+            dt: DVec3::ZERO,
+        }
+    }
+}
+
 /// Newton (or Levenberg–Marquardt where the Jacobian is near singular) on the first two
 /// ray-space coordinates, from [`bilinear_start`] and, should that fail (its corners can
-/// coincide at a pole), from the middle. Returns the root `(s, t)` and its ray distance.
-pub(super) fn newton(p: &BezierPatch, tolerance: f64, start: (f64, f64)) -> Option<(f64, f64, f64)> {
+/// coincide at a pole), from the middle. Returns the root, its ray distance and the
+/// derivatives there.
+pub(super) fn newton(p: &BezierPatch, tolerance: f64, start: (f64, f64)) -> Option<Root> {
     let clamped = !(0.0..=1.0).contains(&start.0) || !(0.0..=1.0).contains(&start.1);
     newton_from(p, tolerance, start)
         .or_else(|| clamped.then(|| newton_from(p, tolerance, (0.5, 0.5))).flatten())
 }
 
 /// Newton from `(s, t)`, with steps limited to half the sub-patch.
-fn newton_from(p: &BezierPatch, tolerance: f64, (mut s, mut t): (f64, f64)) -> Option<(f64, f64, f64)> {
+fn newton_from(p: &BezierPatch, tolerance: f64, (mut s, mut t): (f64, f64)) -> Option<Root> {
     let mut previous = f64::INFINITY;
     for iteration in 0..MAX_NEWTON_ITERATIONS {
         let [f, fs, ft] = p.eval_xy_with_derivs(s, t);
         let residual = f.x.abs().max(f.y.abs());
         if residual <= tolerance {
-            return Some((s, t, p.eval(s, t).z));
+            // The third coordinate completes the derivatives this step evaluated: the
+            // distance and the tangents (so the normal) at the root, for one coordinate's cost.
+            let [dist, zs, zt] = p.eval_z_with_derivs(s, t);
+            return Some(Root {
+                s,
+                t,
+                dist,
+                ds: fs.extend(zs),
+                dt: ft.extend(zt),
+            });
         }
         // Converging Newton shrinks the residual far faster than this; give the split
         // fallback the sub-patch instead of iterating on.
