@@ -212,8 +212,7 @@ fn newton_from(p: &BezierPatch, tolerance: f64, (mut s, mut t): (f64, f64)) -> O
         // Trust region: never jump more than half the sub-patch in one step.
         let step = ds.abs().max(dt.abs());
         if step > MAX_STEP {
-            ds *= MAX_STEP / step;
-            dt *= MAX_STEP / step;
+            (ds, dt) = shortened(ds, dt, step);
         }
         s -= ds;
         t -= dt;
@@ -227,6 +226,15 @@ fn newton_from(p: &BezierPatch, tolerance: f64, (mut s, mut t): (f64, f64)) -> O
 
 /// Largest Newton step in sub-patch parameters.
 const MAX_STEP: f64 = 0.5;
+
+/// The Newton step `(ds, dt)`, whose larger component is `step`, shortened to [`MAX_STEP`].
+/// Out of line: taken inline, the compiler computes the division on every step (a select
+/// rather than a branch), an eighth of the solve's own time, for a step rarely this long.
+#[cold]
+#[inline(never)]
+fn shortened(ds: f64, dt: f64, step: f64) -> (f64, f64) {
+    (ds * (MAX_STEP / step), dt * (MAX_STEP / step))
+}
 
 /// Whether `det [∂(x,y)/∂s ∂(x,y)/∂t]` — which in ray space is `(Ps × Pt)·d`, the normal
 /// against the ray direction — provably keeps one sign over the sub-patch. The derivative
