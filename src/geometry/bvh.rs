@@ -45,6 +45,14 @@ const SHORT_STACK: usize = 32;
 /// The same for deeper trees (deeper still, the stack is on the heap).
 const LONG_STACK: usize = 64;
 
+/// A traversal's stack: the nodes still to visit, where the ray enters their boxes and where
+/// it leaves them.
+struct Stack<'a> {
+    node: &'a mut [u32],
+    enter: &'a mut [f64],
+    exit: &'a mut [f64],
+}
+
 struct BuildItem {
     bounds: Aabb,
     centroid: DVec3,
@@ -168,47 +176,54 @@ impl Bvh {
 
     /// Visits, front to back, every primitive whose leaf the ray reaches before `t_max`
     /// (in a tree of at most [`FLAT_PRIMITIVES`], every primitive, in the tree's order).
-    /// `visit(primitive, t_max)` returns the distance of a nearer hit, which then bounds the
-    /// rest of the traversal. Returns the final `t_max`.
+    /// `visit(primitive, t_max, span)` returns the distance of a nearer hit, which then bounds
+    /// the rest of the traversal; `span` is the piece `(near, far)` of the ray inside the
+    /// leaf's box ([`Aabb::hit_interval`]'s, `far` clipped to `t_max` when the box was tested;
+    /// `(0, t_max)` in a tree that is not walked). Returns the final `t_max`.
     #[inline]
-    pub fn traverse(&self, ray: &Ray, mut t_max: f64, mut visit: impl FnMut(u32, f64) -> Option<f64>) -> f64 {
+    pub fn traverse(
+        &self,
+        ray: &Ray,
+        mut t_max: f64,
+        mut visit: impl FnMut(u32, f64, (f64, f64)) -> Option<f64>,
+    ) -> f64 {
         if self.order.len() <= FLAT_PRIMITIVES {
             for &prim in &self.order {
-                if let Some(t) = visit(prim, t_max) {
+                if let Some(t) = visit(prim, t_max, (0.0, t_max)) {
                     t_max = t_max.min(t);
                 }
             }
             return t_max;
         }
         let inv_dir = safe_inverse(ray.dir);
-        match self.nodes.first() {
-            Some(root) if root.bounds.hit_interval(ray.origin, inv_dir, t_max).is_some() => {}
-            _ => return t_max,
-        }
-        // Stack entries are nodes whose box the ray enters at the stored distance: a node's
-        // ancestors' other children, fewer than the tree's depth. Two plain arrays (not an
-        // array of pairs, whose padding makes the start-up zeroing a scalar loop). Zeroing is
-        // a measurable part of a short traversal, so the arrays are sized to the tree.
+        let root = match self.nodes.first() {
+            Some(root) => match root.bounds.hit_interval(ray.origin, inv_dir, t_max) {
+                Some(span) => span,
+                None => return t_max,
+            },
+            None => return t_max,
+        };
+        // Stack entries are nodes whose box the ray enters and leaves at the stored distances:
+        // a node's ancestors' other children, fewer than the tree's depth. Plain arrays (not
+        // an array of triples, whose padding makes the start-up zeroing a scalar loop).
+        // Zeroing is a measurable part of a short traversal, so the arrays are sized to the
+        // tree.
         if self.levels <= SHORT_STACK {
-            self.walk(
-                ray,
-                inv_dir,
-                t_max,
-                visit,
-                &mut [0; SHORT_STACK],
-                &mut [0.0; SHORT_STACK],
-            )
+            let stack = Stack {
+                node: &mut [0; SHORT_STACK],
+                enter: &mut [0.0; SHORT_STACK],
+                exit: &mut [0.0; SHORT_STACK],
+            };
+            self.walk(ray, inv_dir, root, t_max, visit, stack)
         } else if self.levels <= LONG_STACK {
-            self.walk(
-                ray,
-                inv_dir,
-                t_max,
-                visit,
-                &mut [0; LONG_STACK],
-                &mut [0.0; LONG_STACK],
-            )
+            let stack = Stack {
+                node: &mut [0; LONG_STACK],
+                enter: &mut [0.0; LONG_STACK],
+                exit: &mut [0.0; LONG_STACK],
+            };
+            self.walk(ray, inv_dir, root, t_max, visit, stack)
         } else {
-            self.traverse_deep(ray, inv_dir, t_max, visit)
+            self.traverse_deep(ray, inv_dir, root, t_max, visit)
         }
     }
 
@@ -221,33 +236,45 @@ impl Bvh {
         &self,
         ray: &Ray,
         inv_dir: DVec3,
+        root: (f64, f64),
         t_max: f64,
-        visit: impl FnMut(u32, f64) -> Option<f64>,
+        visit: impl FnMut(u32, f64, (f64, f64)) -> Option<f64>,
     ) -> f64 {
-        let (mut nodes, mut enter) = (vec![0; self.levels], vec![0.0; self.levels]);
-        self.walk(ray, inv_dir, t_max, visit, &mut nodes, &mut enter)
+        let (mut node, mut enter, mut exit) = (
+            vec![0; self.levels],
+            vec![0.0; self.levels],
+            vec![0.0; self.levels],
+        );
+        let stack = Stack {
+            node: &mut node,
+            enter: &mut enter,
+            exit: &mut exit,
+        };
+        self.walk(ray, inv_dir, root, t_max, visit, stack)
     }
 
-    /// [`Bvh::traverse`] past the root's box (which the ray enters), with a stack of at least
-    /// [`Bvh::depth`] entries.
+    /// [`Bvh::traverse`] past the root's box (which the ray enters over `root`), with a stack
+    /// of at least [`Bvh::depth`] entries.
     #[inline]
     fn walk(
         &self,
         ray: &Ray,
         inv_dir: DVec3,
+        root: (f64, f64),
         mut t_max: f64,
-        mut visit: impl FnMut(u32, f64) -> Option<f64>,
-        stack_node: &mut [u32],
-        stack_enter: &mut [f64],
+        mut visit: impl FnMut(u32, f64, (f64, f64)) -> Option<f64>,
+        stack: Stack<'_>,
     ) -> f64 {
         let mut top = 0usize;
         let mut node = 0usize;
+        // The piece of the ray inside the current node's box.
+        let mut span = root;
         loop {
             let n = &self.nodes[node];
             if n.count > 0 {
                 let first = n.offset as usize;
                 for &prim in &self.order[first..first + n.count as usize] {
-                    if let Some(t) = visit(prim, t_max) {
+                    if let Some(t) = visit(prim, t_max, span) {
                         t_max = t_max.min(t);
                     }
                 }
@@ -257,20 +284,25 @@ impl Bvh {
                 let ha = self.nodes[a].bounds.hit_interval(ray.origin, inv_dir, t_max);
                 let hb = self.nodes[b].bounds.hit_interval(ray.origin, inv_dir, t_max);
                 match (ha, hb) {
-                    (Some((ta, _)), Some((tb, _))) => {
-                        let (near, far, t_far) = if ta <= tb { (a, b, tb) } else { (b, a, ta) };
-                        stack_node[top] = far as u32;
-                        stack_enter[top] = t_far;
+                    (Some(sa), Some(sb)) => {
+                        let ((near, s_near), (far, s_far)) = if sa.0 <= sb.0 {
+                            ((a, sa), (b, sb))
+                        } else {
+                            ((b, sb), (a, sa))
+                        };
+                        stack.node[top] = far as u32;
+                        stack.enter[top] = s_far.0;
+                        stack.exit[top] = s_far.1;
                         top += 1;
-                        node = near;
+                        (node, span) = (near, s_near);
                         continue;
                     }
-                    (Some(_), None) => {
-                        node = a;
+                    (Some(sa), None) => {
+                        (node, span) = (a, sa);
                         continue;
                     }
-                    (None, Some(_)) => {
-                        node = b;
+                    (None, Some(sb)) => {
+                        (node, span) = (b, sb);
                         continue;
                     }
                     (None, None) => {}
@@ -282,20 +314,21 @@ impl Bvh {
                     return t_max;
                 }
                 top -= 1;
-                if stack_enter[top] <= t_max {
-                    node = stack_node[top] as usize;
+                if stack.enter[top] <= t_max {
+                    node = stack.node[top] as usize;
+                    span = (stack.enter[top], stack.exit[top]);
                     break;
                 }
             }
         }
     }
 
-    /// Whether any primitive reports a hit before `t_max`: `test(primitive)` for each candidate
-    /// until one returns `true` (shadow rays).
-    pub fn any(&self, ray: &Ray, t_max: f64, mut test: impl FnMut(u32) -> bool) -> bool {
+    /// Whether any primitive reports a hit before `t_max`: `test(primitive, span)` for each
+    /// candidate until one returns `true` (shadow rays); `span` as [`Bvh::traverse`]'s.
+    pub fn any(&self, ray: &Ray, t_max: f64, mut test: impl FnMut(u32, (f64, f64)) -> bool) -> bool {
         let mut found = false;
-        self.traverse(ray, t_max, |prim, _| {
-            if !found && test(prim) {
+        self.traverse(ray, t_max, |prim, _, span| {
+            if !found && test(prim, span) {
                 found = true;
                 // A negative distance ends the traversal: no box starts before it.
                 return Some(-1.0);
@@ -399,14 +432,20 @@ mod tests {
                 let inv = safe_inverse(ray.dir);
                 let entry = |b: &Aabb| b.hit_interval(ray.origin, inv, f64::INFINITY).map(|(t0, _)| t0);
                 let brute = boxes.iter().filter_map(entry).fold(f64::INFINITY, f64::min);
-                let found = bvh.traverse(&ray, f64::INFINITY, |p, _| entry(&boxes[p as usize]));
+                let found = bvh.traverse(&ray, f64::INFINITY, |p, t_max, span| {
+                    // The span is the piece of the ray in a box holding the primitive's.
+                    if let Some(own) = boxes[p as usize].hit_interval(ray.origin, inv, t_max) {
+                        assert!(span.0 <= own.0 && own.1 <= span.1, "{own:?} outside {span:?}");
+                    }
+                    entry(&boxes[p as usize])
+                });
                 assert_eq!(brute, found, "{n} boxes");
-                let any = bvh.any(&ray, f64::INFINITY, |p| entry(&boxes[p as usize]).is_some());
+                let any = bvh.any(&ray, f64::INFINITY, |p, _| entry(&boxes[p as usize]).is_some());
                 assert_eq!(any, brute.is_finite(), "{n} boxes");
                 hits += brute.is_finite() as usize;
                 if n <= FLAT_PRIMITIVES {
                     let mut visits = 0;
-                    bvh.traverse(&ray, f64::INFINITY, |_, _| {
+                    bvh.traverse(&ray, f64::INFINITY, |_, _, _| {
                         visits += 1;
                         None
                     });
@@ -443,13 +482,13 @@ mod tests {
             let inv = safe_inverse(ray.dir);
             let entry = |b: &Aabb| b.hit_interval(ray.origin, inv, f64::INFINITY).map(|(t0, _)| t0);
             let mut visited = 0;
-            let found = bvh.traverse(&ray, f64::INFINITY, |p, _| {
+            let found = bvh.traverse(&ray, f64::INFINITY, |p, _, _| {
                 visited += 1;
                 entry(&boxes[p as usize]).map(|_| f64::INFINITY)
             });
             assert_eq!(found, f64::INFINITY);
             assert_eq!(visited, boxes.len(), "growth {growth}");
-            let nearest = bvh.traverse(&ray, f64::INFINITY, |p, _| entry(&boxes[p as usize]));
+            let nearest = bvh.traverse(&ray, f64::INFINITY, |p, _, _| entry(&boxes[p as usize]));
             let brute = boxes.iter().filter_map(entry).fold(f64::INFINITY, f64::min);
             assert_eq!(nearest, brute, "growth {growth}");
         }
@@ -485,7 +524,7 @@ mod tests {
             let brute = moved.iter().filter_map(entry).fold(f64::INFINITY, f64::min);
             assert_eq!(
                 brute,
-                bvh.traverse(&ray, f64::INFINITY, |p, _| entry(&moved[p as usize]))
+                bvh.traverse(&ray, f64::INFINITY, |p, _, _| entry(&moved[p as usize]))
             );
         }
     }

@@ -489,11 +489,14 @@ impl SceneGeometry {
         !self.patches.is_empty()
     }
 
+    /// `primitive`'s nearest hit by `ray` before `t_max`; `span`, the piece of the ray inside
+    /// a box holding the primitive ([`Bvh::traverse`]'s), rules out patch leaves early.
     fn test(
         &self,
         primitive: Primitive,
         ray: &Ray,
         frame: &Option<RayFrame>,
+        span: (f64, f64),
         t_max: f64,
     ) -> Option<Candidate> {
         let hit = |t: f64, param: DVec2| Candidate {
@@ -521,7 +524,7 @@ impl SceneGeometry {
                 .map(|h| hit(h.t, h.barycentric)),
             Primitive::PatchLeaf(i) => {
                 let frame = frame.as_ref()?;
-                intersect_leaf(&self.leaves[i as usize], frame, 0.0, t_max).map(patch_hit)
+                intersect_leaf(&self.leaves[i as usize], frame, span, 0.0, t_max).map(patch_hit)
             }
             Primitive::Patch(i) => {
                 let depth = match self.patch_method {
@@ -548,14 +551,14 @@ impl SceneGeometry {
     fn nearest(&self, ray: &Ray, t_max: f64) -> Option<Candidate> {
         let frame = self.has_patches().then(|| RayFrame::new(ray));
         let mut best: Option<Candidate> = None;
-        let t_max = self.bvh.traverse(ray, t_max, |k, t_max| {
-            let c = self.test(self.primitives[k as usize], ray, &frame, t_max)?;
+        let t_max = self.bvh.traverse(ray, t_max, |k, t_max, span| {
+            let c = self.test(self.primitives[k as usize], ray, &frame, span, t_max)?;
             best = Some(c);
             Some(c.t)
         });
         for k in 0..self.planes.len() {
             let t_max = best.map_or(t_max, |b| b.t);
-            if let Some(c) = self.test(Primitive::Plane(k as u32), ray, &frame, t_max) {
+            if let Some(c) = self.test(Primitive::Plane(k as u32), ray, &frame, (0.0, t_max), t_max) {
                 best = Some(c);
             }
         }
@@ -661,14 +664,14 @@ impl SceneGeometry {
             return true;
         }
         let frame = self.has_patches().then(|| RayFrame::new(ray));
-        self.bvh.any(ray, t_max, |k| {
+        self.bvh.any(ray, t_max, |k, span| {
             let primitive = self.primitives[k as usize];
             counts(self.object_of(primitive))
                 && match (primitive, &frame) {
                     (Primitive::PatchLeaf(i), Some(frame)) => {
-                        leaf_occludes(&self.leaves[i as usize], frame, 0.0, t_max)
+                        leaf_occludes(&self.leaves[i as usize], frame, span, 0.0, t_max)
                     }
-                    _ => self.test(primitive, ray, &frame, t_max).is_some(),
+                    _ => self.test(primitive, ray, &frame, span, t_max).is_some(),
                 }
         })
     }

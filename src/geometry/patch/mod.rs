@@ -45,14 +45,16 @@
 
 use glam::{DVec2, DVec3};
 
-use super::aabb::Aabb;
+use super::aabb::{safe_inverse, Aabb};
 use super::bezier::BezierPatch;
 use super::ray::Ray;
 
 mod cone;
 mod root;
+mod slab;
 
 pub use cone::NormalCone;
+pub use slab::Slab;
 
 use root::{beside, bilinear_start, jacobian_at, jacobian_sign, newton, Root};
 
@@ -137,6 +139,18 @@ pub struct PatchLeaf {
     /// A cone holding every normal of the sub-patch: tells a ray that leaves the leaf whether
     /// the normal keeps one side towards it, before the leaf is projected ([`departure`]).
     pub normals: NormalCone,
+    /// A slab that holds the sub-patch: with `bounds`, rules out rays that pass through the
+    /// box above or below a leaf lying oblique to the axes, before it is projected.
+    pub slab: Slab,
+}
+
+impl PatchLeaf {
+    /// The piece `(near, far)` of `frame`'s ray inside the leaf's own box, up to `t_max`
+    /// ([`intersect_leaf`]'s `span` where no BVH has found one).
+    pub fn span(&self, frame: &RayFrame, t_max: f64) -> Option<(f64, f64)> {
+        self.bounds
+            .hit_interval(frame.origin, safe_inverse(frame.dir), t_max)
+    }
 }
 
 /// How finely [`subdivide`] cuts a patch.
@@ -184,6 +198,7 @@ pub fn subdivide(patch: &BezierPatch, patch_index: u32, params: &SubdivisionPara
                 scale,
                 deviation,
                 normals: NormalCone::of(&sub),
+                slab: Slab::of(&sub),
             });
         } else {
             for (child, w) in sub.split_quad().into_iter().zip(window.quarters()) {
@@ -569,20 +584,42 @@ fn tolerance(scale: f64, rounding: f64) -> f64 {
     (RELATIVE_TOLERANCE * scale).max(rounding)
 }
 
-/// Intersects `ray` with a prepared leaf: the nearest hit in `(t_min, t_max)`.
-pub fn intersect_leaf(leaf: &PatchLeaf, frame: &RayFrame, t_min: f64, t_max: f64) -> Option<PatchHit> {
-    search_leaf(leaf, frame, t_min, t_max, false)
+/// Intersects `ray` with a prepared leaf: the nearest hit in `(t_min, t_max)`. `span` is the
+/// piece `(near, far)` of the ray inside a box that holds the leaf, as the BVH's walk found it
+/// ([`Bvh::traverse`](super::bvh::Bvh::traverse)) or [`PatchLeaf::span`] finds it.
+pub fn intersect_leaf(
+    leaf: &PatchLeaf,
+    frame: &RayFrame,
+    span: (f64, f64),
+    t_min: f64,
+    t_max: f64,
+) -> Option<PatchHit> {
+    search_leaf(leaf, frame, span, t_min, t_max, false)
 }
 
 /// Whether `ray` meets a prepared leaf anywhere in `(t_min, t_max)` (shadow rays): the same
 /// search as [`intersect_leaf`], ended at the first root found. Where the ray's sub-patch may
 /// hold two roots (the ray nearly tangent to it, as shadow rays often are) the nearest-hit
 /// search splits it to rule out a nearer one; this has no need to.
-pub fn leaf_occludes(leaf: &PatchLeaf, frame: &RayFrame, t_min: f64, t_max: f64) -> bool {
-    search_leaf(leaf, frame, t_min, t_max, true).is_some()
+pub fn leaf_occludes(leaf: &PatchLeaf, frame: &RayFrame, span: (f64, f64), t_min: f64, t_max: f64) -> bool {
+    search_leaf(leaf, frame, span, t_min, t_max, true).is_some()
 }
 
-fn search_leaf(leaf: &PatchLeaf, frame: &RayFrame, t_min: f64, t_max: f64, any: bool) -> Option<PatchHit> {
+fn search_leaf(
+    leaf: &PatchLeaf,
+    frame: &RayFrame,
+    span: (f64, f64),
+    t_min: f64,
+    t_max: f64,
+    any: bool,
+) -> Option<PatchHit> {
+    // The ray's piece in a box holding the leaf passes above or below it: no projection needed.
+    if leaf
+        .slab
+        .misses(frame.origin, frame.dir, span.0, span.1.min(t_max))
+    {
+        return None;
+    }
     let from = departure_point(leaf, frame.leaving);
     // A leaf the ray leaves, first by its normal cone: no projection needed.
     if let Some((s, t)) = from {
@@ -707,7 +744,7 @@ mod tests {
             let frame = RayFrame::new(&ray);
             let prepared = leaves
                 .iter()
-                .filter_map(|l| intersect_leaf(l, &frame, 0.0, f64::INFINITY))
+                .filter_map(|l| intersect_leaf(l, &frame, l.span(&frame, f64::INFINITY)?, 0.0, f64::INFINITY))
                 .min_by(|a, b| a.t.total_cmp(&b.t))
                 .expect("prepared hit");
             let reference =
@@ -734,7 +771,9 @@ mod tests {
                 let frame = RayFrame::new(&ray);
                 let hit = leaves
                     .iter()
-                    .filter_map(|l| intersect_leaf(l, &frame, 0.0, f64::INFINITY))
+                    .filter_map(|l| {
+                        intersect_leaf(l, &frame, l.span(&frame, f64::INFINITY)?, 0.0, f64::INFINITY)
+                    })
                     .min_by(|a, b| a.t.total_cmp(&b.t))
                     .expect("prepared hit");
                 let solved = hit.normal.expect("a regular point's normal comes from the solve");
