@@ -92,13 +92,17 @@ pub(super) fn beside(p: &BezierPatch, tolerance: f64, deviation: f64) -> bool {
     if !turns.iter().all(|&turn| turn * orientation > 0.0) {
         return false;
     }
-    // Distance of the ray (the origin) outside each edge line; the largest one.
-    let mut outside = f64::NEG_INFINITY;
+    // Distance of the ray (the origin) outside each edge line; the largest one. An edge the
+    // origin lies inside of cannot decide the test (that needs a distance above the
+    // tolerance), so its length (a square root and a division) is not taken: a ray through
+    // the quadrilateral, as every hitting ray's is, takes none.
+    let mut outside: f64 = 0.0;
     for (edge, start) in edges.iter().zip(quad) {
-        let length = edge.length();
         // The origin relative to the edge's start, against the interior's side.
-        let side = -orientation * cross(*edge, -start) / length;
-        outside = outside.max(side);
+        let signed = -orientation * cross(*edge, -start);
+        if signed > 0.0 {
+            outside = outside.max(signed / edge.length());
+        }
     }
     // (No NaN reaches here: a NaN corner fails the convexity test above.)
     if outside <= tolerance {
