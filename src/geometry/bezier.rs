@@ -11,6 +11,8 @@
 //! [`BezierPatch::sub_patch`] needs to cut out an arbitrary `(u,v)` window exactly.
 //! Intersection with rays lives apart, in [`crate::geometry::patch`].
 
+use std::ops::{Add, AddAssign, Mul};
+
 use glam::{DAffine3, DVec2, DVec3};
 
 use super::aabb::Aabb;
@@ -95,21 +97,7 @@ impl BezierPatch {
     /// `P(u,v)` with `∂P/∂u` and `∂P/∂v`.
     #[inline]
     pub fn eval_with_derivs(&self, u: f64, v: f64) -> SurfacePoint {
-        let bu = bernstein(u);
-        let bv = bernstein(v);
-        let du = bernstein_deriv(u);
-        let dv = bernstein_deriv(v);
-        let mut position = DVec3::ZERO;
-        let mut dp_du = DVec3::ZERO;
-        let mut dp_dv = DVec3::ZERO;
-        for i in 0..4 {
-            let r = &self.points[4 * i..4 * i + 4];
-            let row = bv[0] * r[0] + bv[1] * r[1] + bv[2] * r[2] + bv[3] * r[3];
-            let row_dv = dv[0] * r[0] + dv[1] * r[1] + dv[2] * r[2] + dv[3] * r[3];
-            position += bu[i] * row;
-            dp_du += du[i] * row;
-            dp_dv += bu[i] * row_dv;
-        }
+        let [position, dp_du, dp_dv] = self.eval_part_with_derivs(u, v, |p| p);
         SurfacePoint {
             position,
             dp_du,
@@ -123,22 +111,7 @@ impl BezierPatch {
     /// so the same bits.
     #[inline]
     pub fn eval_xy_with_derivs(&self, u: f64, v: f64) -> [DVec2; 3] {
-        let bu = bernstein(u);
-        let bv = bernstein(v);
-        let du = bernstein_deriv(u);
-        let dv = bernstein_deriv(v);
-        let mut position = DVec2::ZERO;
-        let mut dp_du = DVec2::ZERO;
-        let mut dp_dv = DVec2::ZERO;
-        for i in 0..4 {
-            let r = |j: usize| self.points[4 * i + j].truncate();
-            let row = bv[0] * r(0) + bv[1] * r(1) + bv[2] * r(2) + bv[3] * r(3);
-            let row_dv = dv[0] * r(0) + dv[1] * r(1) + dv[2] * r(2) + dv[3] * r(3);
-            position += bu[i] * row;
-            dp_du += du[i] * row;
-            dp_dv += bu[i] * row_dv;
-        }
-        [position, dp_du, dp_dv]
+        self.eval_part_with_derivs(u, v, DVec3::truncate)
     }
 
     /// The third coordinate of `P(u,v)`, `∂P/∂u` and `∂P/∂v`: what a root finder in ray space
@@ -147,13 +120,25 @@ impl BezierPatch {
     /// [`BezierPatch::eval_with_derivs`] on that coordinate, so the same bits.
     #[inline]
     pub fn eval_z_with_derivs(&self, u: f64, v: f64) -> [f64; 3] {
+        self.eval_part_with_derivs(u, v, |p| p.z)
+    }
+
+    /// `part` of `P(u,v)`, `∂P/∂u` and `∂P/∂v`, where `part` picks coordinates of a point (a
+    /// linear map, so it commutes with the sums): the one body of the three evaluations
+    /// above, whose arithmetic per coordinate is therefore the same.
+    #[inline(always)]
+    fn eval_part_with_derivs<T>(&self, u: f64, v: f64, part: impl Fn(DVec3) -> T) -> [T; 3]
+    where
+        T: Copy + Default + Add<Output = T> + AddAssign,
+        f64: Mul<T, Output = T>,
+    {
         let bu = bernstein(u);
         let bv = bernstein(v);
         let du = bernstein_deriv(u);
         let dv = bernstein_deriv(v);
-        let (mut position, mut dp_du, mut dp_dv) = (0.0, 0.0, 0.0);
+        let (mut position, mut dp_du, mut dp_dv) = (T::default(), T::default(), T::default());
         for i in 0..4 {
-            let r = |j: usize| self.points[4 * i + j].z;
+            let r = |j: usize| part(self.points[4 * i + j]);
             let row = bv[0] * r(0) + bv[1] * r(1) + bv[2] * r(2) + bv[3] * r(3);
             let row_dv = dv[0] * r(0) + dv[1] * r(1) + dv[2] * r(2) + dv[3] * r(3);
             position += bu[i] * row;
