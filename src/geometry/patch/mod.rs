@@ -412,14 +412,16 @@ impl Problem {
     /// sub-patches that splitting reaches, whose limit normal the caller takes instead
     /// ([`BezierPatch::normal_at_scale`]). [`BezierPatch::normal_at_scale`]'s own threshold,
     /// `1e-12 · scale²` for the original patch's normal, which the sub-patch's scales by the
-    /// window's area, holds too.
+    /// window's area, holds too. Both are compared squared, without square roots, the turn's
+    /// `(|∂P/∂s| + |∂P/∂t|)²` bounded by `2 (|∂P/∂s|² + |∂P/∂t|²)`.
     fn normal(&self, root: &Root, window: Window) -> Option<DVec3> {
         let n = root.ds.cross(root.dt);
-        let length = n.length();
+        let length2 = n.length_squared();
         let area = (window.u1 - window.u0) * (window.v1 - window.v0);
         let tiny = 1e-12 * self.scale * self.scale * area;
-        let turn = self.rounding * (root.ds.length() + root.dt.length());
-        (length > tiny && turn < NORMAL_TURN * length).then_some(n)
+        let turn2 =
+            2.0 * self.rounding * self.rounding * (root.ds.length_squared() + root.dt.length_squared());
+        (length2 > tiny * tiny && turn2 < NORMAL_TURN * NORMAL_TURN * length2).then_some(n)
     }
 
     /// Finds the nearest root of the ray-space patch `p` over `window` (whose hull the caller
