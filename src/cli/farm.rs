@@ -121,30 +121,28 @@ impl Job {
         self.check_render_args()
     }
 
+    /// What follows `render` on a shard's command line, as shell text: `index` is the shell
+    /// text of the shard's index (`$K` in the Slurm script, `$JOB_COMPLETION_INDEX` in the
+    /// Kubernetes Job). The scripts and [`Job::check_render_args`] all take it from here.
+    fn shard_flags(&self, index: &str) -> String {
+        let extra: String = self.render_args.iter().map(|a| format!(" {}", sh(a))).collect();
+        format!(
+            "{scene} --shard \"{index}/{shards}\" --passes {passes} --threads {threads} --out {out}/part_{index}.exr --force{extra}",
+            scene = sh(&self.scene.display().to_string()),
+            shards = self.shards,
+            passes = self.passes,
+            threads = self.threads,
+            out = sh(&self.out.display().to_string()),
+        )
+    }
+
     /// Parses the first shard's command line as `caustic render` will, so that a misspelt or
     /// repeated flag after `--` is reported here rather than by every task of the job.
     fn check_render_args(&self) -> Result<()> {
-        let (shard, passes, threads) = (
-            format!("0/{}", self.shards),
-            self.passes.to_string(),
-            self.threads.to_string(),
-        );
-        let fixed = [
-            "caustic render".as_ref(),
-            self.scene.as_os_str(),
-            "--shard".as_ref(),
-            shard.as_ref(),
-            "--passes".as_ref(),
-            passes.as_ref(),
-            "--threads".as_ref(),
-            threads.as_ref(),
-            "--out".as_ref(),
-            "part_0.exr".as_ref(),
-            "--force".as_ref(),
-        ];
-        let line = fixed
-            .into_iter()
-            .chain(self.render_args.iter().map(|a| a.as_ref()));
+        // The words the shell makes of the scripts' line, with the index 0.
+        let words = shlex::split(&self.shard_flags("0"))
+            .context("a shard's command line does not split into words")?;
+        let line = std::iter::once("caustic render".to_owned()).chain(words);
         match <ShardLine as clap::Parser>::try_parse_from(line) {
             Ok(_) => Ok(()),
             Err(e) => {
@@ -219,7 +217,6 @@ fn slurm_script(job: &Job) -> String {
         None => sh(program),
     };
     let out = job.out.display().to_string();
-    let extra: String = job.render_args.iter().map(|a| format!(" {}", sh(a))).collect();
     let partition = job
         .partition
         .as_ref()
@@ -242,7 +239,7 @@ shards=$(sbatch --parsable <<'SHARDS'
 {partition}#SBATCH --output={out_q}/logs/shard_%a.out
 set -euo pipefail
 K=$SLURM_ARRAY_TASK_ID
-{run} render {scene_q} --shard "$K/{shards}" --passes {passes} --threads {threads} --out {out_q}/part_$K.exr --force{extra}
+{run} render {flags}
 SHARDS
 )
 shards=${{shards%%;*}}
@@ -261,7 +258,7 @@ MERGE
 echo "merge: job ${{merge%%;*}} (writes {out_q}/image.exr)"
 "#,
         scene = job.scene.display(),
-        scene_q = sh(&job.scene.display().to_string()),
+        flags = job.shard_flags("$K"),
         shards = job.shards,
         passes = job.passes,
         last = job.shards - 1,
@@ -278,15 +275,10 @@ fn kubernetes_manifest(job: &Job) -> Result<String> {
     let program = job.program.as_deref().unwrap_or("caustic");
     let scene = job.scene.display().to_string();
     let out = job.out.display().to_string();
-    let extra: String = job.render_args.iter().map(|a| format!(" {}", sh(a))).collect();
     let shard_command = format!(
-        "exec {} render {} --shard \"$JOB_COMPLETION_INDEX/{}\" --passes {} --threads {} --out {}/part_$JOB_COMPLETION_INDEX.exr --force{extra}",
+        "exec {} render {}",
         sh(program),
-        sh(&scene),
-        job.shards,
-        job.passes,
-        job.threads,
-        sh(&out)
+        job.shard_flags("$JOB_COMPLETION_INDEX")
     );
     let merge_command = format!(
         "until [ \"$(ls {out_q}/part_*.exr 2>/dev/null | wc -l)\" -ge {n} ]; do sleep 10; done; exec {} merge {out_q}/part_*.exr --out {out_q}/image.exr --force",
