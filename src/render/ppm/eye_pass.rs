@@ -200,20 +200,27 @@ impl Ppm {
             return;
         }
         let start = Instant::now();
-        let slots = &self.slots;
-        let light = direct::area_light_pass(
-            scene,
-            &self.points,
-            |k| self.points.shade[k].slot as u64,
-            self.stream_pass(),
-            self.seed,
-        );
-        for (shade, l) in self.points.shade.iter().zip(light) {
-            let pixel = slots[shade.slot as usize].pixel as usize;
-            if self.stochastic {
-                self.pass_direct[pixel] += l.as_vec3();
-            } else {
-                self.area_direct[pixel] += l;
+        let (pass, points) = (self.stream_pass(), self.points.len());
+        let mut light = Vec::with_capacity(direct::BLOCK.min(points));
+        for start in (0..points).step_by(direct::BLOCK) {
+            let block = start..(start + direct::BLOCK).min(points);
+            let key = |k: usize| self.points.shade[k].slot as u64;
+            direct::area_light_pass(
+                scene,
+                &self.points,
+                block.clone(),
+                key,
+                pass,
+                self.seed,
+                &mut light,
+            );
+            for (shade, &l) in self.points.shade[block].iter().zip(&light) {
+                let pixel = self.slots[shade.slot as usize].pixel as usize;
+                if self.stochastic {
+                    self.pass_direct[pixel] += l.as_vec3();
+                } else {
+                    self.area_direct[pixel] += l;
+                }
             }
         }
         self.stats.direct_secs += start.elapsed().as_secs_f64();
