@@ -1,6 +1,7 @@
 //! A bounding volume hierarchy over primitive bounds: binned SAH construction (Wald 2007,
 //! "On fast construction of SAH-based bounding volume hierarchies"; pbrt-v4 `BVHAggregate`)
-//! flattened into a depth-first array, traversed front-to-back with an explicit stack.
+//! flattened into a depth-first array, traversed with an explicit stack, at each node the child
+//! nearer along its split axis first (pbrt-v4's `BVHAggregate::Intersect`).
 
 use glam::DVec3;
 
@@ -17,7 +18,7 @@ pub struct BvhNode {
     pub offset: u32,
     /// Number of primitives; 0 for an interior node.
     pub count: u16,
-    /// Split axis of an interior node.
+    /// Split axis of an interior node: its first child holds the lower side.
     pub axis: u8,
 }
 
@@ -174,7 +175,7 @@ impl Bvh {
         node
     }
 
-    /// Visits, front to back, every primitive whose leaf the ray reaches before `t_max`
+    /// Visits, nearer children first, every primitive whose leaf the ray reaches before `t_max`
     /// (in a tree of at most [`FLAT_PRIMITIVES`], every primitive, in the tree's order).
     /// `visit(primitive, t_max, span)` returns the distance of a nearer hit, which then bounds
     /// the rest of the traversal; `span` is the piece `(near, far)` of the ray inside the
@@ -265,6 +266,8 @@ impl Bvh {
         mut visit: impl FnMut(u32, f64, (f64, f64)) -> Option<f64>,
         stack: Stack<'_>,
     ) -> f64 {
+        // Along which axes the ray runs towards lower coordinates.
+        let negative = [ray.dir.x < 0.0, ray.dir.y < 0.0, ray.dir.z < 0.0];
         let mut top = 0usize;
         let mut node = 0usize;
         // The piece of the ray inside the current node's box.
@@ -279,13 +282,21 @@ impl Bvh {
                     }
                 }
             } else {
-                // Test both children here; go to the nearer, keep the farther for later.
+                // Test both children here; go to the nearer, keep the farther for later. The
+                // nearer is the one on the near side of the node's split axis for the ray's
+                // direction (the first child holds the lower side; pbrt-v4's `dirIsNeg`): the
+                // same answer at every node split on that axis, so the branch is predicted,
+                // where comparing the two entries was the walk's most mispredicted one.
+                // Equal entries keep the first child first, as comparing them did, so that
+                // primitives met at exactly one distance (two walls along their shared edge)
+                // resolve as they always have.
                 let (a, b) = (node + 1, n.offset as usize);
                 let ha = self.nodes[a].bounds.hit_interval(ray.origin, inv_dir, t_max);
                 let hb = self.nodes[b].bounds.hit_interval(ray.origin, inv_dir, t_max);
                 match (ha, hb) {
                     (Some(sa), Some(sb)) => {
-                        let ((near, s_near), (far, s_far)) = if sa.0 <= sb.0 {
+                        let first = sa.0 == sb.0 || !negative[n.axis as usize];
+                        let ((near, s_near), (far, s_far)) = if first {
                             ((a, sa), (b, sb))
                         } else {
                             ((b, sb), (a, sa))
