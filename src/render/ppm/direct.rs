@@ -29,55 +29,89 @@ pub fn has_area_lights(scene: &Scene) -> bool {
     scene.lights.iter().any(|l| l.is_area())
 }
 
-/// Points [`area_light_pass`] samples at a time: the light it hands back takes 24 bytes a
-/// point, and for a whole pass's points at 1920×1080 that was 50 MiB of the render's peak
-/// (`caustic bench memory`), where a block's is 1.5 MiB. Large enough that each block keeps
-/// every thread busy.
-pub const BLOCK: usize = 1 << 16;
+/// Points [`area_light_pass`] samples at a time: their light takes 24 bytes a point, and
+/// for a whole pass's points at 1920×1080 that was 50 MiB of the render's peak (`caustic
+/// bench memory`), where a block's is 1.5 MiB. Large enough that each block keeps every
+/// thread busy.
+const BLOCK: usize = 1 << 16;
 
-/// Reflected radiance from every area light at the points `block` (one sample each), in point
-/// order, into `light` (replacing what it held, keeping its memory): `point.weight × L ×
-/// cos θ / pdf` where the shadow ray is clear. `key(k)` names point `k` stably across passes
-/// (its statistics slot), for the stratification.
+/// Reflected radiance from every area light at each point (one sample each), handed to
+/// `add(k, light)` in point order: `point.weight × L × cos θ / pdf` where the shadow ray is
+/// clear. `key(k)` names point `k` stably across passes (its statistics slot), for the
+/// stratification. Sampled [`BLOCK`] points at a time, in parallel.
 pub fn area_light_pass(
     scene: &Scene,
     points: &VisiblePoints,
-    block: Range<usize>,
     key: impl Fn(usize) -> u64 + Sync,
     pass: u64,
     seed: u64,
-    light: &mut Vec<DVec3>,
+    mut add: impl FnMut(usize, DVec3),
 ) {
-    let lights: Vec<(u64, &crate::scene::Light)> =
-        (0u64..).zip(&scene.lights).filter(|(_, l)| l.is_area()).collect();
-    let count = scene.lights.len() as u64;
-    let first = block.start;
-    points.reach[block.clone()]
-        .par_iter()
-        .zip(&points.shade[block])
-        .enumerate()
-        .map(|(i, (reach, shade))| {
-            let k = first + i;
-            let (position, normal) = (reach.position, shade.normal.as_dvec3());
-            let mut sum = DVec3::ZERO;
-            for &(l, light) in &lights {
-                let mut rng = stream_rng(seed, OFFSET_STREAM, key(k) * count + l);
-                let offset = DVec2::new(rng.random(), rng.random());
-                let u = sequence::rotated(sequence::r4(pass)[1], offset);
-                let Some(ls) = light.sample(position, u) else {
-                    continue;
-                };
-                let cos = normal.dot(ls.wi);
-                if cos <= 0.0 {
-                    continue;
+    let sampler = Sampler::new(scene, points, key, pass, seed);
+    let mut light = Vec::with_capacity(BLOCK.min(points.len()));
+    for first in (0..points.len()).step_by(BLOCK) {
+        sampler.sample(first..(first + BLOCK).min(points.len()), &mut light);
+        for (k, &l) in (first..).zip(&light) {
+            add(k, l);
+        }
+    }
+}
+
+/// What sampling the area lights at a pass's points needs.
+struct Sampler<'a, K> {
+    scene: &'a Scene,
+    points: &'a VisiblePoints,
+    key: K,
+    pass: u64,
+    seed: u64,
+    /// The scene's area lights with their indices.
+    lights: Vec<(u64, &'a crate::scene::Light)>,
+}
+
+impl<'a, K: Fn(usize) -> u64 + Sync> Sampler<'a, K> {
+    fn new(scene: &'a Scene, points: &'a VisiblePoints, key: K, pass: u64, seed: u64) -> Self {
+        Self {
+            scene,
+            points,
+            key,
+            pass,
+            seed,
+            lights: (0u64..).zip(&scene.lights).filter(|(_, l)| l.is_area()).collect(),
+        }
+    }
+
+    /// The light at the points `block`, in point order, into `light` (replacing what it held,
+    /// keeping its memory).
+    fn sample(&self, block: Range<usize>, light: &mut Vec<DVec3>) {
+        let (scene, count) = (self.scene, self.scene.lights.len() as u64);
+        let first = block.start;
+        self.points.reach[block.clone()]
+            .par_iter()
+            .zip(&self.points.shade[block])
+            .enumerate()
+            .map(|(i, (reach, shade))| {
+                let k = first + i;
+                let (position, normal) = (reach.position, shade.normal.as_dvec3());
+                let mut sum = DVec3::ZERO;
+                for &(l, light) in &self.lights {
+                    let mut rng = stream_rng(self.seed, OFFSET_STREAM, (self.key)(k) * count + l);
+                    let offset = DVec2::new(rng.random(), rng.random());
+                    let u = sequence::rotated(sequence::r4(self.pass)[1], offset);
+                    let Some(ls) = light.sample(position, u) else {
+                        continue;
+                    };
+                    let cos = normal.dot(ls.wi);
+                    if cos <= 0.0 {
+                        continue;
+                    }
+                    if !scene.occluded_from(position, normal, l as usize, &ls) {
+                        sum += shade.weight.as_dvec3() * ls.incident * cos;
+                    }
                 }
-                if !scene.occluded_from(position, normal, l as usize, &ls) {
-                    sum += shade.weight.as_dvec3() * ls.incident * cos;
-                }
-            }
-            sum
-        })
-        .collect_into_vec(light);
+                sum
+            })
+            .collect_into_vec(light);
+    }
 }
 
 #[cfg(test)]
@@ -103,8 +137,9 @@ mod tests {
             })
             .collect();
         let key = |k: usize| 7 * k as u64 + 3;
+        let sampler = Sampler::new(&scene, &points, key, 5, 11);
         let mut whole = Vec::new();
-        area_light_pass(&scene, &points, 0..n, key, 5, 11, &mut whole);
+        sampler.sample(0..n, &mut whole);
         assert_eq!(whole.len(), n);
         let lit = whole.iter().filter(|l| l.max_element() > 0.0).count();
         assert!(
@@ -113,9 +148,13 @@ mod tests {
         );
         let (mut blocked, mut block) = (Vec::new(), Vec::new());
         for range in [0..1, 1..1000, 1000..1000, 1000..n - 1, n - 1..n] {
-            area_light_pass(&scene, &points, range, key, 5, 11, &mut block);
+            sampler.sample(range, &mut block);
             blocked.extend_from_slice(&block);
         }
         assert_eq!(whole, blocked);
+        // The pass hands every point's light once, in point order.
+        let mut handed = Vec::new();
+        area_light_pass(&scene, &points, key, 5, 11, |k, l| handed.push((k, l)));
+        assert_eq!(handed, whole.into_iter().enumerate().collect::<Vec<_>>());
     }
 }

@@ -200,29 +200,19 @@ impl Ppm {
             return;
         }
         let start = Instant::now();
-        let (pass, points) = (self.stream_pass(), self.points.len());
-        let mut light = Vec::with_capacity(direct::BLOCK.min(points));
-        for start in (0..points).step_by(direct::BLOCK) {
-            let block = start..(start + direct::BLOCK).min(points);
-            let key = |k: usize| self.points.shade[k].slot as u64;
-            direct::area_light_pass(
-                scene,
-                &self.points,
-                block.clone(),
-                key,
-                pass,
-                self.seed,
-                &mut light,
-            );
-            for (shade, &l) in self.points.shade[block].iter().zip(&light) {
-                let pixel = self.slots[shade.slot as usize].pixel as usize;
-                if self.stochastic {
-                    self.pass_direct[pixel] += l.as_vec3();
-                } else {
-                    self.area_direct[pixel] += l;
-                }
+        let (pass, seed) = (self.stream_pass(), self.seed);
+        let shade = &self.points.shade;
+        let key = |k: usize| shade[k].slot as u64;
+        let (slots, stochastic) = (&self.slots, self.stochastic);
+        let (pass_direct, area_direct) = (&mut self.pass_direct, &mut self.area_direct);
+        direct::area_light_pass(scene, &self.points, key, pass, seed, |k, l| {
+            let pixel = slots[shade[k].slot as usize].pixel as usize;
+            if stochastic {
+                pass_direct[pixel] += l.as_vec3();
+            } else {
+                area_direct[pixel] += l;
             }
-        }
+        });
         self.stats.direct_secs += start.elapsed().as_secs_f64();
     }
 }
