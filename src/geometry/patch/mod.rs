@@ -384,6 +384,23 @@ fn hull(p: &BezierPatch) -> (DVec3, DVec3) {
 }
 
 impl Problem {
+    /// A search over the ray-space sub-patch `p` of a patch whose bounds' diagonal is `scale`:
+    /// its tolerance and its normals' rounding bound come from `p`'s own coordinates
+    /// ([`rounding`], [`tolerance`]); `deviation` is [`Problem::deviation`]'s.
+    fn new(p: &BezierPatch, scale: f64, t_min: f64, any: bool, deviation: f64) -> Self {
+        let rounding = rounding(p);
+        Self {
+            budget: SPLIT_BUDGET,
+            t_min,
+            tolerance: tolerance(scale, rounding),
+            scale,
+            rounding,
+            best: None,
+            any,
+            deviation,
+        }
+    }
+
     /// Whether a ray-space patch with hull `(lo, hi)` can meet the ray within `(t_min, t_max)`.
     #[inline]
     fn may_hit(&self, (lo, hi): (DVec3, DVec3), t_max: f64) -> bool {
@@ -635,17 +652,7 @@ fn search_leaf(
         }
     }
     let p = frame.project(&leaf.sub_patch);
-    let rounding = rounding(&p);
-    let mut problem = Problem {
-        budget: SPLIT_BUDGET,
-        t_min,
-        tolerance: tolerance(leaf.scale, rounding),
-        scale: leaf.scale,
-        rounding,
-        best: None,
-        any,
-        deviation: leaf.deviation,
-    };
+    let mut problem = Problem::new(&p, leaf.scale, t_min, any, leaf.deviation);
     if problem.may_hit(hull(&p), t_max) {
         // In ray space the Jacobian is n·d too; its interval test sometimes proves the sign
         // where the cone does not.
@@ -699,17 +706,7 @@ pub fn intersect_per_ray(
     let mut best: Option<PatchHit> = None;
     for (sub, window) in survivors {
         let p = frame.project(&sub);
-        let rounding = rounding(&p);
-        let mut problem = Problem {
-            budget: SPLIT_BUDGET,
-            t_min,
-            tolerance: tolerance(scale, rounding),
-            scale,
-            rounding,
-            best: None,
-            any: false,
-            deviation: f64::INFINITY,
-        };
+        let mut problem = Problem::new(&p, scale, t_min, false, f64::INFINITY);
         problem.run(&p, window, LEAF_FALLBACK_DEPTH, best.map_or(t_max, |h| h.t));
         if let Some(found) = problem.best {
             best = Some(frame.hit(found));
