@@ -207,6 +207,53 @@ fn ppm_is_identical_for_one_and_two_threads() {
     }
 }
 
+/// A frame's per-pixel layers, swept in parallel blocks that each find their first slot by a
+/// binary search, are each pixel's values from its own slots, for 1 and 2 threads: at
+/// 96×72 two blocks, the second partial, and with a pinhole camera (classic PPM) glass
+/// splits eye paths, so some pixels have several slots and some none.
+#[test]
+fn a_frames_pixel_layers_are_each_pixels_slots() {
+    let mut scene = cornell_small(0.0);
+    (scene.camera.width, scene.camera.height) = (96, 72);
+    let layers = |threads: usize| {
+        pool(threads).install(|| {
+            let mut ppm = Ppm::new(&scene, PpmOptions::default());
+            for _ in 0..2 {
+                ppm.run_pass(&scene, &mut |_| Control::Continue);
+            }
+            let mut slot_counts = [0usize; 3];
+            for slots in ppm.slots_by_pixel() {
+                slot_counts[slots.len().min(2)] += 1;
+            }
+            assert!(
+                slot_counts.iter().all(|&n| n > 0),
+                "pixels with 0, 1, 2+ slots: {slot_counts:?}"
+            );
+            let layers = ppm.pixel_layers();
+            assert_eq!(&layers.radiance[..], &ppm.radiance()[..]);
+            for (k, slots) in ppm.slots_by_pixel().enumerate() {
+                let largest = slots
+                    .iter()
+                    .map(|s| s.primary.radius2().sqrt() as f32)
+                    .fold(0.0, f32::max);
+                let gathered = slots
+                    .iter()
+                    .fold(0.0, |sum, s| sum + (s.primary.n() + s.indirect.n()) as f32);
+                assert_eq!(
+                    (layers.radius[k], layers.gathered[k]),
+                    (largest, gathered),
+                    "pixel {k}"
+                );
+            }
+            assert!(layers.gathered.iter().any(|&n| n > 0.0));
+            layers
+        })
+    };
+    let (one, two) = (layers(1), layers(2));
+    assert_eq!(one.radiance, two.radiance);
+    assert_eq!((&one.radius, &one.gathered), (&two.radius, &two.gathered));
+}
+
 #[test]
 fn kd_tree_and_hash_grid_find_the_same_points() {
     let scene = cornell_small(0.0);

@@ -1,7 +1,6 @@
 //! Progressive photon mapping ([`crate::render::ppm`]) as an integrator: a pass at a time, α
 //! and the photon counts taken from each pass's plan.
 
-use std::sync::Arc;
 
 use super::{Integrator, PassPlan, Setup};
 use crate::render::frame::{Frame, FrameStats, StatRow};
@@ -72,7 +71,7 @@ impl Frame {
     pub fn from_ppm(ppm: &Ppm, epoch: u64, elapsed_secs: f64) -> Frame {
         let (width, height) = ppm.size();
         let stats = ppm.stats().clone();
-        let (radius, gathered) = pixel_statistics(ppm);
+        let layers = ppm.pixel_layers();
         Frame {
             epoch,
             pass: stats.passes,
@@ -81,35 +80,12 @@ impl Frame {
             stats: FrameStats::from(stats),
             width,
             height,
-            radiance: ppm.radiance_shared(),
-            radius,
-            gathered,
+            radiance: layers.radiance,
+            radius: layers.radius,
+            gathered: layers.gathered,
             preview: false,
         }
     }
-}
-
-/// Per-pixel search radius (largest of the pixel's slots) and photon count (sum of them),
-/// each made in one allocation.
-fn pixel_statistics(ppm: &Ppm) -> (Arc<[f32]>, Arc<[f32]>) {
-    let radius = ppm
-        .slots_by_pixel()
-        .map(|slots| {
-            slots
-                .iter()
-                .map(|s| s.primary.radius2().sqrt() as f32)
-                .fold(0.0, f32::max)
-        })
-        .collect();
-    let gathered = ppm
-        .slots_by_pixel()
-        .map(|slots| {
-            slots
-                .iter()
-                .fold(0.0, |sum, s| sum + (s.primary.n() + s.indirect.n()) as f32)
-        })
-        .collect();
-    (radius, gathered)
 }
 
 /// A number with thousands separators.
