@@ -1,7 +1,6 @@
 //! Progressive photon mapping ([`crate::render::ppm`]) as an integrator: a pass at a time, α
 //! and the photon counts taken from each pass's plan.
 
-
 use super::{Integrator, PassPlan, Setup};
 use crate::render::frame::{Frame, FrameStats, StatRow};
 use crate::render::ppm::{Control, PassOutcome, Ppm, PpmStats};
