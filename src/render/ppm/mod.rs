@@ -478,11 +478,16 @@ impl Ppm {
     /// What a frame shows per pixel — [`Ppm::radiance`], the largest search radius of the
     /// pixel's slots and the photons they gathered — each in one allocation, made in one
     /// parallel sweep over the slots, [`PIXEL_BLOCK`] pixels a task (each block finds its
-    /// first slot by a binary search: they lie in pixel order). Three serial sweeps were
-    /// 24–34 ms of every 600-ms pass of `caustic bench ppm` on 2 threads; each pixel's values
-    /// depend on it alone, so they are the same for any number of threads.
+    /// first slot by a binary search: they lie in pixel order). Three serial sweeps took
+    /// 31–42 ms of every 600-ms pass of `caustic bench ppm` on 2 threads, one parallel sweep
+    /// takes 15–19 ms; each pixel's values depend on it alone, so they are the same for any
+    /// number of threads.
     pub fn pixel_layers(&self) -> PixelLayers {
         use rayon::prelude::*;
+        debug_assert!(
+            self.slots.is_sorted_by_key(|s| s.pixel),
+            "slots lie in pixel order"
+        );
         let n = self.direct.len();
         let mut radiance: Arc<[[f32; 3]]> = std::iter::repeat_n([0.0; 3], n).collect();
         let mut radius: Arc<[f32]> = std::iter::repeat_n(0.0, n).collect();
@@ -520,6 +525,8 @@ impl Ppm {
                         .fold(0.0, |sum, s| sum + (s.primary.n() + s.indirect.n()) as f32);
                 }
             });
+        // The global schedule's radiance is the mean of its passes' sums, not the slots' (the
+        // sweep left its layer zero).
         if let Some(g) = &self.global {
             radiance = g.sums.mean().into();
         }
