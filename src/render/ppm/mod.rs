@@ -489,11 +489,16 @@ impl Ppm {
             "slots lie in pixel order"
         );
         let n = self.direct.len();
-        let mut radiance: Arc<[[f32; 3]]> = std::iter::repeat_n([0.0; 3], n).collect();
+        // The global schedule's radiance is the mean of its passes' sums, not the slots'.
+        let per_point = self.global.is_none();
+        let mut radiance: Arc<[[f32; 3]]> = match &self.global {
+            Some(g) => g.sums.mean().into(),
+            None => std::iter::repeat_n([0.0; 3], n).collect(),
+        };
         let mut radius: Arc<[f32]> = std::iter::repeat_n(0.0, n).collect();
         let mut gathered: Arc<[f32]> = std::iter::repeat_n(0.0, n).collect();
-        let per_point = self.global.is_none();
         let unique = "a new Arc has no other owner";
+        debug_assert_eq!(radiance.len(), n);
         Arc::get_mut(&mut radiance)
             .expect(unique)
             .par_chunks_mut(PIXEL_BLOCK)
@@ -525,11 +530,6 @@ impl Ppm {
                         .fold(0.0, |sum, s| sum + (s.primary.n() + s.indirect.n()) as f32);
                 }
             });
-        // The global schedule's radiance is the mean of its passes' sums, not the slots' (the
-        // sweep left its layer zero).
-        if let Some(g) = &self.global {
-            radiance = g.sums.mean().into();
-        }
         PixelLayers {
             radiance,
             radius,
