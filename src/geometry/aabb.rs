@@ -18,6 +18,9 @@ pub struct Aabb {
 /// `γ₃ = 3ε / (1 - 3ε)`, the rounding bound pbrt uses to pad the slab test's far distance.
 const GAMMA3: f64 = 3.0 * f64::EPSILON * 0.5 / (1.0 - 3.0 * f64::EPSILON * 0.5);
 
+/// The factor the slab test pads its far distance by, `1 + 2γ₃` (pbrt-v4's `Bounds3::IntersectP`).
+pub(crate) const FAR_SCALE: f64 = 1.0 + 2.0 * GAMMA3;
+
 impl Default for Aabb {
     fn default() -> Self {
         Self::EMPTY
@@ -119,7 +122,7 @@ impl Aabb {
         let a = (self.min - origin) * inv_dir;
         let b = (self.max - origin) * inv_dir;
         let near = DVec3::new(min(a.x, b.x), min(a.y, b.y), min(a.z, b.z));
-        let far = DVec3::new(max(a.x, b.x), max(a.y, b.y), max(a.z, b.z)) * (1.0 + 2.0 * GAMMA3);
+        let far = DVec3::new(max(a.x, b.x), max(a.y, b.y), max(a.z, b.z)) * FAR_SCALE;
         let t0 = max(max(max(near.x, near.y), near.z), 0.0);
         let t1 = min(min(min(far.x, far.y), far.z), t_max);
         (t0 <= t1).then_some((t0, t1))

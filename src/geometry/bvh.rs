@@ -2,10 +2,19 @@
 //! "On fast construction of SAH-based bounding volume hierarchies"; pbrt-v4 `BVHAggregate`)
 //! flattened into a depth-first array, traversed with an explicit stack, at each node the child
 //! nearer along its split axis first (pbrt-v4's `BVHAggregate::Intersect`).
+//!
+//! The walk reads the interior nodes in a second layout ([`NodePair`]): each holds its two
+//! children's boxes side by side, as wider BVHs do (Wald et al. 2008, "Getting rid of packets";
+//! Embree's BVH4 has four), so one step loads one record and tests both boxes with two-wide
+//! arithmetic. On `bench intersect` that took the teapot's hitting rays from 678 to 642 ns (the
+//! least of six interleaved runs each; 813 against 856 in a second set, on a slower host).
+//! Glass-teapot renders did not change measurably. Four boxes a step, tried too, was slower:
+//! its records span four cache lines and its lane ordering branches (hitting rays 784-867 ns
+//! against 696-905, missing rays 87-90 ns against 61-62, interleaved).
 
 use glam::DVec3;
 
-use super::aabb::{safe_inverse, Aabb};
+use super::aabb::{safe_inverse, Aabb, FAR_SCALE};
 use super::ray::Ray;
 
 /// A flattened node: an interior node's first child follows it, the second is at `offset`; a
@@ -31,6 +40,59 @@ pub struct Bvh {
     pub order: Vec<u32>,
     /// Depth of the deepest leaf: a traversal's stack holds fewer entries than this.
     levels: usize,
+    /// The interior nodes as the walk reads them, both children's boxes side by side
+    /// ([`NodePair`]), in depth-first order; derived from `nodes` after a build or a refit.
+    pairs: Vec<NodePair>,
+}
+
+/// A child as the walk sees it: a leaf's primitives (`count > 0`, starting at `index` in
+/// [`Bvh::order`]) or an interior node (`count == 0`, [`Bvh::pairs`]' entry `index`).
+#[derive(Clone, Copy, Debug, Default)]
+struct Child {
+    index: u32,
+    count: u16,
+}
+
+/// An interior node laid out for the walk: its two children's boxes coordinate by coordinate,
+/// the two side by side (`lo[axis][child]`), so that one pass of paired arithmetic tests both
+/// (two-wide SIMD, which SSE2 has for `f64`), from one place in memory. Each lane computes
+/// exactly [`Aabb::hit_interval`]'s arithmetic in its order, so spans, and everything that
+/// follows from them, are the same as testing the children's own nodes one by one.
+#[derive(Clone, Copy, Debug)]
+struct NodePair {
+    lo: [[f64; 2]; 3],
+    hi: [[f64; 2]; 3],
+    child: [Child; 2],
+    /// The node's split axis: its first child holds the lower side.
+    axis: u8,
+}
+
+impl NodePair {
+    /// The pieces `(near, far)` of the ray inside each child's box, clipped to `[0, t_max]`
+    /// (a lane whose `near > far` misses): [`Aabb::hit_interval`] for both children at once.
+    #[inline(always)]
+    fn hit_intervals(&self, origin: DVec3, inv_dir: DVec3, t_max: f64) -> ([f64; 2], [f64; 2]) {
+        let min = |a: f64, b: f64| if a < b { a } else { b };
+        let max = |a: f64, b: f64| if a > b { a } else { b };
+        let (o, inv) = (origin.to_array(), inv_dir.to_array());
+        let mut near = [[0.0; 2]; 3];
+        let mut far = [[0.0; 2]; 3];
+        for k in 0..3 {
+            for c in 0..2 {
+                let a = (self.lo[k][c] - o[k]) * inv[k];
+                let b = (self.hi[k][c] - o[k]) * inv[k];
+                near[k][c] = min(a, b);
+                far[k][c] = max(a, b) * FAR_SCALE;
+            }
+        }
+        let mut t0 = [0.0; 2];
+        let mut t1 = [0.0; 2];
+        for c in 0..2 {
+            t0[c] = max(max(max(near[0][c], near[1][c]), near[2][c]), 0.0);
+            t1[c] = min(min(min(far[0][c], far[1][c]), far[2][c]), t_max);
+        }
+        (t0, t1)
+    }
 }
 
 const BINS: usize = 16;
@@ -50,6 +112,7 @@ const LONG_STACK: usize = 64;
 /// it leaves them.
 struct Stack<'a> {
     node: &'a mut [u32],
+    count: &'a mut [u16],
     enter: &'a mut [f64],
     exit: &'a mut [f64],
 }
@@ -76,12 +139,52 @@ impl Bvh {
             nodes: Vec::with_capacity(2 * bounds.len()),
             order: Vec::with_capacity(bounds.len()),
             levels: 0,
+            pairs: Vec::new(),
         };
         if !items.is_empty() {
             bvh.build_node(&mut items);
         }
         bvh.levels = bvh.measure_depth();
+        bvh.pair_up();
         bvh
+    }
+
+    /// Derives [`Bvh::pairs`] from [`Bvh::nodes`]: interior nodes keep their depth-first order,
+    /// so a node's first child, when interior, is the next pair.
+    fn pair_up(&mut self) {
+        let mut pair_of = Vec::with_capacity(self.nodes.len());
+        let mut interior = 0u32;
+        for n in &self.nodes {
+            pair_of.push(interior);
+            interior += (n.count == 0) as u32;
+        }
+        let child = |node: usize| {
+            let n = &self.nodes[node];
+            if n.count > 0 {
+                Child {
+                    index: n.offset,
+                    count: n.count,
+                }
+            } else {
+                Child {
+                    index: pair_of[node],
+                    count: 0,
+                }
+            }
+        };
+        self.pairs = (0..self.nodes.len())
+            .filter(|&i| self.nodes[i].count == 0)
+            .map(|i| {
+                let n = &self.nodes[i];
+                let (a, b) = (&self.nodes[i + 1].bounds, &self.nodes[n.offset as usize].bounds);
+                NodePair {
+                    lo: [0, 1, 2].map(|k| [a.min[k], b.min[k]]),
+                    hi: [0, 1, 2].map(|k| [a.max[k], b.max[k]]),
+                    child: [child(i + 1), child(n.offset as usize)],
+                    axis: n.axis,
+                }
+            })
+            .collect();
     }
 
     /// Bounds of everything, or the empty box.
@@ -212,6 +315,7 @@ impl Bvh {
         if self.levels <= SHORT_STACK {
             let stack = Stack {
                 node: &mut [0; SHORT_STACK],
+                count: &mut [0; SHORT_STACK],
                 enter: &mut [0.0; SHORT_STACK],
                 exit: &mut [0.0; SHORT_STACK],
             };
@@ -219,6 +323,7 @@ impl Bvh {
         } else if self.levels <= LONG_STACK {
             let stack = Stack {
                 node: &mut [0; LONG_STACK],
+                count: &mut [0; LONG_STACK],
                 enter: &mut [0.0; LONG_STACK],
                 exit: &mut [0.0; LONG_STACK],
             };
@@ -241,13 +346,15 @@ impl Bvh {
         t_max: f64,
         visit: impl FnMut(u32, f64, (f64, f64)) -> Option<f64>,
     ) -> f64 {
-        let (mut node, mut enter, mut exit) = (
+        let (mut node, mut count, mut enter, mut exit) = (
+            vec![0; self.levels],
             vec![0; self.levels],
             vec![0.0; self.levels],
             vec![0.0; self.levels],
         );
         let stack = Stack {
             node: &mut node,
+            count: &mut count,
             enter: &mut enter,
             exit: &mut exit,
         };
@@ -269,14 +376,17 @@ impl Bvh {
         // Along which axes the ray runs towards lower coordinates.
         let negative = [ray.dir.x < 0.0, ray.dir.y < 0.0, ray.dir.z < 0.0];
         let mut top = 0usize;
-        let mut node = 0usize;
+        let root_node = &self.nodes[0];
+        let mut node = Child {
+            index: if root_node.count > 0 { root_node.offset } else { 0 },
+            count: root_node.count,
+        };
         // The piece of the ray inside the current node's box.
         let mut span = root;
         loop {
-            let n = &self.nodes[node];
-            if n.count > 0 {
-                let first = n.offset as usize;
-                for &prim in &self.order[first..first + n.count as usize] {
+            if node.count > 0 {
+                let first = node.index as usize;
+                for &prim in &self.order[first..first + node.count as usize] {
                     if let Some(t) = visit(prim, t_max, span) {
                         t_max = t_max.min(t);
                     }
@@ -290,33 +400,35 @@ impl Bvh {
                 // Equal entries keep the first child first, as comparing them did, so that
                 // primitives met at exactly one distance (two walls along their shared edge)
                 // resolve as they always have.
-                let (a, b) = (node + 1, n.offset as usize);
-                let ha = self.nodes[a].bounds.hit_interval(ray.origin, inv_dir, t_max);
-                let hb = self.nodes[b].bounds.hit_interval(ray.origin, inv_dir, t_max);
-                match (ha, hb) {
-                    (Some(sa), Some(sb)) => {
-                        let first = sa.0 == sb.0 || !negative[n.axis as usize];
+                let pair = &self.pairs[node.index as usize];
+                let (t0, t1) = pair.hit_intervals(ray.origin, inv_dir, t_max);
+                let (a, b) = (pair.child[0], pair.child[1]);
+                let (sa, sb) = ((t0[0], t1[0]), (t0[1], t1[1]));
+                match (t0[0] <= t1[0], t0[1] <= t1[1]) {
+                    (true, true) => {
+                        let first = sa.0 == sb.0 || !negative[pair.axis as usize];
                         let ((near, s_near), (far, s_far)) = if first {
                             ((a, sa), (b, sb))
                         } else {
                             ((b, sb), (a, sa))
                         };
-                        stack.node[top] = far as u32;
+                        stack.node[top] = far.index;
+                        stack.count[top] = far.count;
                         stack.enter[top] = s_far.0;
                         stack.exit[top] = s_far.1;
                         top += 1;
                         (node, span) = (near, s_near);
                         continue;
                     }
-                    (Some(sa), None) => {
+                    (true, false) => {
                         (node, span) = (a, sa);
                         continue;
                     }
-                    (None, Some(sb)) => {
+                    (false, true) => {
                         (node, span) = (b, sb);
                         continue;
                     }
-                    (None, None) => {}
+                    (false, false) => {}
                 }
             }
             // Pop the next node the ray still reaches before the nearest hit so far.
@@ -326,7 +438,10 @@ impl Bvh {
                 }
                 top -= 1;
                 if stack.enter[top] <= t_max {
-                    node = stack.node[top] as usize;
+                    node = Child {
+                        index: stack.node[top],
+                        count: stack.count[top],
+                    };
                     span = (stack.enter[top], stack.exit[top]);
                     break;
                 }
@@ -366,6 +481,7 @@ impl Bvh {
                     .union(self.nodes[n.offset as usize].bounds)
             };
         }
+        self.pair_up();
     }
 
     /// Depth of the deepest leaf (for statistics and the stack-size guarantee).
@@ -464,6 +580,111 @@ mod tests {
                 }
             }
             assert!(hits > 100, "{n} boxes: {hits} of 500 rays hit");
+        }
+    }
+
+    /// The binary walk the paired layout replaced, over [`Bvh::nodes`] and their own boxes: a
+    /// reference for the order of the visits and their spans.
+    fn reference_walk(
+        bvh: &Bvh,
+        ray: &Ray,
+        mut t_max: f64,
+        visit: &mut dyn FnMut(u32, f64, (f64, f64)) -> Option<f64>,
+    ) {
+        let inv = safe_inverse(ray.dir);
+        let negative = [ray.dir.x < 0.0, ray.dir.y < 0.0, ray.dir.z < 0.0];
+        let Some(root) = bvh.nodes[0].bounds.hit_interval(ray.origin, inv, t_max) else {
+            return;
+        };
+        let mut stack = vec![(0usize, root)];
+        while let Some((node, span)) = stack.pop() {
+            if span.0 > t_max {
+                continue;
+            }
+            let n = bvh.nodes[node];
+            if n.count > 0 {
+                let first = n.offset as usize;
+                for &prim in &bvh.order[first..first + n.count as usize] {
+                    if let Some(t) = visit(prim, t_max, span) {
+                        t_max = t_max.min(t);
+                    }
+                }
+                continue;
+            }
+            let (a, b) = (node + 1, n.offset as usize);
+            let ha = bvh.nodes[a].bounds.hit_interval(ray.origin, inv, t_max);
+            let hb = bvh.nodes[b].bounds.hit_interval(ray.origin, inv, t_max);
+            match (ha, hb) {
+                (Some(sa), Some(sb)) => {
+                    let first = sa.0 == sb.0 || !negative[n.axis as usize];
+                    let (near, far) = if first {
+                        ((a, sa), (b, sb))
+                    } else {
+                        ((b, sb), (a, sa))
+                    };
+                    stack.push(far);
+                    stack.push(near);
+                }
+                (Some(sa), None) => stack.push((a, sa)),
+                (None, Some(sb)) => stack.push((b, sb)),
+                (None, None) => {}
+            }
+        }
+    }
+
+    #[test]
+    fn the_paired_walk_visits_as_the_binary_walk_did() {
+        // Boxes on a grid (many entries tie where rays run along a row) and a random cloud.
+        let mut x = 0x9E3779B97F4A7C15u64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let grid: Vec<Aabb> = (0..400)
+            .map(|i| {
+                let c = DVec3::new((i % 20) as f64, (i / 20) as f64, 0.0);
+                Aabb::new(c, c + DVec3::new(1.0, 1.0, 0.5))
+            })
+            .collect();
+        let cloud: Vec<Aabb> = (0..1500)
+            .map(|_| {
+                let c = DVec3::new(next(), next(), next()) * 20.0;
+                Aabb::new(c, c + DVec3::new(next(), next(), next()))
+            })
+            .collect();
+        for boxes in [grid, cloud] {
+            let bvh = Bvh::build(&boxes);
+            for k in 0..400 {
+                let o = DVec3::new(next() * 24.0 - 2.0, next() * 24.0 - 2.0, next() * 8.0 - 4.0);
+                // Every fourth ray runs along an axis, along the grid's rows and columns.
+                let d = if k % 4 == 0 {
+                    [DVec3::X, DVec3::NEG_Y, DVec3::Z][k / 4 % 3]
+                } else {
+                    DVec3::new(next() - 0.5, next() - 0.5, next() - 0.5)
+                };
+                let ray = Ray::new(o, d);
+                let inv = safe_inverse(ray.dir);
+                // A visit that records what it is shown and reports every other box's entry as a
+                // hit, so that t_max shrinks and prunes as a search's would.
+                let record = |log: &mut Vec<(u32, f64, (f64, f64))>, p: u32, t_max: f64, span: (f64, f64)| {
+                    log.push((p, t_max, span));
+                    p.is_multiple_of(2)
+                        .then(|| {
+                            boxes[p as usize]
+                                .hit_interval(ray.origin, inv, t_max)
+                                .map(|h| h.0)
+                        })
+                        .flatten()
+                };
+                let (mut walked, mut reference) = (Vec::new(), Vec::new());
+                bvh.traverse(&ray, f64::INFINITY, |p, t, span| record(&mut walked, p, t, span));
+                reference_walk(&bvh, &ray, f64::INFINITY, &mut |p, t, span| {
+                    record(&mut reference, p, t, span)
+                });
+                assert_eq!(walked, reference, "ray {k}");
+            }
         }
     }
 
