@@ -6,8 +6,9 @@ use std::f64::consts::PI;
 
 use super::gathered::Gathered;
 use super::radius::IndirectScale;
-use super::Ppm;
+use super::{Ppm, PARALLEL_MIN};
 use glam::{DVec3, Vec3};
+use rayon::prelude::*;
 
 /// One progressive density estimate (Hachisuka et al. 2008 §4): search radius², photon
 /// count `N` and flux `τ`, updated after every pass. Stored in f32 (20 bytes instead of 40:
@@ -156,19 +157,27 @@ impl Ppm {
         if let (Some(guide), Some(tally)) = (&mut self.guide, &gathered.tally) {
             guide.learn(tally);
         }
-        // Compute new photon counts, radii and flux (Hachisuka et al. 2008, eqs. 6–11).
+        // Compute new photon counts, radii and flux (Hachisuka et al. 2008, eqs. 6–11), slot by
+        // slot, [`PARALLEL_MIN`] a task. It is memory-bound (52-byte slots): in smallppm's scene
+        // at 1024×768 (`bench ppm`) an update took 15-17 ms with two threads serially and
+        // 11.6-16.7 ms in parallel; with one thread 14-16 ms either way.
         let alpha = self.alpha;
-        for (k, s) in self.slots.iter_mut().enumerate() {
-            if s.restart == Restart::Pending {
-                // The first pass's flux only stood in until this pass: it was gathered over
-                // the wide radius.
-                s.primary = Estimate::empty(s.primary.radius2());
-                s.restart = Restart::Restarted;
-            }
-            s.primary.update(gathered.flux(k, 0), gathered.count(k, 0), alpha);
-            s.indirect
-                .update(gathered.flux(k, 1), gathered.count(k, 1), alpha);
-        }
+        self.slots
+            .par_chunks_mut(PARALLEL_MIN)
+            .enumerate()
+            .for_each(|(chunk, slots)| {
+                for (k, s) in (chunk * PARALLEL_MIN..).zip(slots) {
+                    if s.restart == Restart::Pending {
+                        // The first pass's flux only stood in until this pass: it was
+                        // gathered over the wide radius.
+                        s.primary = Estimate::empty(s.primary.radius2());
+                        s.restart = Restart::Restarted;
+                    }
+                    s.primary.update(gathered.flux(k, 0), gathered.count(k, 0), alpha);
+                    s.indirect
+                        .update(gathered.flux(k, 1), gathered.count(k, 1), alpha);
+                }
+            });
         if self.indirect_scale == IndirectScale::Automatic && self.stats.passes == 0 {
             self.widen_indirect(&gathered);
         }

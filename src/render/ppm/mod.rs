@@ -235,6 +235,11 @@ fn skipped_work(scene: &Scene, stochastic: bool) -> Vec<String> {
     skipped
 }
 
+/// Items (slots, visible points) a task of a parallel sweep over them takes: large enough
+/// that handing out the tasks costs nothing beside them (with one thread, a sweep is as
+/// fast as a plain loop), small enough that two threads share a 320×240 image evenly.
+pub(super) const PARALLEL_MIN: usize = 4096;
+
 /// Pixels a task of [`Ppm::pixel_layers`] sweeps: large enough that finding its first slot
 /// costs nothing beside it, small enough that two threads share a 320×240 frame evenly.
 const PIXEL_BLOCK: usize = 4096;
