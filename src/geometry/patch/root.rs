@@ -63,14 +63,18 @@ pub(super) fn bilinear_start(p: &BezierPatch) -> (f64, f64) {
 /// Whether the ray passes farther than `tolerance` from the ray-space sub-patch `p`, judged by
 /// the bilinear patch `L` through its four corners.
 ///
-/// `p − L` is itself a Bézier patch whose control points are `P_ij − L(i/3, j/3)` (a bilinear
-/// patch degree-elevated to bicubic has the control points `L(i/3, j/3)`), so by the convex
-/// hull property every point of `p` lies within `δ = max |P_ij − L(i/3, j/3)|` of `L`. Where
-/// the corners form a strictly convex quadrilateral, `L` maps the unit square onto it, and a
-/// ray farther than `δ + tolerance` outside one of its edge lines meets no point of `p`. For a
-/// nearly flat sub-patch the quadrilateral is much tighter than the box of the control
-/// points: this one test replaces the Newton solves and splits that find no root where the
-/// ray passes beside a sub-patch (its root lies in a neighbour, or it misses).
+/// `p − L` is itself a Bézier patch whose control points are `D_ij = P_ij − L(i/3, j/3)` (a
+/// bilinear patch degree-elevated to bicubic has the control points `L(i/3, j/3)`). Where the
+/// corners form a strictly convex quadrilateral, `L` maps the unit square onto it, so by the
+/// convex hull property no point of `p` lies farther outside an edge line than
+/// `δ_e = max n_e·D_ij` (`n_e` the edge's outward unit normal), and a ray farther than `δ_e +
+/// tolerance` outside it meets no point of `p`. (`δ_e` is at most the largest `|D_ij|`, which
+/// `deviation` bounds, and is often far smaller: a flat leaf's deviations mostly lie along
+/// its edges. On `bench intersect`'s teapot the per-edge bound rules out 0.19 sub-patches per
+/// hitting ray against 0.13 for the largest `|D_ij|`, and the Newton steps fall from 4.58 to
+/// 4.35 per ray.) For a nearly flat sub-patch the quadrilateral is much tighter than the box
+/// of the control points: this one test replaces the Newton solves and splits that find no
+/// root where the ray passes beside a sub-patch (its root lies in a neighbour, or it misses).
 pub(super) fn beside(p: &BezierPatch, tolerance: f64, deviation: f64) -> bool {
     let corner = |k: usize| p.points[k].truncate();
     // Counter-clockwise or clockwise; the orientation comes from the first corner's turn.
@@ -92,16 +96,19 @@ pub(super) fn beside(p: &BezierPatch, tolerance: f64, deviation: f64) -> bool {
     if !turns.iter().all(|&turn| turn * orientation > 0.0) {
         return false;
     }
-    // Distance of the ray (the origin) outside each edge line; the largest one. An edge the
-    // origin lies inside of cannot decide the test (that needs a distance above the
-    // tolerance), so its length (a square root and a division) is not taken: a ray through
-    // the quadrilateral, as every hitting ray's is, takes none.
+    // Distance of the ray (the origin) outside each edge line (times the edge's length); the
+    // largest one. An edge the origin lies inside of cannot decide the test (that needs a
+    // distance above the tolerance), so its length (a square root) is not taken: a ray
+    // through the quadrilateral, as every hitting ray's is, takes none.
     let mut outside: f64 = 0.0;
-    for (edge, start) in edges.iter().zip(quad) {
+    let mut beyond = [(0.0, 0.0); 4];
+    for (k, (edge, start)) in edges.iter().zip(quad).enumerate() {
         // The origin relative to the edge's start, against the interior's side.
         let signed = -orientation * cross(*edge, -start);
         if signed > 0.0 {
-            outside = outside.max(signed / edge.length());
+            let length = edge.length();
+            beyond[k] = (signed, length);
+            outside = outside.max(signed / length);
         }
     }
     // (No NaN reaches here: a NaN corner fails the convexity test above.)
@@ -110,26 +117,37 @@ pub(super) fn beside(p: &BezierPatch, tolerance: f64, deviation: f64) -> bool {
     }
     // A bound on the deviation the caller knows (the leaf's, in space: its projection is no
     // larger) may settle it before the sixteen points are measured.
-    let margin = outside - tolerance;
-    if margin > deviation {
+    if outside - tolerance > deviation {
         return true;
     }
+    // The surface is `L + D`, `D` the Bézier patch of the deviations `D_ij`. Beyond an edge
+    // line, `L` lies inside (a convex quadrilateral holds `L`'s image) and `D` reaches at most
+    // `max n·D_ij`, `n` the edge's outward unit normal (the convex hull property): the ray
+    // misses when it lies farther than that, plus the tolerance, outside some edge. That is
+    // never looser than the largest `|D_ij|` and, for the edge a ray passes beside, often far
+    // tighter: a flat leaf's deviations mostly lie along the edges.
     let (p00, e, f, g) = (
         quad[0],
         edges[0],
         quad[3] - quad[0],
         quad[0] - quad[1] + quad[2] - quad[3],
     );
-    let mut deviation2: f64 = 0.0;
+    let mut reach = [f64::NEG_INFINITY; 4];
     for i in 0..4 {
         let s = i as f64 / 3.0;
         for j in 0..4 {
             let t = j as f64 / 3.0;
-            let bilinear = p00 + e * s + f * t + g * (s * t);
-            deviation2 = deviation2.max((corner(4 * i + j) - bilinear).length_squared());
+            let d = corner(4 * i + j) - (p00 + e * s + f * t + g * (s * t));
+            for (k, edge) in edges.iter().enumerate() {
+                // `n·D` times the edge's length.
+                reach[k] = reach[k].max(-orientation * cross(*edge, d));
+            }
         }
     }
-    margin * margin > deviation2
+    beyond
+        .iter()
+        .zip(reach)
+        .any(|(&(signed, length), reach)| signed > 0.0 && signed - tolerance * length > reach)
 }
 
 /// A root of a ray-space sub-patch: where the ray meets it.
@@ -287,4 +305,108 @@ pub(super) fn jacobian_sign(p: &BezierPatch) -> Option<f64> {
 pub(super) fn jacobian_at(p: &BezierPatch, s: f64, t: f64) -> f64 {
     let [_, fs, ft] = p.eval_xy_with_derivs(s, t);
     fs.x * ft.y - fs.y * ft.x
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    /// A curved sub-patch over the unit square: the bilinear patch through four corners, its
+    /// control points moved by up to `bend` in every coordinate.
+    fn bent_patch(next: &mut impl FnMut() -> f64, bend: f64) -> BezierPatch {
+        let corners = [
+            DVec2::new(0.0, 0.0) + DVec2::new(next(), next()) * 0.2,
+            DVec2::new(1.0, 0.0) + DVec2::new(next(), next()) * 0.2,
+            DVec2::new(0.0, 1.0) + DVec2::new(next(), next()) * 0.2,
+            DVec2::new(1.0, 1.0) + DVec2::new(next(), next()) * 0.2,
+        ];
+        let mut points = [DVec3::ZERO; 16];
+        for i in 0..4 {
+            for j in 0..4 {
+                let (s, t) = (i as f64 / 3.0, j as f64 / 3.0);
+                let xy = corners[0] * (1.0 - s) * (1.0 - t)
+                    + corners[1] * s * (1.0 - t)
+                    + corners[2] * (1.0 - s) * t
+                    + corners[3] * s * t;
+                let corner = (i == 0 || i == 3) && (j == 0 || j == 3);
+                let moved = if corner { 0.0 } else { bend };
+                let offset = DVec3::new(next() - 0.5, next() - 0.5, next() - 0.5) * 2.0 * moved;
+                points[4 * i + j] = xy.extend(2.0) + offset;
+            }
+        }
+        BezierPatch::new(points)
+    }
+
+    #[test]
+    fn beside_never_rules_out_a_ray_that_comes_within_the_tolerance() {
+        let mut x = 0x2545F4914F6CDD1Du64;
+        let mut next = move || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let tolerance = 0.02;
+        let (mut ruled_out, mut near) = (0, 0);
+        for _ in 0..300 {
+            let p = bent_patch(&mut next, 0.15);
+            // Points on the patch, densely: a ray passing within the tolerance of one of them
+            // may not be ruled out.
+            let samples: Vec<DVec2> = (0..=40)
+                .flat_map(|i| (0..=40).map(move |j| (i as f64 / 40.0, j as f64 / 40.0)))
+                .map(|(s, t)| p.eval(s, t).truncate())
+                .collect();
+            for _ in 0..40 {
+                // Rays from well inside to well outside the quadrilateral.
+                let ray = DVec2::new(next(), next()) * 1.8 - DVec2::splat(0.4);
+                let shifted = BezierPatch::new(p.points.map(|c| c - ray.extend(0.0)));
+                let verdict = beside(&shifted, tolerance, f64::INFINITY);
+                if samples.iter().any(|q| (*q - ray).length() <= tolerance) {
+                    near += 1;
+                    assert!(
+                        !verdict,
+                        "a ray through {ray} passes within the tolerance of the patch"
+                    );
+                }
+                ruled_out += verdict as usize;
+            }
+        }
+        assert!(
+            near > 2000 && ruled_out > 2000,
+            "near {near}, ruled out {ruled_out}"
+        );
+    }
+
+    #[test]
+    fn beside_bounds_each_edge_by_the_deviation_across_it() {
+        // The unit square, its inner control points pushed along the edge at x = 1 (in y)
+        // by 0.3: far from the bilinear patch, but not across that edge.
+        let mut points = [DVec3::ZERO; 16];
+        for i in 0..4 {
+            for j in 0..4 {
+                let along = if (1..3).contains(&i) && (1..3).contains(&j) {
+                    0.3
+                } else {
+                    0.0
+                };
+                points[4 * i + j] = DVec3::new(i as f64 / 3.0, j as f64 / 3.0 + along, 1.0);
+            }
+        }
+        let p = BezierPatch::new(points);
+        // A ray 0.1 beyond the edge x = 1: nearer than the largest deviation (0.3), farther
+        // than any deviation across the edge (none) and the tolerance.
+        let shifted = BezierPatch::new(p.points.map(|c| c - DVec3::new(1.1, 0.5, 0.0)));
+        assert!(beside(&shifted, 0.01, f64::INFINITY));
+        // Pushed across the edge instead, the same ray may meet the patch.
+        let mut across = points;
+        for (k, q) in across.iter_mut().enumerate() {
+            let (i, j) = (k / 4, k % 4);
+            if (1..3).contains(&i) && (1..3).contains(&j) {
+                *q = DVec3::new(i as f64 / 3.0 + 0.3, j as f64 / 3.0, 1.0);
+            }
+        }
+        let shifted = BezierPatch::new(across.map(|c| c - DVec3::new(1.1, 0.5, 0.0)));
+        assert!(!beside(&shifted, 0.01, f64::INFINITY));
+    }
 }
