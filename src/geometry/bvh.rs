@@ -6,11 +6,12 @@
 //! The walk reads the interior nodes in a second layout ([`NodePair`]): each holds its two
 //! children's boxes side by side, as wider BVHs do (Wald et al. 2008, "Getting rid of packets";
 //! Embree's BVH4 has four), so one step loads one record and tests both boxes with two-wide
-//! arithmetic. On `bench intersect` that took the teapot's hitting rays from 678 to 642 ns (the
-//! least of six interleaved runs each; 813 against 856 in a second set, on a slower host).
-//! Glass-teapot renders did not change measurably. Four boxes a step, tried too, was slower:
-//! its records span four cache lines and its lane ordering branches (hitting rays 784-867 ns
-//! against 696-905, missing rays 87-90 ns against 61-62, interleaved).
+//! arithmetic. The gain is small: on `bench intersect` the teapot's hitting rays took 642 ns
+//! against 678 at best (six interleaved runs each; 813 against 856 in a second set, on a
+//! slower host), and in two calmer sets later, with a tighter patch test as well, 642-669
+//! against 658-686. Glass-teapot renders did not change measurably. Four boxes a step, tried
+//! too, was slower: its records span four cache lines and its lane ordering branches (hitting
+//! rays 784-867 ns against 696-905, missing rays 87-90 ns against 61-62, interleaved).
 
 use glam::DVec3;
 
