@@ -54,6 +54,23 @@ struct Child {
     count: u16,
 }
 
+impl Child {
+    /// The child `node` stands for, given its entry in [`Bvh::pairs`] should it be interior.
+    fn of(node: &BvhNode, pair: u32) -> Self {
+        if node.count > 0 {
+            Self {
+                index: node.offset,
+                count: node.count,
+            }
+        } else {
+            Self {
+                index: pair,
+                count: 0,
+            }
+        }
+    }
+}
+
 /// An interior node laid out for the walk: its two children's boxes coordinate by coordinate,
 /// the two side by side (`lo[axis][child]`), so that one pass of paired arithmetic tests both
 /// (two-wide SIMD, which SSE2 has for `f64`), from one place in memory. Each lane computes
@@ -110,7 +127,9 @@ const SHORT_STACK: usize = 32;
 const LONG_STACK: usize = 64;
 
 /// A traversal's stack: the nodes still to visit, where the ray enters their boxes and where
-/// it leaves them.
+/// it leaves them. A node is kept as its [`Child`]'s two fields in two arrays: one array of
+/// `Child` (8 bytes an entry, padding included, against 6) made `bench intersect`'s missing
+/// rays 4-5 ns slower (64.2-72.1 ns against 59.2-74.9, six interleaved runs).
 struct Stack<'a> {
     node: &'a mut [u32],
     count: &'a mut [u16],
@@ -159,20 +178,7 @@ impl Bvh {
             pair_of.push(interior);
             interior += (n.count == 0) as u32;
         }
-        let child = |node: usize| {
-            let n = &self.nodes[node];
-            if n.count > 0 {
-                Child {
-                    index: n.offset,
-                    count: n.count,
-                }
-            } else {
-                Child {
-                    index: pair_of[node],
-                    count: 0,
-                }
-            }
-        };
+        let child = |node: usize| Child::of(&self.nodes[node], pair_of[node]);
         self.pairs = (0..self.nodes.len())
             .filter(|&i| self.nodes[i].count == 0)
             .map(|i| {
@@ -377,11 +383,8 @@ impl Bvh {
         // Along which axes the ray runs towards lower coordinates.
         let negative = [ray.dir.x < 0.0, ray.dir.y < 0.0, ray.dir.z < 0.0];
         let mut top = 0usize;
-        let root_node = &self.nodes[0];
-        let mut node = Child {
-            index: if root_node.count > 0 { root_node.offset } else { 0 },
-            count: root_node.count,
-        };
+        // The root, when interior, is the first pair.
+        let mut node = Child::of(&self.nodes[0], 0);
         // The piece of the ray inside the current node's box.
         let mut span = root;
         loop {

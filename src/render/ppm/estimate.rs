@@ -6,7 +6,7 @@ use std::f64::consts::PI;
 
 use super::gathered::Gathered;
 use super::radius::IndirectScale;
-use super::{Ppm, PARALLEL_MIN};
+use super::{Ppm, SWEEP_BLOCK};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
@@ -158,15 +158,15 @@ impl Ppm {
             guide.learn(tally);
         }
         // Compute new photon counts, radii and flux (Hachisuka et al. 2008, eqs. 6–11), slot by
-        // slot, [`PARALLEL_MIN`] a task. It is memory-bound (52-byte slots): in smallppm's scene
+        // slot, [`SWEEP_BLOCK`] a task. It is memory-bound (52-byte slots): in smallppm's scene
         // at 1024×768 (`bench ppm`) an update took 15-17 ms with two threads serially and
         // 11.6-16.7 ms in parallel; with one thread 14-16 ms either way.
         let alpha = self.alpha;
         self.slots
-            .par_chunks_mut(PARALLEL_MIN)
+            .par_chunks_mut(SWEEP_BLOCK)
             .enumerate()
             .for_each(|(chunk, slots)| {
-                for (k, s) in (chunk * PARALLEL_MIN..).zip(slots) {
+                for (k, s) in (chunk * SWEEP_BLOCK..).zip(slots) {
                     if s.restart == Restart::Pending {
                         // The first pass's flux only stood in until this pass: it was
                         // gathered over the wide radius.

@@ -235,14 +235,11 @@ fn skipped_work(scene: &Scene, stochastic: bool) -> Vec<String> {
     skipped
 }
 
-/// Items (slots, visible points) a task of a parallel sweep over them takes: large enough
-/// that handing out the tasks costs nothing beside them (with one thread, a sweep is as
-/// fast as a plain loop), small enough that two threads share a 320×240 image evenly.
-pub(super) const PARALLEL_MIN: usize = 4096;
-
-/// Pixels a task of [`Ppm::pixel_layers`] sweeps: large enough that finding its first slot
-/// costs nothing beside it, small enough that two threads share a 320×240 frame evenly.
-const PIXEL_BLOCK: usize = 4096;
+/// Items (pixels, slots, visible points) a task of a pass's parallel sweeps over them takes:
+/// large enough that handing out the tasks, or a frame's block finding its first slot
+/// ([`Ppm::pixel_layers`]), costs nothing beside them (with one thread a sweep is as fast as
+/// a plain loop), small enough that two threads share a 320×240 image evenly.
+pub(super) const SWEEP_BLOCK: usize = 4096;
 
 /// The slots of each pixel of `pixels` in turn (empty for a pixel without any), from `slots`
 /// in pixel order starting at the first of those pixels.
@@ -482,7 +479,7 @@ impl Ppm {
 
     /// What a frame shows per pixel — [`Ppm::radiance`], the largest search radius of the
     /// pixel's slots and the photons they gathered — each in one allocation, made in one
-    /// parallel sweep over the slots, [`PIXEL_BLOCK`] pixels a task (each block finds its
+    /// parallel sweep over the slots, [`SWEEP_BLOCK`] pixels a task (each block finds its
     /// first slot by a binary search: they lie in pixel order). Three serial sweeps took
     /// 31–42 ms of every 600-ms pass of `caustic bench ppm` on 2 threads, one parallel sweep
     /// takes 15–19 ms; each pixel's values depend on it alone, so they are the same for any
@@ -506,20 +503,20 @@ impl Ppm {
         debug_assert_eq!(radiance.len(), n);
         Arc::get_mut(&mut radiance)
             .expect(unique)
-            .par_chunks_mut(PIXEL_BLOCK)
+            .par_chunks_mut(SWEEP_BLOCK)
             .zip(
                 Arc::get_mut(&mut radius)
                     .expect(unique)
-                    .par_chunks_mut(PIXEL_BLOCK),
+                    .par_chunks_mut(SWEEP_BLOCK),
             )
             .zip(
                 Arc::get_mut(&mut gathered)
                     .expect(unique)
-                    .par_chunks_mut(PIXEL_BLOCK),
+                    .par_chunks_mut(SWEEP_BLOCK),
             )
             .enumerate()
             .for_each(|(b, ((radiance, radius), gathered))| {
-                let first = b * PIXEL_BLOCK;
+                let first = b * SWEEP_BLOCK;
                 let start = self.slots.partition_point(|s| (s.pixel as usize) < first);
                 let pixels = first..first + radiance.len();
                 for (k, slots) in slots_by_pixel(&self.slots[start..], pixels).enumerate() {

@@ -12,7 +12,7 @@ use rayon::prelude::*;
 use super::estimate::Estimate;
 use super::estimate::Slot;
 use super::visible::VisiblePoint;
-use super::PARALLEL_MIN;
+use super::SWEEP_BLOCK;
 
 /// A search sphere the spatial indices are built over: a centre and the radius² that reaches
 /// farthest.
@@ -149,7 +149,7 @@ impl VisiblePoints {
     }
 
     /// Copies each point's slot's radii² into its reach; returns the largest radius² of each
-    /// estimate (0 without points). In parallel, [`PARALLEL_MIN`] points a task: every pass
+    /// estimate (0 without points). In parallel, [`SWEEP_BLOCK`] points a task: every pass
     /// does it before its photons, and each point reads its slot from wherever it lies. In
     /// smallppm's scene at 1024×768 (`bench ppm`, passes 2-5) it took 20-25 ms a pass with one
     /// thread or two; now 13.5-19.5 ms with two (one thread unchanged). The largest of a set
@@ -165,8 +165,8 @@ impl VisiblePoints {
             largest
         };
         self.reach
-            .par_chunks_mut(PARALLEL_MIN)
-            .zip(self.shade.par_chunks(PARALLEL_MIN))
+            .par_chunks_mut(SWEEP_BLOCK)
+            .zip(self.shade.par_chunks(SWEEP_BLOCK))
             .map(|(reach, shade)| largest(reach, shade))
             .reduce(|| [0.0f32; 2], |a, b| [a[0].max(b[0]), a[1].max(b[1])])
     }
