@@ -347,11 +347,12 @@ fn opening_another_scene_with_unsaved_edits_asks_first() {
 
 /// Three deterministic passes of the small teapot.
 fn teapot_frame() -> Frame {
-    // Photons only, their directions at random: the snapshot's image stays the same whatever
-    // the render defaults.
+    // Photons only, their directions at random, every point at the initial radius: the
+    // snapshot's image stays the same whatever the render defaults.
     let mut scene = teapot();
     scene.params.direct_light = false;
     scene.params.stratified_photons = false;
+    scene.params.adaptive_radius = false;
     let mut ppm = Ppm::new(&scene, PpmOptions::default());
     for _ in 0..3 {
         ppm.run_pass(&scene, &mut |_| Control::Continue);

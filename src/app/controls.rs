@@ -375,7 +375,7 @@ fn photon_mapping_section_ui(p: &mut PanelParams, ranges: Ranges, ui: &mut egui:
             p.set_auto_indirect_scale(false);
         }
         ui.checkbox(&mut p.render.adaptive_radius, "Adaptive radius")
-            .on_hover_text("After the first pass, points where photons are dense (the inside of a caustic) restart with a radius up to 4× narrower, so that a pass still hands them about 64 photons: sharp light is not blurred by the initial radius for dozens of passes. Off: every point starts at the initial radius. Restarts.");
+            .on_hover_text("After the first pass, points where photons are dense (the inside of a caustic) restart with a radius up to 4× narrower, so that a pass still hands them about 64 photons: sharp light is not blurred by the initial radius for dozens of passes. Points where they are sparse (fewer than 2 a pass, no denser light within two pixels) restart up to 2× wider (no wider than the indirect radius): light spread thin is less noisy. Off: every point starts at the initial radius. Restarts.");
         ui.checkbox(&mut p.render.direct_light, "Direct light by light sampling")
             .on_hover_text("Direct light from every light by shadow rays at the visible points (area lights: one sample per pass); photons carry only caustics and indirect light. Off: photons carry everything. Restarts.");
         ui.checkbox(&mut p.render.guided_emission, "Photons where the camera looks")

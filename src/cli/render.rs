@@ -143,8 +143,9 @@ pub struct PpmArgs {
     #[arg(long, value_name = "K")]
     indirect_radius_scale: Option<f64>,
     /// Photon mapping: after the first pass, narrow the radius (up to 4×) of points where
-    /// photons are dense, such as the inside of a caustic (default: the scene's
-    /// `adaptive_radius`, on unless it says otherwise).
+    /// photons are dense, such as the inside of a caustic, and widen it (up to 2×) where they
+    /// are sparse and no denser light is near (default: the scene's `adaptive_radius`, on
+    /// unless it says otherwise).
     #[arg(long, value_name = "on|off", action = clap::ArgAction::Set,
           value_parser = clap::builder::BoolishValueParser::new())]
     adaptive_radius: Option<bool>,

@@ -41,12 +41,15 @@ pub struct RenderParams {
     /// indirect photons, between 1× and 4×; 1: one estimate for all photons (the paper's
     /// PPM).
     pub indirect_radius_scale: Option<f64>,
-    /// Photon mapping: narrow the radius where photons are dense. After the first pass, a
-    /// point that pass handed many more photons than it needs (the inside of a caustic)
-    /// restarts its estimate with a radius that would have handed it about 64, up to 4×
-    /// narrower, so that sharp light is not blurred by the initial radius for the first dozens
-    /// of passes. On by default; off, every point starts at the initial radius (the paper's
-    /// PPM).
+    /// Photon mapping: narrow the radius where photons are dense, widen it where they are
+    /// sparse. After the first pass (gathered over twice the initial radius), a point that
+    /// pass handed many more photons than it needs (the inside of a caustic) restarts its
+    /// estimate with a radius that would have handed it about 64, up to 4× narrower, so that
+    /// sharp light is not blurred by the initial radius for the first dozens of passes; one
+    /// handed fewer than 2 within the initial radius, with no denser light within two pixels,
+    /// with a radius that would have handed it 2, up to 2× wider (no wider than the indirect
+    /// estimate), so that light spread thin is less noisy. On by default; off, every point
+    /// starts at the initial radius (the paper's PPM).
     pub adaptive_radius: bool,
     /// Maximum specular bounces of eye rays and photons.
     pub max_depth: u32,

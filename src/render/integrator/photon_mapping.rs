@@ -135,6 +135,11 @@ fn rows(s: &PpmStats) -> Vec<StatRow> {
             "Share of the points whose radius was narrowed after the first pass, where photons were dense (adaptive radius)",
         ),
         StatRow::new(
+            "Widened radius",
+            format!("{:.1} %", 100.0 * s.widened_share),
+            "Share of the points whose radius was widened after the first pass, where photons were sparse and no denser light was near (adaptive radius)",
+        ),
+        StatRow::new(
             "Supersampled",
             format!("{:.2} %", 100.0 * s.supersampled_share),
             "Share of the pixels whose light seen directly (a lamp's outline, its images in mirrors and glass) takes 16 more eye rays a pass",
@@ -166,10 +171,11 @@ fn summary(s: &PpmStats, guided: bool) -> Vec<String> {
             s.indirect_radius_scale
         ));
     }
-    if s.narrowed_share > 0.0 {
+    if s.narrowed_share > 0.0 || s.widened_share > 0.0 {
         lines.push(format!(
-            "  adaptive radius: {:.1} % of the points narrowed after the first pass, where photons were dense",
-            100.0 * s.narrowed_share
+            "  adaptive radius: {:.1} % of the points narrowed after the first pass, where photons were dense, {:.1} % widened, where they were sparse",
+            100.0 * s.narrowed_share,
+            100.0 * s.widened_share
         ));
     }
     if s.supersampled_share > 0.0 {

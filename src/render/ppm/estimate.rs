@@ -111,7 +111,7 @@ pub struct Slot {
     pub primary: Estimate,
     /// Photons after a diffuse bounce (indirect light), when the scale is above 1.
     pub indirect: Estimate,
-    /// Whether the primary estimate was restarted with a narrower radius after the first
+    /// Whether the primary estimate was restarted with its adapted radius after the first
     /// pass (adaptive radius).
     pub restart: Restart,
     /// Photons emitted before this epoch that both estimates' flux already counts: a slot a
@@ -120,13 +120,13 @@ pub struct Slot {
     pub prior: f32,
 }
 
-/// A primary estimate's restart with a narrower radius ([`Ppm::narrow_dense`]).
+/// A primary estimate's restart with its adapted radius ([`Ppm::adapt_radii`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Restart {
     /// Not restarted: it counts every pass.
     #[default]
     None,
-    /// Narrowed after the first pass: its radius is the new one, its flux the first pass's
+    /// Adapted after the first pass: its radius is the new one, its flux the first pass's
     /// (scaled by the area, so the image does not change) until the second pass replaces it.
     Pending,
     /// Restarted at the second pass: the first pass's photons do not count for it.
@@ -183,7 +183,7 @@ impl Ppm {
         }
         if self.adaptive_radius && self.stats.passes == 0 {
             self.first_pass_photons = self.pass_photons;
-            self.narrow_dense(&gathered);
+            self.adapt_radii(&gathered);
         }
         if self.stochastic && self.options.warm_restarts {
             self.last_points = self.point_records();

@@ -181,8 +181,9 @@ impl Ppm {
                 .initial_radius
                 .unwrap_or_else(|| self.automatic_radius(scene));
             let indirect = self.indirect_scale.initial_radius(r0);
+            let primary = self.first_pass_radius2(r0 * r0);
             for s in &mut self.slots {
-                s.primary = Estimate::empty(r0 * r0);
+                s.primary = Estimate::empty(primary);
                 s.indirect = Estimate::empty(indirect * indirect);
             }
             self.initial_radius2 = r0 * r0;

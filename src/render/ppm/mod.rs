@@ -13,10 +13,11 @@
 //! and the radiance is `L = τ / (π R² N_emitted)` plus light seen directly (in stochastic
 //! passes supersampled where it changes within a pixel, [`seen`]). No brightness
 //! factor: exposure belongs to the viewer. After the first pass, two per-point choices are
-//! made from its photon counts: the indirect estimate's radius ([`Ppm::widen_indirect`]) and,
-//! where photons are dense, a narrower restart of the primary one ([`Ppm::narrow_dense`], the
-//! adaptive radius: in the spirit of classic photon mapping's k-nearest-neighbour radius,
-//! Jensen 2001, chosen once and then shrunk by the paper's rule).
+//! made from its photon counts: the indirect estimate's radius ([`Ppm::widen_indirect`]) and
+//! a restart of the primary one, narrower where photons are dense and wider where they are
+//! sparse ([`Ppm::adapt_radii`], the adaptive radius: in the spirit of classic photon
+//! mapping's k-nearest-neighbour radius, Jensen 2001, chosen once and then shrunk by the
+//! paper's rule).
 //!
 //! Determinism: photon `i` of the render uses the random stream `(seed, photon, i)` (and, when
 //! photons are stratified, point `i` of Sobol's sequence under a shift drawn from the seed), pixels

@@ -25,6 +25,9 @@ pub struct PpmStats {
     /// Share of the statistics slots whose estimate restarted with a narrower radius after
     /// the first pass (adaptive radius; 0 before it or when off).
     pub narrowed_share: f64,
+    /// Share of the statistics slots whose estimate restarted with a wider radius after the
+    /// first pass, where photons were sparse (adaptive radius; 0 before it or when off).
+    pub widened_share: f64,
     /// Share of the pixels whose light seen directly takes extra eye rays every pass, where it
     /// changes within the pixel (a lamp's outline and its images; [`super::seen`]).
     pub supersampled_share: f64,

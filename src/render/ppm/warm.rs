@@ -215,7 +215,7 @@ impl Reopen {
     }
 
     /// `e` (an estimate that counts `photons` emitted photons) brought to the radius at which
-    /// a first pass would hand it about `aim` photons — as [`Ppm::narrow_dense`] and
+    /// a first pass would hand it about `aim` photons — as [`Ppm::adapt_radii`] and
     /// [`Ppm::widen_indirect`] choose a cold slot's — never narrower than it is nor wider than
     /// a cold slot's `ceiling2`; `N` and `τ` scaled by the area as PPM's update assumes, so its
     /// value is unchanged. Its density is taken from `N`, which grows by `α M` a pass; the
