@@ -34,6 +34,7 @@ impl Integrator for PhotonMapping {
         let full = plan.params.pass_photons(ppm.is_stochastic(), w as u64 * h as u64);
         // The global schedule's passes are estimates of one kind, whatever process renders
         // them: every one is full (no ramp).
+        ppm.full_pass_photons = full;
         ppm.photons_per_pass = if ppm.pass_sums().is_some() {
             full
         } else {

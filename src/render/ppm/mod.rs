@@ -160,6 +160,10 @@ pub struct Ppm {
     pub alpha: f64,
     /// Photons per pass from the next pass on.
     pub photons_per_pass: u64,
+    /// Photons of a full pass, what `photons_per_pass` ramps up to (the viewer's first passes
+    /// are smaller): the adaptive radius tells sparse points by the photons such a pass
+    /// would hand them ([`Ppm::adapt_radii`]). The scene's photons per pass unless set.
+    pub full_pass_photons: u64,
     initial_radius: Option<f64>,
     slots: Vec<Slot>,
     /// This pass's visible points (classic PPM: the one eye pass's).
@@ -291,6 +295,9 @@ impl Ppm {
             first_pass_photons: 0,
             alpha: scene.params.alpha,
             photons_per_pass: scene
+                .params
+                .pass_photons(stochastic, cam.width as u64 * cam.height as u64),
+            full_pass_photons: scene
                 .params
                 .pass_photons(stochastic, cam.width as u64 * cam.height as u64),
             initial_radius: scene.params.initial_radius,

@@ -148,9 +148,11 @@ impl Ppm {
     ///   (the blur of sharp light such as a caustic's edge) grows with the radius and shrinks
     ///   only pass by pass, while its noise depends on photons per point: where they are dense
     ///   a narrower radius removes blur at once for little noise;
-    /// - **sparse** (`m < SPARSE_PHOTONS`, and no point of a pixel within
-    ///   [`SPARSE_NEIGHBOURHOOD`] pixels has `2·SPARSE_PHOTONS` or more): widened so that a
-    ///   pass hands it about that many, `R² = R₀² · SPARSE_PHOTONS / m`, at most
+    /// - **sparse** (`m⁺ < SPARSE_PHOTONS`, `m⁺` the photons a full pass would hand it within
+    ///   `R₀` counting one more than the first pass found, [`Ppm::full_pass_photons`]; and no
+    ///   point of a pixel within [`SPARSE_NEIGHBOURHOOD`] pixels has `2·SPARSE_PHOTONS` or
+    ///   more): widened so that a pass hands it about that many,
+    ///   `R² = R₀² · SPARSE_PHOTONS / m⁺`, at most
     ///   [`MAX_WIDENING`] times wider and no wider than the indirect estimate (none when one
     ///   estimate holds all photons). Where a pass hands a point a photon or none (light
     ///   spread thin, such as a curved glass's reflection over a floor) its noise dominates and
@@ -165,10 +167,11 @@ impl Ppm {
     /// uses. Counts are deterministic, so are the radii.
     ///
     /// Measured on `scenes/glass_teapot.toml` at 320×240 (46 passes, against `bench
-    /// convergence`'s reference): RMSE 4.69e-3 against 5.49e-3 narrowing only; first passes at
-    /// 1.5, 3 and 4 times the radius and thresholds of 1, 3, 4 and 8 photons did no better, and
-    /// without the neighbours' counts the lens of `scenes/lens.toml`, which shows its focus,
-    /// had 5 times the relative MSE.
+    /// convergence`'s reference): RMSE 4.78e-3 against 5.49e-3 narrowing only (4.68e-3
+    /// without the one more photon, which the viewer's small first pass needs); first passes
+    /// at 1.5, 3 and 4 times the radius and thresholds of 1, 3, 4 and 8 photons did no
+    /// better, and without the neighbours' counts the lens of `scenes/lens.toml`, which shows
+    /// its focus, had 5 times the relative MSE.
     pub(super) fn adapt_radii(&mut self, gathered: &Gathered) {
         let merged = self.indirect_scale == IndirectScale::Off;
         let r0_2 = self.initial_radius2;
@@ -189,20 +192,26 @@ impl Ppm {
                 gathered.count(k, 0) as f64 / area + if merged { gathered.count(k, 1) as f64 } else { 0.0 }
             })
             .collect();
-        let nearby = densest_nearby(&self.slots, &within, self.width, self.height);
+        // The sparse test counts photons as a full pass would hand them, and one more than
+        // the first pass found: the viewer's first pass is smaller (16,384 photons), and its
+        // few photons cannot tell a sparse point from one they missed (`bench edit`, counting
+        // only what it found: a cold restart took 3.9 s to relative MSE 1e-2 against 0.7 s).
+        let full = (self.full_pass_photons as f64 / self.pass_photons.max(1) as f64).max(1.0);
+        let full_within: Vec<f64> = within.iter().map(|m| m * full).collect();
+        let nearby = densest_nearby(&self.slots, &full_within, self.width, self.height);
         let (mut narrowed, mut widened) = (0usize, 0usize);
         for (k, s) in self.slots.iter_mut().enumerate() {
             // A slot a warm restart kept has its radius already.
             if s.primary.radius2() <= 0.0 || s.prior > 0.0 {
                 continue;
             }
-            let m = within[k];
+            let (m, m_full) = (within[k], (within[k] + 1.0 / area) * full);
             let factor = if m > DENSE_PHOTONS {
                 narrowed += 1;
                 (DENSE_PHOTONS / m).max(MAX_NARROWING.powi(-2))
-            } else if m < SPARSE_PHOTONS && nearby[k] < 2.0 * SPARSE_PHOTONS && widest2 > 1.0 {
+            } else if m_full < SPARSE_PHOTONS && nearby[k] < 2.0 * SPARSE_PHOTONS && widest2 > 1.0 {
                 widened += 1;
-                (SPARSE_PHOTONS / m.max(f64::MIN_POSITIVE)).min(widest2)
+                (SPARSE_PHOTONS / m_full.max(f64::MIN_POSITIVE)).min(widest2)
             } else {
                 1.0
             };
