@@ -186,10 +186,13 @@ impl Ppm {
             _ => 1.0,
         };
         // Photons within R₀: the primary's over the wide radius's area; when one estimate was
-        // kept, the indirect one's too, which gathered at R₀ itself.
-        let within: Vec<f64> = (0..self.slots.len())
+        // kept, the indirect one's too, which gathered at R₀ itself. In f32, exact for counts
+        // (quarters of integers below 2²⁴): at 1920×1080 these arrays are the first pass's
+        // only extra memory, 8 MiB each.
+        let within: Vec<f32> = (0..self.slots.len())
             .map(|k| {
-                gathered.count(k, 0) as f64 / area + if merged { gathered.count(k, 1) as f64 } else { 0.0 }
+                let wide = gathered.count(k, 0) as f64 / area;
+                (wide + if merged { gathered.count(k, 1) as f64 } else { 0.0 }) as f32
             })
             .collect();
         // The sparse test counts photons as a full pass would hand them, and one more than
@@ -197,19 +200,22 @@ impl Ppm {
         // few photons cannot tell a sparse point from one they missed (`bench edit`, counting
         // only what it found: a cold restart took 3.9 s to relative MSE 1e-2 against 0.7 s).
         let full = (self.full_pass_photons as f64 / self.pass_photons.max(1) as f64).max(1.0);
-        let full_within: Vec<f64> = within.iter().map(|m| m * full).collect();
-        let nearby = densest_nearby(&self.slots, &full_within, self.width, self.height);
+        let nearby = densest_nearby(&self.slots, &within, self.width, self.height);
         let (mut narrowed, mut widened) = (0usize, 0usize);
         for (k, s) in self.slots.iter_mut().enumerate() {
             // A slot a warm restart kept has its radius already.
             if s.primary.radius2() <= 0.0 || s.prior > 0.0 {
                 continue;
             }
-            let (m, m_full) = (within[k], (within[k] + 1.0 / area) * full);
+            let m = within[k] as f64;
+            let m_full = (m + 1.0 / area) * full;
             let factor = if m > DENSE_PHOTONS {
                 narrowed += 1;
                 (DENSE_PHOTONS / m).max(MAX_NARROWING.powi(-2))
-            } else if m_full < SPARSE_PHOTONS && nearby[k] < 2.0 * SPARSE_PHOTONS && widest2 > 1.0 {
+            } else if m_full < SPARSE_PHOTONS
+                && nearby[k] as f64 * full < 2.0 * SPARSE_PHOTONS
+                && widest2 > 1.0
+            {
                 widened += 1;
                 (SPARSE_PHOTONS / m_full.max(f64::MIN_POSITIVE)).min(widest2)
             } else {
@@ -227,21 +233,21 @@ impl Ppm {
 /// For every slot, the most photons `within` gives any slot of a pixel within
 /// [`SPARSE_NEIGHBOURHOOD`] pixels of its own (its own included): a square window over the
 /// image, each pixel holding the largest count of its slots.
-fn densest_nearby(slots: &[Slot], within: &[f64], width: u32, height: u32) -> Vec<f64> {
+fn densest_nearby(slots: &[Slot], within: &[f32], width: u32, height: u32) -> Vec<f32> {
     let (w, h) = (width as usize, height as usize);
-    let mut per_pixel = vec![0.0f64; w * h];
+    let mut per_pixel = vec![0.0f32; w * h];
     for (s, &m) in slots.iter().zip(within) {
         let p = &mut per_pixel[s.pixel as usize];
         *p = p.max(m);
     }
     // The window's maximum, rows then columns (a separable filter).
     let reach = SPARSE_NEIGHBOURHOOD;
-    let mut rows = vec![0.0f64; w * h];
+    let mut rows = vec![0.0f32; w * h];
     for y in 0..h {
         let row = &per_pixel[y * w..(y + 1) * w];
         for x in 0..w {
             let span = &row[x.saturating_sub(reach)..(x + reach + 1).min(w)];
-            rows[y * w + x] = span.iter().copied().fold(0.0, f64::max);
+            rows[y * w + x] = span.iter().copied().fold(0.0, f32::max);
         }
     }
     slots
@@ -250,7 +256,7 @@ fn densest_nearby(slots: &[Slot], within: &[f64], width: u32, height: u32) -> Ve
             let (x, y) = (s.pixel as usize % w, s.pixel as usize / w);
             (y.saturating_sub(reach)..(y + reach + 1).min(h))
                 .map(|yy| rows[yy * w + x])
-                .fold(0.0, f64::max)
+                .fold(0.0, f32::max)
         })
         .collect()
 }
