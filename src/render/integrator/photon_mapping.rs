@@ -32,9 +32,9 @@ impl Integrator for PhotonMapping {
         ppm.alpha = plan.params.alpha;
         let (w, h) = ppm.size();
         let full = plan.params.pass_photons(ppm.is_stochastic(), w as u64 * h as u64);
+        ppm.full_pass_photons = full;
         // The global schedule's passes are estimates of one kind, whatever process renders
         // them: every one is full (no ramp).
-        ppm.full_pass_photons = full;
         ppm.photons_per_pass = if ppm.pass_sums().is_some() {
             full
         } else {

@@ -275,6 +275,7 @@ impl Ppm {
         let stochastic = options.force_stochastic || cam.aperture > 0.0 || scene.params.antialias;
         let skipped = skipped_work(scene, stochastic);
         let pixels = cam.width as usize * cam.height as usize;
+        let full_pass = scene.params.pass_photons(stochastic, pixels as u64);
         Self {
             options,
             direct_light: scene.params.direct_light,
@@ -294,12 +295,8 @@ impl Ppm {
             initial_radius2: 0.0,
             first_pass_photons: 0,
             alpha: scene.params.alpha,
-            photons_per_pass: scene
-                .params
-                .pass_photons(stochastic, cam.width as u64 * cam.height as u64),
-            full_pass_photons: scene
-                .params
-                .pass_photons(stochastic, cam.width as u64 * cam.height as u64),
+            photons_per_pass: full_pass,
+            full_pass_photons: full_pass,
             initial_radius: scene.params.initial_radius,
             slots: Vec::new(),
             points: VisiblePoints::default(),

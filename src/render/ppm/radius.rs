@@ -4,7 +4,6 @@
 //! ([`Ppm::adapt_radii`]; in the spirit of classic photon mapping's k-nearest-neighbour
 //! radius, Jensen 2001, chosen once and then shrunk by the paper's rule).
 
-use super::estimate::Slot;
 use super::gathered::Gathered;
 use super::{Estimate, Ppm, PpmOptions, Restart};
 use crate::scene::Scene;
@@ -200,7 +199,8 @@ impl Ppm {
         // few photons cannot tell a sparse point from one they missed (`bench edit`, counting
         // only what it found: a cold restart took 3.9 s to relative MSE 1e-2 against 0.7 s).
         let full = (self.full_pass_photons as f64 / self.pass_photons.max(1) as f64).max(1.0);
-        let nearby = densest_nearby(&self.slots, &within, self.width, self.height);
+        let pixels = self.slots.iter().map(|s| s.pixel);
+        let nearby = densest_nearby(pixels, &within, self.width, self.height);
         let (mut narrowed, mut widened) = (0usize, 0usize);
         for (k, s) in self.slots.iter_mut().enumerate() {
             // A slot a warm restart kept has its radius already.
@@ -217,7 +217,7 @@ impl Ppm {
                 && widest2 > 1.0
             {
                 widened += 1;
-                (SPARSE_PHOTONS / m_full.max(f64::MIN_POSITIVE)).min(widest2)
+                (SPARSE_PHOTONS / m_full).min(widest2)
             } else {
                 1.0
             };
@@ -230,14 +230,19 @@ impl Ppm {
     }
 }
 
-/// For every slot, the most photons `within` gives any slot of a pixel within
-/// [`SPARSE_NEIGHBOURHOOD`] pixels of its own (its own included): a square window over the
-/// image, each pixel holding the largest count of its slots.
-fn densest_nearby(slots: &[Slot], within: &[f32], width: u32, height: u32) -> Vec<f32> {
+/// For every slot (its pixel in `pixels`), the most photons `within` gives any slot of a
+/// pixel within [`SPARSE_NEIGHBOURHOOD`] pixels of its own (its own included): a square
+/// window over the image, each pixel holding the largest count of its slots.
+fn densest_nearby(
+    pixels: impl Iterator<Item = u32> + Clone,
+    within: &[f32],
+    width: u32,
+    height: u32,
+) -> Vec<f32> {
     let (w, h) = (width as usize, height as usize);
     let mut per_pixel = vec![0.0f32; w * h];
-    for (s, &m) in slots.iter().zip(within) {
-        let p = &mut per_pixel[s.pixel as usize];
+    for (pixel, &m) in pixels.clone().zip(within) {
+        let p = &mut per_pixel[pixel as usize];
         *p = p.max(m);
     }
     // The window's maximum, rows then columns (a separable filter).
@@ -250,10 +255,9 @@ fn densest_nearby(slots: &[Slot], within: &[f32], width: u32, height: u32) -> Ve
             rows[y * w + x] = span.iter().copied().fold(0.0, f32::max);
         }
     }
-    slots
-        .iter()
-        .map(|s| {
-            let (x, y) = (s.pixel as usize % w, s.pixel as usize / w);
+    pixels
+        .map(|pixel| {
+            let (x, y) = (pixel as usize % w, pixel as usize / w);
             (y.saturating_sub(reach)..(y + reach + 1).min(h))
                 .map(|yy| rows[yy * w + x])
                 .fold(0.0, f32::max)
@@ -263,6 +267,7 @@ fn densest_nearby(slots: &[Slot], within: &[f32], width: u32, height: u32) -> Ve
 
 #[cfg(test)]
 mod tests {
+    use super::super::Slot;
     use super::*;
 
     /// One dense pixel in a 9×7 image: it is the densest light of every pixel within
@@ -278,7 +283,7 @@ mod tests {
         let dense = (4, 3);
         within[(dense.1 * w + dense.0) as usize] = 10.0;
         *within.last_mut().expect("a slot") = 3.0;
-        let nearby = densest_nearby(&slots, &within, w, h);
+        let nearby = densest_nearby(slots.iter().map(|s| s.pixel), &within, w, h);
         for (k, s) in slots.iter().enumerate() {
             let (x, y) = ((s.pixel % w) as i64, (s.pixel / w) as i64);
             let reach = SPARSE_NEIGHBOURHOOD as i64;
