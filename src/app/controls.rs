@@ -388,7 +388,7 @@ fn photon_mapping_section_ui(p: &mut PanelParams, ranges: Ranges, ui: &mut egui:
                 .on_hover_text("Choose photons' directions by a low-discrepancy sequence over the render's photons, so each pass covers the light's directions evenly: caustics and light carried by photons are less noisy. Off: independent random directions. Restarts.");
         });
         ui.checkbox(&mut p.render.supersample_light_seen, "Supersampled lamp outlines")
-            .on_hover_text("Where the light a pixel sees directly changes within it (a lamp's outline, its images in mirrors and glass), the pixel traces 16 more eye rays a pass for that light (at most a quarter more eye rays in all): outlines settle about 16 times sooner. Off: one eye ray per pixel a pass. Restarts.");
+            .on_hover_text("Where the light a pixel sees directly changes within it (a lamp's outline, its images in mirrors and glass), the pixel traces 16 more eye rays a pass for that light, and where it varied most over the first 8 passes (a texture's or a shadow's edge, a floor seen through glass) 4 more (at most a quarter more eye rays in all): outlines settle about 16 times sooner. Off: one eye ray per pixel a pass. Restarts.");
         schedule_and_index_ui(p, ui);
     });
 }

@@ -131,8 +131,9 @@ pub struct PpmArgs {
     stratified_photons: Option<bool>,
     /// Photon mapping: where the light a pixel sees directly changes within it (a lamp's
     /// outline, its images in mirrors and glass), trace 16 more eye rays a pass there for that
-    /// light, when eye rays are jittered (default: the scene's `supersample_light_seen`, on
-    /// unless it says otherwise).
+    /// light, and 4 more where it varied most over the first 8 passes (a texture's or a
+    /// shadow's edge, a floor seen through glass), when eye rays are jittered (default: the
+    /// scene's `supersample_light_seen`, on unless it says otherwise).
     #[arg(long, value_name = "on|off", action = clap::ArgAction::Set,
           value_parser = clap::builder::BoolishValueParser::new())]
     supersample_light_seen: Option<bool>,

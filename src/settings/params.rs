@@ -90,7 +90,9 @@ pub struct RenderParams {
     /// Photon mapping: where the light a pixel sees directly changes within the pixel (a
     /// lamp's outline, its images in mirrors and glass), that pixel traces 16 more eye rays a
     /// pass that only look for that light (`ppm::seen`), so the outline converges as if it had
-    /// 16 times the passes. The pixels are chosen from the passes so far; a chosen pixel's
+    /// 16 times the passes; after 8 passes, the pixels whose light seen varied most between
+    /// them (a texture's or a shadow's edge, a floor seen through glass) trace 4 more. The
+    /// pixels are chosen from the passes so far; a chosen pixel's
     /// light seen counts only its later passes, so the image converges to the same result.
     /// On by default; matters only when the eye pass is traced every pass (anti-aliasing,
     /// depth of field).

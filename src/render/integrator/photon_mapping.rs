@@ -143,7 +143,7 @@ fn rows(s: &PpmStats) -> Vec<StatRow> {
         StatRow::new(
             "Supersampled",
             format!("{:.2} %", 100.0 * s.supersampled_share),
-            "Share of the pixels whose light seen directly (a lamp's outline, its images in mirrors and glass) takes 16 more eye rays a pass",
+            "Share of the pixels whose light seen directly takes more eye rays a pass: 16 where it changes within the pixel (a lamp's outline, its images in mirrors and glass), 4 where it varies most between passes (a texture's or a shadow's edge, a floor seen through glass)",
         ),
     ]
 }
@@ -181,9 +181,10 @@ fn summary(s: &PpmStats, guided: bool) -> Vec<String> {
     }
     if s.supersampled_share > 0.0 {
         lines.push(format!(
-            "  light seen directly supersampled ({} eye rays a pass) in {:.2} % of the pixels, where it changes within them",
+            "  light seen directly supersampled in {:.2} % of the pixels ({} more eye rays a pass where it changes within them, {} where it varies most between passes)",
+            100.0 * s.supersampled_share,
             crate::render::ppm::SUBSAMPLES,
-            100.0 * s.supersampled_share
+            crate::render::ppm::VARIED_SUBSAMPLES,
         ));
     }
     lines.push(format!(

@@ -86,7 +86,7 @@ impl Ppm {
                     &mut sink,
                 );
                 *direct = if chosen {
-                    subsampler.light_seen(i, x, y)
+                    subsampler.light_seen(i, x, y, seen.subsamples(i as usize))
                 } else {
                     seen_once
                 }

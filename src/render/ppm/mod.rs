@@ -67,7 +67,7 @@ pub use global::schedule_factor;
 pub use index::SpatialIndex;
 pub use photon_pass::DEFAULT_BATCH_PHOTONS;
 use radius::IndirectScale;
-pub use seen::SUBSAMPLES;
+pub use seen::{SUBSAMPLES, VARIED_SUBSAMPLES};
 pub use stats::PpmStats;
 pub use warm::{StreamOffset, WarmStart};
 
