@@ -828,20 +828,30 @@ fn stratified_eye_rays_settle_a_lights_outline_sooner() {
         scene.params.seed = seed;
         scene
     };
-    // Another seed: other per-pixel offsets, so its error is independent of the renders'.
-    let reference = render_passes(&scene(true, 7), PpmOptions::default(), 2048);
-    let [stratified, independent] =
-        [true, false].map(|on| render_passes(&scene(on, 1), PpmOptions::default(), 64));
-    let rms = |image: &[[f32; 3]]| rms_red(image, &reference);
-    let (e_stratified, e_independent) = (rms(&stratified), rms(&independent));
+    assert_settles_sooner(scene, 2048, 64, 0.5, ["stratified", "independent"]);
+}
+
+/// Renders `scene(on, 1)` for `passes` passes with an option on and off, and `scene(true, 7)`
+/// for `reference_passes` (another seed: other per-pixel offsets, so its error is independent
+/// of the renders'). Asserts that the option on leaves less than `factor` times the RMS error
+/// (red) it leaves off, and that both keep the long render's mean; `names` name the two.
+fn assert_settles_sooner(
+    scene: impl Fn(bool, u64) -> Scene,
+    reference_passes: u32,
+    passes: u32,
+    factor: f64,
+    names: [&str; 2],
+) {
+    let reference = render_passes(&scene(true, 7), PpmOptions::default(), reference_passes);
+    let [on, off] = [true, false].map(|on| render_passes(&scene(on, 1), PpmOptions::default(), passes));
+    let (e_on, e_off) = (rms_red(&on, &reference), rms_red(&off, &reference));
     assert!(
-        e_stratified < 0.5 * e_independent,
-        "RMS error after 64 passes: stratified {e_stratified}, independent {e_independent}"
+        e_on < factor * e_off,
+        "RMS error after {passes} passes: {} {e_on}, {} {e_off}",
+        names[0],
+        names[1]
     );
-    assert_means_within_1_percent(
-        &reference,
-        [("stratified", &stratified), ("independent", &independent)],
-    );
+    assert_means_within_1_percent(&reference, [(names[0], &on), (names[1], &off)]);
 }
 
 /// Supersampled light seen (the default): a small sphere light seen directly, high above the
@@ -866,20 +876,8 @@ fn supersampled_outlines_settle_sooner_and_keep_the_image() {
         scene.params.seed = seed;
         scene
     };
-    let reference = render_passes(&scene(true, 7), PpmOptions::default(), 512);
-    let [supersampled, single] =
-        [true, false].map(|on| render_passes(&scene(on, 1), PpmOptions::default(), 32));
-    let rms = |image: &[[f32; 3]]| rms_red(image, &reference);
-    let (e_on, e_off) = (rms(&supersampled), rms(&single));
     // Measured: 0.016 against 0.164.
-    assert!(
-        e_on < 0.25 * e_off,
-        "RMS error after 32 passes: supersampled {e_on}, one ray a pass {e_off}"
-    );
-    assert_means_within_1_percent(
-        &reference,
-        [("supersampled", &supersampled), ("one ray", &single)],
-    );
+    assert_settles_sooner(scene, 512, 32, 0.25, ["supersampled", "one ray"]);
     let mut ppm = Ppm::new(&scene(true, 1), PpmOptions::default());
     ppm.run_pass(&scene(true, 1), &mut |_| Control::Continue);
     let share = ppm.stats().supersampled_share;
@@ -914,20 +912,8 @@ fn pixels_whose_light_varies_between_passes_are_supersampled_and_keep_the_image(
         scene.params.seed = seed;
         scene
     };
-    let reference = render_passes(&scene(true, 7), PpmOptions::default(), 512);
-    let [supersampled, single] =
-        [true, false].map(|on| render_passes(&scene(on, 1), PpmOptions::default(), 64));
-    let rms = |image: &[[f32; 3]]| rms_red(image, &reference);
-    let (e_on, e_off) = (rms(&supersampled), rms(&single));
     // Measured: 6.7e-4 against 1.23e-3.
-    assert!(
-        e_on < 0.7 * e_off,
-        "RMS error after 64 passes: supersampled {e_on}, one ray a pass {e_off}"
-    );
-    assert_means_within_1_percent(
-        &reference,
-        [("supersampled", &supersampled), ("one ray", &single)],
-    );
+    assert_settles_sooner(scene, 512, 64, 0.7, ["supersampled", "one ray"]);
     let share = |passes: u32| {
         let mut ppm = Ppm::new(&scene(true, 1), PpmOptions::default());
         for _ in 0..passes {
