@@ -103,6 +103,16 @@ fn value(c: &Vec3) -> f32 {
     (c.x + c.y + c.z) / 3.0
 }
 
+/// Pixel `i`'s bit in a one-bit-per-pixel set.
+fn bit(set: &[u64], i: usize) -> bool {
+    set.get(i / 64).is_some_and(|w| w >> (i % 64) & 1 == 1)
+}
+
+/// Sets pixel `i`'s bit in a one-bit-per-pixel set.
+fn set_bit(set: &mut [u64], i: usize) {
+    set[i / 64] |= 1 << (i % 64);
+}
+
 /// Which pixels take extra samples of the light they see, chosen from completed passes.
 #[derive(Clone, Debug, Default)]
 pub struct SeenLight {
@@ -141,14 +151,14 @@ impl SeenLight {
 
     /// Whether pixel `i` takes extra samples.
     pub fn chosen(&self, i: usize) -> bool {
-        self.chosen.get(i / 64).is_some_and(|w| w >> (i % 64) & 1 == 1)
+        bit(&self.chosen, i)
     }
 
     /// Extra rays pixel `i` takes (0 when not chosen).
     pub fn subsamples(&self, i: usize) -> u32 {
         if !self.chosen(i) {
             0
-        } else if self.varied.get(i / 64).is_some_and(|w| w >> (i % 64) & 1 == 1) {
+        } else if bit(&self.varied, i) {
             VARIED_SUBSAMPLES
         } else {
             SUBSAMPLES
@@ -200,10 +210,7 @@ impl SeenLight {
             .collect();
         found.sort_unstable_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
         found.truncate(self.room() / VARIED_SUBSAMPLES as usize);
-        for &(i, _) in &found {
-            self.varied[i as usize / 64] |= 1 << (i % 64);
-        }
-        self.add(found.into_iter().map(|(i, _)| i), eye_passes);
+        self.add(found.into_iter().map(|(i, _)| i), eye_passes, true);
     }
 
     /// Extra rays a pass the budget still allows.
@@ -211,16 +218,18 @@ impl SeenLight {
         ((BUDGET * self.pixels as f64) as usize).saturating_sub(self.rays)
     }
 
-    /// Chooses `pixels` (not chosen yet) after `eye_passes` completed passes.
-    fn add(&mut self, pixels: impl Iterator<Item = u32>, eye_passes: u32) {
-        let before = self.pending.len();
+    /// Chooses `pixels` (not chosen yet) after `eye_passes` completed passes: for their
+    /// variance (`varied`, [`VARIED_SUBSAMPLES`] rays each) or their outline ([`SUBSAMPLES`]).
+    fn add(&mut self, pixels: impl Iterator<Item = u32>, eye_passes: u32, varied: bool) {
+        let rays = if varied { VARIED_SUBSAMPLES } else { SUBSAMPLES } as usize;
         for i in pixels {
-            self.chosen[i as usize / 64] |= 1 << (i % 64);
+            set_bit(&mut self.chosen, i as usize);
+            if varied {
+                set_bit(&mut self.varied, i as usize);
+            }
             self.since.push((i, eye_passes));
             self.pending.push(i);
-        }
-        for k in before..self.pending.len() {
-            self.rays += self.subsamples(self.pending[k] as usize) as usize;
+            self.rays += rays;
         }
         self.since.sort_unstable();
     }
@@ -281,7 +290,7 @@ impl SeenLight {
     pub fn choose(&mut self, eye_passes: u32) {
         let mut candidates = std::mem::take(&mut self.candidates);
         candidates.truncate(self.room() / SUBSAMPLES as usize);
-        self.add(candidates.into_iter(), eye_passes);
+        self.add(candidates.into_iter(), eye_passes, false);
     }
 
     /// The pixels chosen since this was last asked: their light seen so far no longer counts
