@@ -14,6 +14,7 @@ pub mod quad;
 pub mod ray;
 pub mod scene_geometry;
 pub mod sphere;
+pub mod sphere_batch;
 pub mod tessellate;
 
 pub use aabb::Aabb;
@@ -29,3 +30,4 @@ pub use scene_geometry::{
     GeometryBuilder, GeometryStats, Hit, PatchMethod, PatchUpdate, Primitive, SceneGeometry, ShapeRef,
 };
 pub use sphere::Sphere;
+pub use sphere_batch::SphereBatch;

@@ -17,7 +17,7 @@ use glam::{DVec2, DVec3};
 
 use super::aabb::Aabb;
 use super::bezier::BezierPatch;
-use super::bvh::Bvh;
+use super::bvh::{Bvh, FLAT_PRIMITIVES};
 use super::mesh::TriangleMesh;
 use super::patch::{
     intersect_leaf, intersect_per_ray, leaf_occludes, subdivide, PatchHit, PatchLeaf, PatchPoint, RayFrame,
@@ -26,6 +26,7 @@ use super::patch::{
 use super::quad::{Plane, Quad};
 use super::ray::{spawn_ray, Ray};
 use super::sphere::Sphere;
+use super::sphere_batch::SphereBatch;
 
 /// Which ray/patch intersector the geometry uses.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -238,6 +239,7 @@ impl GeometryBuilder {
             }
         }
         let bvh = Bvh::build(&bounds);
+        let flat_spheres = flat_spheres(&bvh, &primitives, &self.spheres);
         SceneGeometry {
             primitive_bounds: bounds,
             spheres: self.spheres,
@@ -250,9 +252,25 @@ impl GeometryBuilder {
             leaves,
             primitives,
             bvh,
+            flat_spheres,
             patch_method: self.patch_method,
         }
     }
+}
+
+/// The spheres of a tree [`Bvh::traverse`] does not walk, when it holds nothing else, in the
+/// order it visits them, each tagged with its index among the spheres ([`SphereBatch`]).
+fn flat_spheres(bvh: &Bvh, primitives: &[Primitive], spheres: &[(Sphere, u32)]) -> Option<SphereBatch> {
+    let flat = !bvh.order.is_empty() && bvh.order.len() <= FLAT_PRIMITIVES;
+    let lanes: Option<Vec<(Sphere, u32, u32)>> = bvh
+        .order
+        .iter()
+        .map(|&k| match primitives[k as usize] {
+            Primitive::Sphere(i) => Some((spheres[i as usize].0, i, spheres[i as usize].1)),
+            _ => None,
+        })
+        .collect();
+    lanes.filter(|_| flat).map(SphereBatch::new)
 }
 
 /// Shapes and the BVH over them, ready for rays.
@@ -272,6 +290,8 @@ pub struct SceneGeometry {
     /// Bounds of `primitives[k]`, kept for refitting the BVH after an edit.
     primitive_bounds: Vec<Aabb>,
     bvh: Bvh,
+    /// The spheres, tested at once, when they are all the BVH holds and it is not walked.
+    flat_spheres: Option<SphereBatch>,
     patch_method: PatchMethod,
 }
 
@@ -364,6 +384,7 @@ impl SceneGeometry {
         self.spheres[k].0 = sphere;
         self.primitive_bounds[k] = sphere.bounds();
         self.bvh.refit(&self.primitive_bounds);
+        self.flat_spheres = flat_spheres(&self.bvh, &self.primitives, &self.spheres);
         true
     }
 
@@ -425,6 +446,7 @@ impl SceneGeometry {
         } else {
             self.bvh = Bvh::build(&self.primitive_bounds);
         }
+        self.flat_spheres = flat_spheres(&self.bvh, &self.primitives, &self.spheres);
         Some(PatchUpdate {
             patches: edits.len(),
             refit,
@@ -551,11 +573,25 @@ impl SceneGeometry {
     fn nearest(&self, ray: &Ray, t_max: f64) -> Option<Candidate> {
         let frame = self.has_patches().then(|| RayFrame::new(ray));
         let mut best: Option<Candidate> = None;
-        let t_max = self.bvh.traverse(ray, t_max, |k, t_max, span| {
-            let c = self.test(self.primitives[k as usize], ray, &frame, span, t_max)?;
-            best = Some(c);
-            Some(c.t)
-        });
+        let t_max = match &self.flat_spheres {
+            Some(batch) => match batch.nearest(ray, t_max) {
+                Some((t, i)) => {
+                    best = Some(Candidate {
+                        t,
+                        primitive: Primitive::Sphere(i),
+                        param: DVec2::ZERO,
+                        normal: None,
+                    });
+                    t
+                }
+                None => t_max,
+            },
+            None => self.bvh.traverse(ray, t_max, |k, t_max, span| {
+                let c = self.test(self.primitives[k as usize], ray, &frame, span, t_max)?;
+                best = Some(c);
+                Some(c.t)
+            }),
+        };
         for k in 0..self.planes.len() {
             let t_max = best.map_or(t_max, |b| b.t);
             if let Some(c) = self.test(Primitive::Plane(k as u32), ray, &frame, (0.0, t_max), t_max) {
@@ -663,6 +699,9 @@ impl SceneGeometry {
         {
             return true;
         }
+        if let Some(batch) = &self.flat_spheres {
+            return batch.any(ray, t_max, skip);
+        }
         let frame = self.has_patches().then(|| RayFrame::new(ray));
         self.bvh.any(ray, t_max, |k, span| {
             let primitive = self.primitives[k as usize];
@@ -755,5 +794,77 @@ mod tests {
             .expect("the ray meets the quad");
         assert_eq!(hit.shape, quad);
         assert!((hit.uv() - DVec2::new(0.05, 0.05)).length() < 1e-12);
+    }
+
+    /// A scene of spheres only, whose BVH is not walked, tests them at once
+    /// ([`SphereBatch`]); the same spheres with a quad far out of the rays' way are tested one
+    /// by one. Both find the same hits bit for bit, the same shadows (an object skipped
+    /// included), also after a sphere is moved.
+    #[test]
+    fn spheres_tested_at_once_find_what_spheres_tested_one_by_one_find() {
+        let spheres = [
+            (DVec3::new(1e5 + 1.0, 40.8, 81.6), 1e5),
+            (DVec3::new(-1e5 + 99.0, 40.8, 81.6), 1e5),
+            (DVec3::new(50.0, 40.8, 1e5), 1e5),
+            (DVec3::new(50.0, 40.8, -1e5 + 170.0), 1e5),
+            (DVec3::new(50.0, 1e5, 81.6), 1e5),
+            (DVec3::new(50.0, -1e5 + 81.6, 81.6), 1e5),
+            (DVec3::new(27.0, 16.5, 47.0), 16.5),
+            (DVec3::new(73.0, 16.5, 78.0), 16.5),
+            (DVec3::new(50.0, 681.33, 81.6), 600.0),
+        ];
+        let build = |with_quad: bool| {
+            let mut builder = GeometryBuilder::default();
+            for (k, &(center, radius)) in spheres.iter().enumerate() {
+                builder.add_sphere(Sphere { center, radius }, k as u32);
+            }
+            if with_quad {
+                let corner = DVec3::splat(1e7);
+                builder.add_quad(
+                    Quad {
+                        corner,
+                        edge_u: DVec3::X,
+                        edge_v: DVec3::Y,
+                    },
+                    99,
+                );
+            }
+            builder.build()
+        };
+        let (mut at_once, mut one_by_one) = (build(false), build(true));
+        assert!(at_once.flat_spheres.is_some() && one_by_one.flat_spheres.is_none());
+        let mut x = 0x2545F4914F6CDD1Du64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for round in 0..2 {
+            if round == 1 {
+                let moved = Sphere {
+                    center: DVec3::new(40.0, 30.0, 60.0),
+                    radius: 10.0,
+                };
+                assert!(at_once.move_sphere(7, moved) && one_by_one.move_sphere(7, moved));
+            }
+            for k in 0..3000 {
+                let origin = DVec3::new(next() * 98.0 + 1.0, next() * 80.0 + 0.5, next() * 160.0 + 5.0);
+                let ray = Ray::new(origin, DVec3::new(next() - 0.5, next() - 0.5, next() - 0.5));
+                let t_max = if k % 2 == 0 { f64::INFINITY } else { 40.0 };
+                let (a, b) = (at_once.intersect(&ray, t_max), one_by_one.intersect(&ray, t_max));
+                let key = |h: Option<Hit>| {
+                    h.map(|h| (h.t.to_bits(), h.object, h.normal.to_array().map(f64::to_bits)))
+                };
+                assert_eq!(key(a), key(b), "round {round}, ray {k}");
+                let skip = Some(k as u32 % 9);
+                assert_eq!(at_once.occluded(&ray, t_max), one_by_one.occluded(&ray, t_max));
+                assert_eq!(
+                    at_once.occluded_except(&ray, t_max, skip),
+                    one_by_one.occluded_except(&ray, t_max, skip),
+                    "round {round}, ray {k}"
+                );
+            }
+        }
     }
 }
