@@ -833,13 +833,8 @@ mod tests {
         };
         let (mut at_once, mut one_by_one) = (build(false), build(true));
         assert!(at_once.flat_spheres.is_some() && one_by_one.flat_spheres.is_none());
-        let mut x = 0x2545F4914F6CDD1Du64;
-        let mut next = || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            (x >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = <rand_pcg::Pcg64Mcg as rand::SeedableRng>::seed_from_u64(5);
+        let mut next = || rand::Rng::random::<f64>(&mut rng);
         for round in 0..2 {
             if round == 1 {
                 let moved = Sphere {
