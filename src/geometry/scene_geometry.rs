@@ -261,7 +261,9 @@ impl GeometryBuilder {
 /// The spheres of a tree [`Bvh::traverse`] does not walk, when it holds nothing else, in the
 /// order it visits them, each tagged with its index among the spheres ([`SphereBatch`]).
 fn flat_spheres(bvh: &Bvh, primitives: &[Primitive], spheres: &[(Sphere, u32)]) -> Option<SphereBatch> {
-    let flat = !bvh.order.is_empty() && bvh.order.len() <= FLAT_PRIMITIVES;
+    if bvh.order.is_empty() || bvh.order.len() > FLAT_PRIMITIVES {
+        return None;
+    }
     let lanes: Option<Vec<(Sphere, u32, u32)>> = bvh
         .order
         .iter()
@@ -270,7 +272,7 @@ fn flat_spheres(bvh: &Bvh, primitives: &[Primitive], spheres: &[(Sphere, u32)]) 
             _ => None,
         })
         .collect();
-    lanes.filter(|_| flat).map(SphereBatch::new)
+    lanes.map(SphereBatch::new)
 }
 
 /// Shapes and the BVH over them, ready for rays.

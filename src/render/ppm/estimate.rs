@@ -190,19 +190,13 @@ impl Ppm {
         }
         if self.stochastic {
             self.forget_before_supersampling();
-            // On the global schedule every pass depends on (seed, pass) alone: the choices
-            // are the pilot's (one pass, too few for a variance).
-            if self.global.is_none() {
-                self.seen.tally(&self.pass_direct);
-            }
+            self.seen.tally(&self.pass_direct);
             for (d, p) in self.direct.iter_mut().zip(self.pass_direct.drain(..)) {
                 *d += p.as_dvec3();
             }
             self.stats.eye_passes += 1;
             self.seen.choose(self.stats.eye_passes);
-            if self.global.is_none() {
-                self.seen.choose_by_variance(&self.direct, self.stats.eye_passes);
-            }
+            self.seen.choose_by_variance(&self.direct, self.stats.eye_passes);
             self.stats.supersampled_share = self.seen.count() as f64 / self.direct.len().max(1) as f64;
         }
         self.stats.passes += 1;

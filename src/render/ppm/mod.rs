@@ -326,8 +326,10 @@ impl Ppm {
             prior_light: Vec::new(),
             global: (scene.params.radius_schedule == RadiusSchedule::Global)
                 .then(|| global::Global::new(options.shard, scene.params.alpha, cam.width, cam.height)),
+            // On the global schedule every pass depends on (seed, pass) alone: its choices are
+            // the pilot's one pass, too few for a variance.
             seen: if stochastic && scene.params.supersample_light_seen {
-                seen::SeenLight::new(pixels)
+                seen::SeenLight::new(pixels, scene.params.radius_schedule != RadiusSchedule::Global)
             } else {
                 seen::SeenLight::default()
             },

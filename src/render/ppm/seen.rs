@@ -138,13 +138,19 @@ pub struct SeenLight {
 }
 
 impl SeenLight {
-    /// Nothing chosen yet in a `pixels`-pixel image (0: supersampling is off).
-    pub fn new(pixels: usize) -> Self {
+    /// Nothing chosen yet in a `pixels`-pixel image (0: supersampling is off); with
+    /// `by_variance`, pixels are also chosen for their variance between passes
+    /// ([`SeenLight::choose_by_variance`]; without it, [`SeenLight::tally`] keeps nothing).
+    pub fn new(pixels: usize, by_variance: bool) -> Self {
         Self {
             pixels,
             chosen: vec![0; pixels.div_ceil(64)],
             varied: vec![0; pixels.div_ceil(64)],
-            squares: vec![0.0; pixels],
+            squares: if by_variance {
+                vec![0.0; pixels]
+            } else {
+                Vec::new()
+            },
             ..Self::default()
         }
     }
@@ -166,7 +172,7 @@ impl SeenLight {
     }
 
     /// Adds a completed pass's light seen per pixel (before it joins the sums) to the
-    /// squares, until the pixels of largest variance are chosen.
+    /// squares, until the pixels of largest variance are chosen (never without `by_variance`).
     pub fn tally(&mut self, seen: &[Vec3]) {
         if seen.len() != self.squares.len() {
             return;
@@ -376,7 +382,7 @@ mod tests {
 
     #[test]
     fn the_outline_of_a_lamp_is_chosen_and_its_inside_is_not() {
-        let mut seen = SeenLight::new(128 * 128);
+        let mut seen = SeenLight::new(128 * 128, true);
         seen.observe(&lamp(), 128);
         seen.choose(1);
         for y in 0..16usize {
@@ -397,7 +403,7 @@ mod tests {
 
     #[test]
     fn a_chosen_pixel_counts_only_the_passes_after_its_first_supersampled_one_began() {
-        let mut seen = SeenLight::new(128 * 128);
+        let mut seen = SeenLight::new(128 * 128, true);
         let mut image = vec![Vec3::ZERO; 128 * 128];
         image[5] = Vec3::splat(10.0);
         seen.observe(&image, 128);
@@ -416,7 +422,7 @@ mod tests {
     #[test]
     fn the_budget_bounds_the_chosen_pixels_largest_differences_first_and_choices_stay() {
         // 64×64: the budget is 4096 / 64 = 64 pixels.
-        let mut seen = SeenLight::new(4096);
+        let mut seen = SeenLight::new(4096, true);
         // A bright row, brighter to the right: it and the rows beside it, 192 pixels, qualify.
         let image: Vec<Vec3> = (0..4096)
             .map(|i| {
@@ -441,7 +447,7 @@ mod tests {
     }
 
     /// A 64×64 image's light seen in pass `k`: 0.5 everywhere, but alternating between 0 and
-    /// `swing` from pass to pass in the pixels `varies` picks.
+    /// `swing(i)` from pass to pass in the pixels `i` where `swing` is positive.
     fn flickering(k: u32, swing: impl Fn(usize) -> f32) -> Vec<Vec3> {
         (0..4096)
             .map(|i| {
@@ -452,6 +458,18 @@ mod tests {
                 })
             })
             .collect()
+    }
+
+    /// A swing for [`flickering`]: pixel `i` flickers when `i % period == at`, the more the
+    /// higher its index.
+    fn flickering_every(period: usize, at: usize) -> impl Fn(usize) -> f32 + Copy {
+        move |i| {
+            if i % period == at {
+                1.0 + i as f32 / 4096.0
+            } else {
+                0.0
+            }
+        }
     }
 
     /// Feeds `passes` completed passes to `seen` as the renderer does: the squares, the sums,
@@ -471,21 +489,15 @@ mod tests {
     #[test]
     fn the_pixels_whose_light_varies_most_between_passes_are_chosen_once() {
         // Eleven pixels flicker, the brighter the higher their index; the rest are steady.
-        let swing = |i: usize| {
-            if i % 400 == 7 {
-                1.0 + i as f32 / 4096.0
-            } else {
-                0.0
-            }
-        };
-        let mut early = SeenLight::new(4096);
+        let swing = flickering_every(400, 7);
+        let mut early = SeenLight::new(4096, true);
         run(&mut early, VARIANCE_PASSES - 1, swing);
         assert_eq!(
             early.count(),
             0,
             "nothing is chosen before the variances are taken"
         );
-        let mut seen = SeenLight::new(4096);
+        let mut seen = SeenLight::new(4096, true);
         run(&mut seen, VARIANCE_PASSES, swing);
         assert_eq!(seen.count(), 11);
         assert!(seen.chosen(7) && seen.chosen(3607) && !seen.chosen(8));
@@ -493,6 +505,10 @@ mod tests {
         assert_eq!(seen.subsamples(8), 0);
         assert_eq!(seen.take_pending().len(), 11);
         assert_eq!(seen.passes(7, VARIANCE_PASSES + 3), 3);
+        // Without the choice by variance (the global radius schedule) nothing is chosen.
+        let mut outlines_only = SeenLight::new(4096, false);
+        run(&mut outlines_only, VARIANCE_PASSES, swing);
+        assert_eq!(outlines_only.count(), 0);
         // Later passes choose nothing more.
         let mut sums = vec![DVec3::ZERO; 4096];
         sums[8] = DVec3::splat(1e3);
@@ -502,23 +518,18 @@ mod tests {
 
     #[test]
     fn an_image_that_varies_evenly_chooses_nothing_and_the_budget_bounds_the_rest() {
-        let mut even = SeenLight::new(4096);
+        let mut even = SeenLight::new(4096, true);
         run(&mut even, VARIANCE_PASSES, |_| 1.0);
         assert_eq!(even.count(), 0, "no pixel varies 8 times more than the mean");
         // 400 pixels flicker: the budget, a quarter of 4096 eye rays at 4 a pixel, takes the
         // 256 that flicker most.
-        let mut seen = SeenLight::new(4096);
-        run(&mut seen, VARIANCE_PASSES, |i| {
-            if i % 10 == 3 {
-                1.0 + i as f32 / 4096.0
-            } else {
-                0.0
-            }
-        });
+        let every_tenth = flickering_every(10, 3);
+        let mut seen = SeenLight::new(4096, true);
+        run(&mut seen, VARIANCE_PASSES, every_tenth);
         assert_eq!(seen.count(), 256);
         assert!(seen.chosen(4093) && !seen.chosen(3));
         // An outline chosen first leaves less: 16 rays for each of its pixels.
-        let mut seen = SeenLight::new(4096);
+        let mut seen = SeenLight::new(4096, true);
         let mut image = vec![Vec3::ZERO; 4096];
         image[5] = Vec3::splat(10.0);
         seen.observe(&image, 64);
@@ -526,19 +537,13 @@ mod tests {
         let outline = seen.count();
         assert_eq!(outline, 6, "the pixel and its neighbours");
         assert_eq!(seen.subsamples(5), SUBSAMPLES);
-        run(&mut seen, VARIANCE_PASSES, |i| {
-            if i % 10 == 3 {
-                1.0 + i as f32 / 4096.0
-            } else {
-                0.0
-            }
-        });
+        run(&mut seen, VARIANCE_PASSES, every_tenth);
         assert_eq!(seen.count(), outline + (1024 - 16 * outline) / 4);
     }
 
     #[test]
     fn an_even_image_chooses_nothing() {
-        let mut seen = SeenLight::new(4096);
+        let mut seen = SeenLight::new(4096, true);
         seen.observe(&vec![Vec3::splat(2.0); 4096], 64);
         seen.choose(1);
         assert_eq!(seen.count(), 0);
