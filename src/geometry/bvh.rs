@@ -417,31 +417,26 @@ impl Bvh {
                 let (t0, t1) = pair.hit_intervals(ray.origin, inv_dir, t_max);
                 let (a, b) = (pair.child[0], pair.child[1]);
                 let (sa, sb) = ((t0[0], t1[0]), (t0[1], t1[1]));
-                match (t0[0] <= t1[0], t0[1] <= t1[1]) {
-                    (true, true) => {
-                        let first = sa.0 == sb.0 || !negative[pair.axis as usize];
-                        let ((near, s_near), (far, s_far)) = if first {
-                            ((a, sa), (b, sb))
-                        } else {
-                            ((b, sb), (a, sa))
-                        };
-                        stack.node[top] = far.index;
-                        stack.count[top] = far.count;
-                        stack.enter[top] = s_far.0;
-                        stack.exit[top] = s_far.1;
-                        top += 1;
-                        (node, span) = (near, s_near);
-                        continue;
-                    }
-                    (true, false) => {
-                        (node, span) = (a, sa);
-                        continue;
-                    }
-                    (false, true) => {
-                        (node, span) = (b, sb);
-                        continue;
-                    }
-                    (false, false) => {}
+                let (hit_a, hit_b) = (t0[0] <= t1[0], t0[1] <= t1[1]);
+                // Which children an incoherent ray (a photon, a secondary ray) enters is hard
+                // to predict: one branch asks whether it enters either, the child to go to is
+                // chosen by selects, and the other is written to the stack whether or not it
+                // is kept (`top` moves on only when both were entered). Four-way branching on
+                // the pair of outcomes made the glass teapot's passes 3 % slower.
+                if hit_a | hit_b {
+                    let a_first = if hit_a & hit_b {
+                        sa.0 == sb.0 || !negative[pair.axis as usize]
+                    } else {
+                        hit_a
+                    };
+                    let (near, s_near, far, s_far) = if a_first { (a, sa, b, sb) } else { (b, sb, a, sa) };
+                    stack.node[top] = far.index;
+                    stack.count[top] = far.count;
+                    stack.enter[top] = s_far.0;
+                    stack.exit[top] = s_far.1;
+                    top += (hit_a & hit_b) as usize;
+                    (node, span) = (near, s_near);
+                    continue;
                 }
             }
             // Pop the next node the ray still reaches before the nearest hit so far.
