@@ -560,6 +560,42 @@ fn every_bench_has_a_json_summary() {
     }
 }
 
+/// `bench intersect --order shuffled` traces the same rays as the image order, only in
+/// another order: the same rays hit and miss, and the report says which order it used.
+#[test]
+fn intersect_bench_shuffles_the_same_rays() {
+    let run = |order: &str| -> serde_json::Value {
+        let out = caustic(&[
+            "bench",
+            "intersect",
+            "--json",
+            "--size",
+            "24",
+            "--repeat",
+            "1",
+            "--method",
+            "prepared",
+            "--order",
+            order,
+        ]);
+        assert!(out.status.success(), "{order}: {}", text(&out));
+        serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{order}: {e}: {}", text(&out)))
+    };
+    let (image, shuffled) = (run("image"), run("shuffled"));
+    assert_eq!(image["order"], "image");
+    assert_eq!(shuffled["order"], "shuffled");
+    let counts = |doc: &serde_json::Value| {
+        let t = &doc["intersectors"][0];
+        (
+            t["hit_rays"].as_u64().expect("hits"),
+            t["miss_rays"].as_u64().expect("misses"),
+        )
+    };
+    let (hits, misses) = counts(&image);
+    assert!(hits > 0 && misses > 0 && hits + misses == 24 * 24, "{image}");
+    assert_eq!(counts(&shuffled), (hits, misses));
+}
+
 /// `bench tessellation`: the exact render, the per-ray one (same picture) and tessellations
 /// whose error falls as they get finer, as a CSV and a readable plot.
 #[test]

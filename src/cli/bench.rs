@@ -4,6 +4,9 @@
 
 use anyhow::{bail, Result};
 use clap::{Subcommand, ValueEnum};
+use rand::seq::SliceRandom;
+use rand::SeedableRng;
+use rand_pcg::Pcg64Mcg;
 
 use super::bench_output::BenchOutput;
 use caustic::bench::{teapot_geometry, teapot_view, time_intersect};
@@ -35,6 +38,9 @@ pub enum BenchCommand {
         /// million for the teapot, 1.6 GB).
         #[arg(long, default_value_t = SubdivisionParams::default().max_depth)]
         max_depth: u32,
+        /// The order the rays are traced in.
+        #[arg(long, value_enum, default_value_t = RayOrder::Image)]
+        order: RayOrder,
     },
     /// Photon mapping: photon paths per core-second at the given thread counts.
     Ppm(super::bench_scaling::PpmArgs),
@@ -58,6 +64,28 @@ pub enum BenchCommand {
     Tessellation(super::tessellation::TessellationArgs),
     /// Whitted ray tracer: rays per second on a scene, at the given thread counts.
     Whitted(super::bench_scaling::WhittedArgs),
+}
+
+/// The order `bench intersect` traces its rays in.
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum RayOrder {
+    /// Row by row through the image, as a camera's rays come: each ray walks the part of
+    /// the tree its neighbour just walked, in cache, and takes the same branches.
+    Image,
+    /// A fixed random permutation of the same rays, as incoherent as a renderer's photons
+    /// and secondary rays: the tree and the leaves come from further down the memory
+    /// hierarchy and the walk's branches are harder to predict.
+    Shuffled,
+}
+
+impl RayOrder {
+    /// The flag's value, for the report.
+    fn name(self) -> &'static str {
+        match self {
+            RayOrder::Image => "image",
+            RayOrder::Shuffled => "shuffled",
+        }
+    }
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -104,13 +132,15 @@ pub fn bench(what: BenchCommand, json: bool) -> Result<()> {
             flatness,
             max_size,
             max_depth,
+            order,
         } => {
             let params = SubdivisionParams {
                 flatness,
                 max_size,
                 max_depth,
             };
-            bench_intersect(size, repeat, method, per_ray_depth, params, &mut out)
+            let rays = IntersectRays { size, repeat, order };
+            bench_intersect(rays, method, per_ray_depth, params, &mut out)
         }
         BenchCommand::Whitted(args) => super::bench_scaling::bench_whitted(args, &mut out),
         BenchCommand::Memory(args) => super::memory::bench_memory(args, &mut out),
@@ -161,21 +191,37 @@ fn check_intersect_args(
     Ok(())
 }
 
-fn bench_intersect(
+/// Which rays `bench intersect` traces, how often and in what order.
+struct IntersectRays {
+    /// Image side in pixels.
     size: usize,
+    /// Times each ray set is traced.
     repeat: usize,
+    order: RayOrder,
+}
+
+/// Seed of [`RayOrder::Shuffled`]'s permutation: every run traces the rays in one order.
+const SHUFFLE_SEED: u64 = 0x5EED_0F0D_3E00;
+
+fn bench_intersect(
+    IntersectRays { size, repeat, order }: IntersectRays,
     method: MethodChoice,
     per_ray_depth: u32,
     params: SubdivisionParams,
     out: &mut BenchOutput,
 ) -> Result<()> {
     check_intersect_args(size, repeat, per_ray_depth, &params)?;
-    let rays = teapot_view(size, size);
+    let mut rays = teapot_view(size, size);
+    if order == RayOrder::Shuffled {
+        rays.shuffle(&mut Pcg64Mcg::seed_from_u64(SHUFFLE_SEED));
+    }
     out.say(format!(
-        "Utah teapot (32 patches), {size}x{size} primary rays, 1 thread, {repeat} repeats"
+        "Utah teapot (32 patches), {size}x{size} primary rays in {} order, 1 thread, {repeat} repeats",
+        order.name()
     ));
     out.set("size", size);
     out.set("repeat", repeat);
+    out.set("order", order.name());
     out.say(format!(
         "{:<22} {:>9} {:>9} {:>12} {:>13}",
         "intersector", "hit rays", "miss rays", "ns/hit ray", "ns/miss ray"
