@@ -156,17 +156,14 @@ impl NodePair {
         if !(hit_a | hit_b) {
             return None;
         }
-        let a_first = if hit_a & hit_b {
+        let both = hit_a & hit_b;
+        let a_first = if both {
             t0[0] == t0[1] || !negative[self.axis as usize]
         } else {
             hit_a
         };
         let (near, far) = if a_first { (a, b) } else { (b, a) };
-        Some(Step {
-            near,
-            far,
-            both: hit_a & hit_b,
-        })
+        Some(Step { near, far, both })
     }
 }
 
@@ -411,26 +408,33 @@ impl Bvh {
         // Zeroing is a measurable part of a short traversal, so the arrays are sized to the
         // tree.
         if self.levels <= SHORT_STACK {
-            let stack = Stack {
-                node: &mut [0; SHORT_STACK],
-                count: &mut [0; SHORT_STACK],
-                enter: &mut [0.0; SHORT_STACK],
-                exit: &mut [0.0; SHORT_STACK],
-                top: 0,
-            };
-            self.walk(ray, inv_dir, root, t_max, visit, stack)
+            self.walk_inline::<SHORT_STACK>(ray, inv_dir, root, t_max, visit)
         } else if self.levels <= LONG_STACK {
-            let stack = Stack {
-                node: &mut [0; LONG_STACK],
-                count: &mut [0; LONG_STACK],
-                enter: &mut [0.0; LONG_STACK],
-                exit: &mut [0.0; LONG_STACK],
-                top: 0,
-            };
-            self.walk(ray, inv_dir, root, t_max, visit, stack)
+            self.walk_inline::<LONG_STACK>(ray, inv_dir, root, t_max, visit)
         } else {
             self.traverse_deep(ray, inv_dir, root, t_max, visit)
         }
+    }
+
+    /// [`Bvh::walk`] with a stack of `N` entries in arrays on the thread's stack (`N` at least
+    /// [`Bvh::depth`]).
+    #[inline(always)]
+    fn walk_inline<const N: usize>(
+        &self,
+        ray: &Ray,
+        inv_dir: DVec3,
+        root: (f64, f64),
+        t_max: f64,
+        visit: impl FnMut(u32, f64, (f64, f64)) -> Option<f64>,
+    ) -> f64 {
+        let stack = Stack {
+            node: &mut [0; N],
+            count: &mut [0; N],
+            enter: &mut [0.0; N],
+            exit: &mut [0.0; N],
+            top: 0,
+        };
+        self.walk(ray, inv_dir, root, t_max, visit, stack)
     }
 
     /// [`Bvh::traverse`] for a degenerate tree, deeper than the inline stacks: primitives
