@@ -54,15 +54,23 @@ fn compact(deposits: &mut Vec<Deposit>) {
 /// cells' buckets were put side by side, [`HashGrid`](super::HashGrid)).
 pub(super) const WINDOW_HITS: usize = 1 << 19;
 
-/// Sorted hits handed to the points as one unit of parallel work and of the deterministic
-/// reduction.
-const GROUP: usize = 4096;
+/// Sorted hits handed to the points as one unit of parallel work. Each wave ends when its
+/// last group does, so a thread waits for up to one group at every wave's end: with 4096
+/// hits a group (about 2 ms on smallppm's scene) the two threads of `bench ppm
+/// --indirect-radius-scale 1` lost about 1 ms of each 10-ms wave. 1024 hits and four times
+/// the groups per wave (the same hits a wave, so the same deposits held at once), three
+/// interleaved runs each: 2 threads 365k–367k paths per core-second against 345k–356k
+/// (speed-up 1.86–1.93× against 1.74–1.79×), 1 thread unchanged (380k–394k against
+/// 385k–399k). Unless a group's deposits outgrow [`MAX_GROUP_DEPOSITS`] and are merged, they
+/// are folded in the sorted hits' order whatever the group, so the image is the same
+/// (bit-identical on every scene in `scenes/`).
+const GROUP: usize = 1024;
 
-/// Groups handed between two looks at the caller's control, and folded together, per
-/// thread: enough to keep every thread busy, few enough that the deposits held at once (a
-/// wave's and the one before it, being folded) stay near what the pass held when photons
-/// were handed chunk by chunk.
-const WAVE_PER_THREAD: usize = 4;
+/// Groups ([`GROUP`] hits each) handed between two looks at the caller's control, and
+/// folded together, per thread: enough to keep every thread busy, few enough that the
+/// deposits held at once (a wave's and the one before it, being folded) stay near what the
+/// pass held when photons were handed chunk by chunk.
+const WAVE_PER_THREAD: usize = 16;
 
 /// What a group of hits handed: deposits, and the window places of the photons that reached
 /// a point.
