@@ -160,6 +160,18 @@ impl EyeRays<'_> {
         let start = c.near / dir.dot(c.forward).max(1e-12);
         Ray::new(origin + start * dir, dir)
     }
+
+    /// [`EyeRays::ray`] leaving the lens where [`concentric_disk`] maps `u`, a point of the
+    /// unit square. A pinhole camera needs no lens point, and skips the mapping's sine and
+    /// cosine (1.5 % of a glass-teapot render's samples, `perf`).
+    pub fn ray_with_lens_sample(&self, pixel: DVec2, u: DVec2) -> Ray {
+        let lens = if self.camera.aperture > 0.0 {
+            concentric_disk(u)
+        } else {
+            DVec2::ZERO
+        };
+        self.ray(pixel, lens)
+    }
 }
 
 /// A uniformly distributed point on the unit disk from two uniform numbers (Shirley & Chiu's

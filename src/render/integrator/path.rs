@@ -31,7 +31,6 @@ use crate::render::ppm::Control;
 use crate::render::provenance;
 use crate::render::rng::stream_rng;
 use crate::render::sequence;
-use crate::scene::camera::concentric_disk;
 use crate::scene::light::{cosine_hemisphere, Light};
 use crate::scene::material::{dielectric, reflect, MaterialKind};
 use crate::scene::Scene;
@@ -251,7 +250,7 @@ impl PathTracer {
         let jitter = sequence::sobol(pass, offsets.random());
         let lens = sequence::rotated(sequence::r4(pass)[0], DVec2::new(offsets.random(), offsets.random()));
         let pixel = DVec2::new((i % w) as f64, (i / w) as f64) + jitter;
-        let ray = scene.camera.eye_rays().ray(pixel, concentric_disk(lens));
+        let ray = scene.camera.eye_rays().ray_with_lens_sample(pixel, lens);
         let mut path = Path {
             scene,
             light_of,

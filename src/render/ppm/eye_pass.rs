@@ -15,7 +15,6 @@ use super::visible::{trace_eye, Branching, VisiblePoint};
 use super::{direct, global, seen, streams, Estimate, Ppm, Slot};
 use crate::render::rng::stream_rng;
 use crate::render::sequence;
-use crate::scene::camera::concentric_disk;
 use crate::scene::Scene;
 
 impl Ppm {
@@ -67,7 +66,6 @@ impl Ppm {
                 let mut rng = stream_rng(seed, streams::EYE, pass * w * h + i);
                 let (jitter, lens, first) = eye_sample(seed, pass, i, sequences, &mut rng);
                 let px = DVec2::new(x as f64, y as f64) + jitter;
-                let lens = concentric_disk(lens);
                 let mut sink = |vp: VisiblePoint| {
                     debug_assert!(shade.slot == Shade::NONE, "a chosen path ends once");
                     (*reach, *shade) = points::split(&vp);
@@ -78,7 +76,7 @@ impl Ppm {
                 let chosen = seen.chosen(i as usize);
                 let seen_once = trace_eye(
                     scene,
-                    &rays.ray(px, lens),
+                    &rays.ray_with_lens_sample(px, lens),
                     i as u32,
                     Branching::Choose { first },
                     direct_light && !chosen,

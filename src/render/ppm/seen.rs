@@ -54,7 +54,7 @@ use super::streams;
 use super::visible::{trace_eye, Branching};
 use crate::render::rng::stream_rng;
 use crate::render::sequence;
-use crate::scene::camera::{concentric_disk, EyeRays};
+use crate::scene::camera::EyeRays;
 use crate::scene::Scene;
 
 /// Extra eye rays a pass in a supersampled pixel. A power of two: each pass's block of Sobol's
@@ -353,7 +353,7 @@ impl Subsampler<'_> {
             let pixel = DVec2::new(x as f64, y as f64) + jitter;
             sum += trace_eye(
                 self.scene,
-                &self.rays.ray(pixel, concentric_disk(lens)),
+                &self.rays.ray_with_lens_sample(pixel, lens),
                 i as u32,
                 Branching::Choose { first },
                 self.direct_light,
