@@ -2,6 +2,7 @@
 //! folds it in.
 
 use glam::{DVec3, Vec3};
+use rayon::prelude::*;
 
 use super::guide::GuideTally;
 use super::photon::PhotonCounts;
@@ -24,7 +25,11 @@ impl Gathered {
     /// Nothing gathered yet by `slots` slots of `estimates` estimates each.
     pub(super) fn new(slots: usize, estimates: usize, tally: Option<GuideTally>) -> Self {
         Self {
-            phi: vec![Vec3::ZERO; estimates * slots],
+            // Filled in parallel: `vec!` writes a non-primitive zero one element at a time.
+            phi: (0..estimates * slots)
+                .into_par_iter()
+                .map(|_| Vec3::ZERO)
+                .collect(),
             m: vec![0; estimates * slots],
             estimates,
             counts: PhotonCounts::default(),
