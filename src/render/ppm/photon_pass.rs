@@ -21,7 +21,7 @@ use crate::scene::Scene;
 /// photons through glass cost several times those that miss it: the glass teapot's passes
 /// (about 70,000 photons at 320×240, a batch of 16 chunks of 4096 and one of 1 or 2) left a
 /// thread waiting for up to a chunk twice a pass. With chunks of 1024 (and
-/// [`Gathered::new`](super::gathered::Gathered) filled in parallel), `render
+/// [`Gathered::new`](super::gathered::Gathered::new) filled in parallel), `render
 /// scenes/glass_teapot.toml --width 320 --passes 50`, 3 interleaved runs: photons 2.49–2.57 s
 /// against 2.59–2.68 s (−4 %); images bit-identical (a photon's random numbers depend on its
 /// number alone).
@@ -130,8 +130,8 @@ impl Ppm {
     }
 
     /// This pass's photons: `photons_per_pass` divided by the guide's gain for an epoch's
-    /// first [`GAIN_DIVIDED_PASSES`] passes, by its square root after them (see [`guide`]),
-    /// but not below [`FEWEST_GUIDED_PHOTONS`] (or all of them).
+    /// first [`GAIN_DIVIDED_PASSES`] passes, by its square root after them (see
+    /// [`guide`](super::guide)), but not below [`FEWEST_GUIDED_PHOTONS`] (or all of them).
     pub(super) fn guided_pass_photons(&self) -> u64 {
         match &self.guide {
             Some(g) => {
