@@ -12,6 +12,8 @@
 //! * [`render`]: the Whitted ray tracer, the film and its PNG/EXR output, random streams.
 //! * [`assets`]: the data the binary carries built in (Newell's teapot).
 //! * [`bench`]: measurement harnesses used by `caustic bench`.
+//! * [`farm`]: the Slurm script and Kubernetes manifest of a sharded render, every value
+//!   quoted by one function.
 //! * [`tev`]: streaming frames to a running tev viewer.
 //! * `app` and `gpu` (feature `viewer`, on by default): the eframe viewer and the wgpu
 //!   control-net overlay it draws; the render core does not depend on them.
@@ -26,10 +28,12 @@ pub mod app;
 pub mod assets;
 pub mod bench;
 pub mod color;
+pub mod farm;
 pub mod files;
 pub mod geometry;
 #[cfg(feature = "viewer")]
 pub mod gpu;
+pub mod input_file;
 pub mod render;
 pub mod scene;
 pub mod settings;

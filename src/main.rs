@@ -3,9 +3,15 @@
 
 mod cli;
 
-fn main() -> anyhow::Result<()> {
+fn main() -> std::process::ExitCode {
     return_large_allocations();
-    cli::run()
+    match cli::run() {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(error) => {
+            eprintln!("{}", cli::error_report(&error));
+            std::process::ExitCode::FAILURE
+        }
+    }
 }
 
 /// Serves every allocation of 16 MiB or more from its own mapping, given back to the system

@@ -170,7 +170,7 @@ fn bad_input_gives_clear_errors() {
     let cases: Vec<(Vec<&str>, &str)> = vec![
         (
             vec!["render", "scenes/nope.toml", "--out", out_s],
-            "scenes/nope.toml:0: cannot read the scene file",
+            "scenes/nope.toml:0: the scene file does not exist",
         ),
         (
             vec!["render", "scenes/leaf.toml", "--out", "x.bmp"],
@@ -198,7 +198,7 @@ fn bad_input_gives_clear_errors() {
         ),
         (
             vec!["render", "scenes/smallppm.toml", "--out", out_s, "--passes", "0"],
-            "--passes must be at least 1",
+            "--passes must be between 1 and 10000000, got 0",
         ),
         (
             vec![

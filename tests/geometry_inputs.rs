@@ -116,7 +116,7 @@ fn obj_meshes_load_and_bad_ones_are_errors() {
     }
     let err = TriangleMesh::load_obj(&dir.path().join("missing.obj")).expect_err("missing");
     assert!(
-        err.to_string().contains("missing.obj: cannot read OBJ mesh"),
+        err.to_string().contains("missing.obj: the file does not exist"),
         "got '{err}'"
     );
 }

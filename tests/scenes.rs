@@ -159,7 +159,7 @@ fn bad_scene_files_are_reported_clearly() {
         ),
         (
             scene_text("[[objects]]\ntype = \"mesh\"\nfile = \"nope.obj\"\nmaterial = \"m\"\n"),
-            "objects[1] (mesh): 'file': file",
+            "nope.obj' does not exist",
         ),
         (
             scene_text("[[objects]]\ntype = \"patches\"\nfile = \"broken.bpt\"\nmaterial = \"m\"\n"),
@@ -205,7 +205,7 @@ fn bad_scene_files_are_reported_clearly() {
                 "type = \"diffuse\"",
                 "type = \"diffuse\"\ntexture = { file = \"missing.png\" }",
             ),
-            "[materials.m] (diffuse): 'texture.file': file",
+            "missing.png' does not exist",
         ),
         (
             scene_text("").replace(
@@ -233,7 +233,7 @@ fn bad_scene_files_are_reported_clearly() {
     let missing = Scene::load(&dir.path().join("absent.toml")).expect_err("missing");
     assert!(missing
         .to_string()
-        .contains("absent.toml:0: cannot read the scene file"));
+        .contains("absent.toml:0: the scene file does not exist"));
 }
 
 #[test]

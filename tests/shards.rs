@@ -30,13 +30,8 @@ fn sheet(width: u32, antialias: bool) -> Scene {
 
 /// The sums of shard `shard` of a `total`-pass render.
 fn shard_sums(scene: &Scene, shard: Shard, total: u32) -> PassSums {
-    let mut ppm = Ppm::new(
-        scene,
-        PpmOptions {
-            shard,
-            ..Default::default()
-        },
-    );
+    let mut ppm = Ppm::new(scene, PpmOptions::default());
+    ppm.render_only(caustic::render::shard::PassSet::Shard(shard));
     ppm.photons_per_pass = scene.params.photons_per_pass;
     for _ in 0..shard.passes_of(total) {
         ppm.run_pass(scene, &mut |_| Control::Continue);

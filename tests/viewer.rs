@@ -704,13 +704,8 @@ fn write_part(scene: &Scene, k: u32, n: u32, total: u32, path: &Path) {
     let mut scene = scene.clone();
     scene.params.radius_schedule = caustic::settings::RadiusSchedule::Global;
     let shard = Shard { index: k, count: n };
-    let mut ppm = Ppm::new(
-        &scene,
-        PpmOptions {
-            shard,
-            ..Default::default()
-        },
-    );
+    let mut ppm = Ppm::new(&scene, PpmOptions::default());
+    ppm.render_only(caustic::render::shard::PassSet::Shard(shard));
     ppm.photons_per_pass = scene.params.photons_per_pass;
     for _ in 0..shard.passes_of(total) {
         ppm.run_pass(&scene, &mut |_| Control::Continue);
@@ -775,4 +770,40 @@ fn watching_a_folder_merges_each_new_part_and_skips_what_does_not_belong() {
     h.step();
     assert!(viewer(&h).watching().is_none());
     assert!(!viewer(&h).params.paused, "rendering again");
+}
+
+#[test]
+fn the_probe_never_reads_past_a_frame_that_shrank() {
+    // A watched folder's 320×240 part is replaced by 32×24 parts while the pointer rests
+    // over the image's lower right.
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut big = ball();
+    (big.camera.width, big.camera.height) = (320, 240);
+    big.params.photons_per_pass = 2000;
+    write_part(&big, 0, 1, 1, &dir.path().join("p_big.exr"));
+    let mut h = harness(ball(), true);
+    viewer_mut(&mut h).watch_folder(dir.path().to_path_buf());
+    step_until(&mut h, "the big part", |v| {
+        v.frame().is_some_and(|f| f.width == 320)
+    });
+    let probed = (0..40).find_map(|k| {
+        let pos = egui::pos2(300.0 + 15.0 * k as f32, 360.0 + 5.0 * k as f32);
+        h.event(egui::Event::PointerMoved(pos));
+        h.run_steps(2);
+        viewer(&h).probe().filter(|&(x, y)| x >= 32 && y >= 24)
+    });
+    assert!(probed.is_some(), "the pointer never probed a pixel past 32×24");
+    std::fs::remove_file(dir.path().join("p_big.exr")).expect("remove");
+    let mut small = ball();
+    (small.camera.width, small.camera.height) = (32, 24);
+    write_part(&small, 0, 2, 2, &dir.path().join("p0.exr"));
+    write_part(&small, 1, 2, 2, &dir.path().join("p1.exr"));
+    step_until(&mut h, "the small parts", |v| {
+        v.frame().is_some_and(|f| f.width == 32)
+    });
+    h.run_steps(3);
+    assert!(
+        h.query_by_label_contains("Hover over the image").is_some()
+            || viewer(&h).probe().is_some_and(|(x, y)| x < 32 && y < 24)
+    );
 }

@@ -210,19 +210,22 @@ fn view_menu_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Action>) 
 /// Pixel probe and the last message.
 pub fn status_ui(viewer: &ViewerState, ui: &mut egui::Ui) {
     ui.horizontal(|ui| {
-        match (&viewer.probe, &viewer.frame) {
-            (Some(p), Some(f)) => {
-                let i = (p.y * f.width + p.x) as usize;
-                let [r, g, b] = f.radiance[i];
+        // The probe was taken on the frame shown last; the frame may since have changed size.
+        let probed = viewer
+            .probe
+            .as_ref()
+            .and_then(|p| Some((p, viewer.frame.as_ref()?.pixel(p.x, p.y)?)));
+        match probed {
+            Some((p, ([r, g, b], radius, photons))) => {
                 ui.monospace(format!(
-                    "({:4}, {:4})  RGB {:.4} {:.4} {:.4}  radius {:.4}  photons {:.0}",
-                    p.x, p.y, r, g, b, f.radius[i], f.gathered[i]
+                    "({:4}, {:4})  RGB {:.4} {:.4} {:.4}  radius {radius:.4}  photons {photons:.0}",
+                    p.x, p.y, r, g, b
                 ))
                 .on_hover_text(
                     "Linear radiance, PPM search radius and accumulated photon count under the cursor",
                 );
             }
-            _ => {
+            None => {
                 ui.monospace("Hover over the image to probe a pixel");
             }
         }

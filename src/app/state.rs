@@ -80,6 +80,12 @@ impl ViewerState {
         self.watching.as_ref()
     }
 
+    /// The pixel under the pointer when the image was last drawn (it may lie outside a frame
+    /// that has since shrunk).
+    pub fn probe(&self) -> Option<(u32, u32)> {
+        self.probe.as_ref().map(|p| (p.x, p.y))
+    }
+
     /// The state of a viewer that has just opened `scene` (parameters as in its file, with
     /// `paused`), with `settings` from storage.
     pub(super) fn new(scene: Scene, settings: ViewerSettings, paused: bool) -> Self {

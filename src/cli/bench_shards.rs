@@ -12,7 +12,7 @@ use super::bench_output::BenchOutput;
 use super::load_scene;
 use super::shard::{merge_parts, shard_part};
 use super::shared_args::Threads;
-use caustic::render::shard::Shard;
+use caustic::render::shard::{PassSet, Shard};
 use caustic::scene::Scene;
 
 /// `bench shards`'s flags.
@@ -96,7 +96,7 @@ fn render_parts(
         reset_peak();
         let start = Instant::now();
         let mut scene = scene.clone();
-        let (part, photons) = shard_part(&mut scene, shard, passes, || {})?;
+        let (part, photons) = shard_part(&mut scene, &PassSet::Shard(shard), passes, || {})?;
         let secs = start.elapsed().as_secs_f64();
         let peak = peak_mib().unwrap_or(0.0);
         let path = dir.join(format!("part_{k}.exr"));

@@ -84,6 +84,21 @@ pub fn run() -> Result<()> {
     }
 }
 
+/// What the user sees of an error: its message and the chain of its causes, one a line —
+/// never a backtrace, which `RUST_BACKTRACE=1` (common in a Rust user's shell) would add to
+/// anyhow's own report: a mistake in a file or a flag is not a crash.
+pub fn error_report(error: &anyhow::Error) -> String {
+    let mut text = format!("Error: {error}");
+    let causes: Vec<String> = error.chain().skip(1).map(|c| c.to_string()).collect();
+    if !causes.is_empty() {
+        text.push_str("\n\nCaused by:");
+        for (k, cause) in causes.iter().enumerate() {
+            text.push_str(&format!("\n    {k}: {cause}"));
+        }
+    }
+    text
+}
+
 /// Sizes rayon's global pool for this run (`--threads N`, like pbrt's `--nthreads` and
 /// Mitsuba's `-t`): every render of the command then uses `N` threads. `None`: one per core.
 fn use_threads(threads: Option<usize>) -> Result<()> {

@@ -15,6 +15,8 @@ use caustic::render::compare::Reference;
 use caustic::render::error::pixel_error_estimate;
 use caustic::render::provenance::{software, Recorded};
 use caustic::render::session::{Frame, FrameStats, SessionOptions};
+use caustic::render::shard::sums::passes_text;
+use caustic::render::shard::{PartHeader, PassSet};
 use caustic::render::{image_metadata, Image, Layer};
 use caustic::scene::{RendererKind, Scene};
 use caustic::settings::limits;
@@ -224,22 +226,38 @@ pub fn render(args: RenderArgs) -> Result<()> {
     args.overwrite.check([out])?;
     let mut report = Report::new(args.json);
     let (mut scene, recorded, exposure) = scene_to_render(&args, &mut report)?;
-    if let Some(shard) = args.shard {
-        if args.reference.is_some() || args.tev.is_some() || args.json {
-            bail!("--reference, --tev and --json report on a whole render: merge the parts, then compare or view the merged image");
-        }
-        if args.ppm.time_limit.is_some() {
-            bail!(
-                "--time-limit cannot be used with --shard: a part holds whole passes, chosen by their number"
-            );
-        }
-        let total = args
-            .ppm
-            .passes
-            .or(recorded.as_ref().and_then(|r| r.passes))
-            .unwrap_or(16);
+    let from_part = match &args.from {
+        Some(image) => part_header(image)?,
+        None => None,
+    };
+    if args.shard.is_some() || from_part.is_some() {
+        check_shard_flags(&args)?;
+        let (passes, total) = match (args.shard, &from_part) {
+            (Some(shard), part) => {
+                // A shard of the render the part belongs to, unless --passes says otherwise.
+                let recorded_total = part
+                    .as_ref()
+                    .map(|p| p.total_passes)
+                    .or(recorded.as_ref().and_then(|r| r.passes));
+                (
+                    PassSet::Shard(shard),
+                    args.ppm.passes.or(recorded_total).unwrap_or(16),
+                )
+            }
+            (None, Some(part)) => {
+                if args.ppm.passes.is_some() {
+                    bail!(
+                        "--passes cannot be used with --from a part file: it renders the part's own passes ({} of {}) again; give --shard K/N to render a shard of its render instead",
+                        passes_text(&part.passes),
+                        part.total_passes
+                    );
+                }
+                (PassSet::List(part.passes.clone().into()), part.total_passes)
+            }
+            (None, None) => unreachable!("one of the two is given"),
+        };
         args.ppm.overlay(&mut scene.params)?;
-        return super::shard::render_shard(&mut scene, shard, total, out, args.overwrite.force);
+        return super::shard::render_shard(&mut scene, passes, total, out, args.overwrite.force);
     }
     let reference = match &args.reference {
         Some(path) => {
@@ -283,6 +301,44 @@ pub fn render(args: RenderArgs) -> Result<()> {
         .save_with_layers(out, exposure, &rendered.metadata, &layers, args.overwrite.force)?;
     report.finish(out, &scene, &rendered.stats, reference.as_ref(), &rendered.image);
     Ok(())
+}
+
+/// Refuses the flags that a part (a shard's, or a part's passes rendered again) cannot take:
+/// what reports on a whole render, a time limit, and another renderer or radius schedule.
+pub fn check_shard_flags(args: &RenderArgs) -> Result<()> {
+    if args.reference.is_some() || args.tev.is_some() || args.json {
+        bail!("--reference, --tev and --json report on a whole render, not on a part: merge the parts, then compare or view the merged image");
+    }
+    if args.ppm.time_limit.is_some() {
+        bail!("--time-limit cannot be used for a part: a part holds whole passes, chosen by their number");
+    }
+    if let Some(kind) = args.renderer.filter(|&k| k != RendererKind::Ppm) {
+        bail!(
+            "--renderer {}: a part is photon mapped with the global radius schedule",
+            kind.name()
+        );
+    }
+    if let Some(schedule) = args.ppm.radius_schedule.filter(|&s| s != RadiusSchedule::Global) {
+        bail!(
+            "--radius-schedule {}: a part's passes follow the global radius schedule",
+            schedule.name()
+        );
+    }
+    Ok(())
+}
+
+/// The header of `image` when it is a part file (`None` for another image); a part whose
+/// header is damaged is an error.
+fn part_header(image: &std::path::Path) -> Result<Option<PartHeader>> {
+    let metadata = caustic::render::film::read_metadata(image)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", image.display()))?;
+    if !metadata
+        .iter()
+        .any(|(k, _)| k == caustic::render::shard::part::PART)
+    {
+        return Ok(None);
+    }
+    Ok(Some(PartHeader::read(image)?))
 }
 
 /// The scene to render (from its file, or as an image recorded it with `--from`) with the
@@ -367,8 +423,8 @@ enum Passes {
 
 /// Renders `passes` (one frame for a renderer that makes one) on a headless session.
 fn render_passes(scene: &mut Scene, passes: Passes, args: &PpmArgs, output: &mut Output) -> Result<Rendered> {
-    if passes == Passes::Count(0) {
-        bail!("--passes must be at least 1");
+    if let Passes::Count(n) = passes {
+        flag_check("--passes", limits::passes(n))?;
     }
     if let Some(t) = args.time_limit {
         if !(t.is_finite() && t > 0.0) {

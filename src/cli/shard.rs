@@ -10,37 +10,36 @@ use anyhow::{bail, Context, Result};
 use super::shared_args::Overwrite;
 use caustic::render::image_metadata;
 use caustic::render::ppm::{Control, PassOutcome, Ppm, PpmOptions};
-use caustic::render::shard::{Part, Shard};
+use caustic::render::shard::{Part, PassSet};
 use caustic::scene::{RendererKind, Scene};
+use caustic::settings::limits;
 use caustic::settings::RadiusSchedule;
 
-/// Renders shard `shard` of a `total`-pass render of `scene` (its photon-mapping flags laid
-/// in) into the part file `out`, which `render` has checked may be written.
-pub fn render_shard(scene: &mut Scene, shard: Shard, total: u32, out: &Path, force: bool) -> Result<()> {
+/// Renders the passes `passes` of a `total`-pass render of `scene` (its photon-mapping flags
+/// laid in) into the part file `out`, which `render` has checked may be written.
+pub fn render_shard(scene: &mut Scene, passes: PassSet, total: u32, out: &Path, force: bool) -> Result<()> {
     if !out.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr")) {
         bail!(
-            "{}: a shard is written as an EXR part file (use .exr)",
+            "{}: a part (a shard, or a part's passes rendered again) is written as an EXR part file (use .exr)",
             out.display()
         );
     }
-    if total == 0 {
-        bail!("--passes must be at least 1");
-    }
+    limits::passes(total).map_err(|e| anyhow::anyhow!("--passes {e}"))?;
     let start = Instant::now();
-    let count = shard.passes_of(total);
+    let count = passes.passes_of(total);
     let bar = super::progress_bar(
         count as u64,
         "{msg} [{bar:40}] pass {pos}/{len}, {elapsed} (eta {eta})",
         format!(
-            "shard {shard} of {total} passes, {}x{}",
+            "{passes} of {total} passes, {}x{}",
             scene.camera.width, scene.camera.height
         ),
     )?;
-    let (part, photons) = shard_part(scene, shard, total, || bar.inc(1))?;
+    let (part, photons) = shard_part(scene, &passes, total, || bar.inc(1))?;
     bar.finish_and_clear();
     part.write(out, force)?;
     println!(
-        "shard {shard}: {count} of {total} passes, {photons} photons in {:.2} s ({:.2} passes/s) → {}",
+        "{passes}: {count} of {total} passes, {photons} photons in {:.2} s ({:.2} passes/s) → {}",
         start.elapsed().as_secs_f64(),
         count as f64 / start.elapsed().as_secs_f64().max(1e-9),
         out.display()
@@ -48,30 +47,25 @@ pub fn render_shard(scene: &mut Scene, shard: Shard, total: u32, out: &Path, for
     Ok(())
 }
 
-/// Renders shard `shard` of a `total`-pass render of `scene` (photon mapping with the global
-/// schedule, whatever the scene says), calling `pass_done` after each pass: its part, and the
-/// photons it emitted.
+/// Renders the passes `passes` of a `total`-pass render of `scene` (photon mapping with the
+/// global schedule, whatever the scene says), calling `pass_done` after each pass: its part,
+/// and the photons it emitted.
 pub fn shard_part(
     scene: &mut Scene,
-    shard: Shard,
+    passes: &PassSet,
     total: u32,
     mut pass_done: impl FnMut(),
 ) -> Result<(Part, u64)> {
     // A shard is photon mapping with the global schedule, whatever the scene's renderer.
     scene.params.renderer = RendererKind::Ppm;
     scene.params.radius_schedule = RadiusSchedule::Global;
-    let mut ppm = Ppm::new(
-        scene,
-        PpmOptions {
-            shard,
-            ..Default::default()
-        },
-    );
+    let mut ppm = Ppm::new(scene, PpmOptions::default());
+    ppm.render_only(passes.clone());
     let (w, h) = ppm.size();
     ppm.photons_per_pass = scene
         .params
         .pass_photons(ppm.is_stochastic(), w as u64 * h as u64);
-    for _ in 0..shard.passes_of(total) {
+    for _ in 0..passes.passes_of(total) {
         if ppm.run_pass(scene, &mut |_| Control::Continue) != PassOutcome::Completed {
             bail!("pass abandoned");
         }
@@ -83,7 +77,9 @@ pub fn shard_part(
         .context("the global schedule keeps sums")?;
     let settings = toml::to_string(&scene.params).context("writing the settings")?;
     let mut metadata = image_metadata(scene, RendererKind::Ppm.name(), None);
-    metadata.push(("caustic:shard".into(), shard.to_string()));
+    if let PassSet::Shard(shard) = passes {
+        metadata.push(("caustic:shard".into(), shard.to_string()));
+    }
     Ok((Part::new(sums, total, metadata, settings), ppm.stats().photons))
 }
 

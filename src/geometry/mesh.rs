@@ -53,9 +53,9 @@ pub struct TriangleHit {
 impl TriangleMesh {
     /// Loads every model of an OBJ file into one mesh (triangulated; materials ignored).
     pub fn load_obj(path: &Path) -> Result<Self, MeshError> {
-        let file = std::fs::File::open(path).map_err(|_| MeshError::Parse {
+        let file = crate::input_file::open(path).map_err(|why| MeshError::Invalid {
             path: path.to_owned(),
-            source: tobj::LoadError::OpenFileFailed,
+            message: format!("the file {why}"),
         })?;
         Self::parse_obj(&mut std::io::BufReader::new(file), path)
     }

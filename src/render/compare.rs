@@ -62,10 +62,12 @@ impl Reference {
             .map(str::to_ascii_lowercase);
         let image = match extension.as_deref() {
             Some("pfm") => {
+                crate::input_file::regular_file(path).map_err(read_error)?;
                 let bytes = std::fs::read(path).map_err(|e| read_error(e.to_string()))?;
                 read_pfm(&bytes).map_err(read_error)?
             }
             Some("exr") => {
+                crate::input_file::regular_file(path).map_err(read_error)?;
                 let decoded = image::open(path).map_err(|e| read_error(e.to_string()))?;
                 let rgb = decoded.to_rgb32f();
                 Image {

@@ -200,6 +200,7 @@ impl Image {
 /// The text metadata of an image this program wrote: EXR string attributes or PNG text
 /// chunks, in file order.
 pub fn read_metadata(path: &Path) -> Result<Metadata, String> {
+    crate::input_file::regular_file(path).map_err(|why| format!("the file {why}"))?;
     match Format::from_path(path) {
         Some(Format::Exr) => {
             let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| e.to_string())?;

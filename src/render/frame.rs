@@ -124,6 +124,20 @@ impl Frame {
         }
     }
 
+    /// Pixel `(x, y)`'s radiance, search radius and photon count, or `None` outside the
+    /// frame (a probe taken on an earlier frame of another size).
+    pub fn pixel(&self, x: u32, y: u32) -> Option<([f32; 3], f32, f32)> {
+        if x >= self.width || y >= self.height {
+            return None;
+        }
+        let i = y as usize * self.width as usize + x as usize;
+        Some((
+            *self.radiance.get(i)?,
+            *self.radius.get(i)?,
+            *self.gathered.get(i)?,
+        ))
+    }
+
     /// This frame at a larger size `(w, h)` (nearest neighbour), marked as a preview.
     pub fn enlarged_preview(self, (w, h): (u32, u32)) -> Frame {
         let small = (self.width, self.height);

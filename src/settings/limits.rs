@@ -18,6 +18,11 @@ pub const PHOTONS_PER_PIXEL: RangeInclusive<f64> = 0.0..=1000.0;
 pub const RADIUS_SCALE: RangeInclusive<f64> = 1.0..=100.0;
 /// Image width and height in pixels.
 pub const IMAGE_SIDE: RangeInclusive<u32> = 1..=16384;
+/// Passes of one render: photon-mapping passes, a sharded render's total and the passes a
+/// part file holds. Ten million passes of the smallest image take days; the bound keeps a
+/// part's pass list (4 bytes a pass once read) and the global schedule's radius factor
+/// (one multiplication a pass) small.
+pub const PASSES: RangeInclusive<u32> = 1..=10_000_000;
 /// Seeds: what a scene file can hold, whose integers are TOML's (signed 64-bit), so that every
 /// render's scene can be saved and recorded in its image.
 pub const SEED: RangeInclusive<u64> = 0..=i64::MAX as u64;
@@ -52,6 +57,11 @@ pub fn max_depth(d: u32) -> Result<u32, Invalid> {
 /// Lens or light samples.
 pub fn samples(n: u32) -> Result<u32, Invalid> {
     within(n, SAMPLES, "")
+}
+
+/// Passes of a render.
+pub fn passes(n: u32) -> Result<u32, Invalid> {
+    within(n, PASSES, "")
 }
 
 /// Image width or height.

@@ -22,7 +22,7 @@ use super::estimate::{mean_primary_radius, Slot};
 use super::gathered::Gathered;
 use super::radius::IndirectScale;
 use super::{Control, Estimate, PassOutcome, Ppm, Restart};
-use crate::render::shard::{PassSums, Shard};
+use crate::render::shard::{PassSet, PassSums};
 use crate::scene::Scene;
 
 /// `r_{i+1}² / r_1²` for pass `i` (0-based) of the global schedule with `alpha`:
@@ -33,12 +33,12 @@ pub fn schedule_factor(pass: u64, alpha: f64) -> f64 {
 
 /// The global schedule's state in a [`Ppm`].
 pub(super) struct Global {
-    shard: Shard,
+    passes: PassSet,
     /// α, fixed for the render.
     alpha: f64,
     /// Per slot, the pilot's radii² `r_1²` (primary, indirect); `None` before the pilot.
     pilot: Option<Vec<(f64, f64)>>,
-    /// This shard's passes completed.
+    /// Its passes completed.
     done: u32,
     /// The stream position: 0 for the pilot, `i + 1` for pass `i`.
     stream: u64,
@@ -47,10 +47,10 @@ pub(super) struct Global {
 }
 
 impl Global {
-    /// Before the pilot pass, for shard `shard` of a `width`×`height` render with `alpha`.
-    pub(super) fn new(shard: Shard, alpha: f64, width: u32, height: u32) -> Self {
+    /// Before the pilot pass, for every pass of a `width`×`height` render with `alpha`.
+    pub(super) fn new(alpha: f64, width: u32, height: u32) -> Self {
         Self {
-            shard,
+            passes: PassSet::default(),
             alpha,
             pilot: None,
             done: 0,
@@ -77,6 +77,14 @@ impl Global {
 }
 
 impl Ppm {
+    /// With the global radius schedule, renders only `passes` of the render (a shard's, or a
+    /// part's own list), in order, instead of every pass; nothing otherwise.
+    pub fn render_only(&mut self, passes: PassSet) {
+        if let Some(g) = &mut self.global {
+            g.passes = passes;
+        }
+    }
+
     /// The next pass of this process's shard: the pilot first (once), then the pass's own eye
     /// pass, photons at the scheduled radii and its estimate added to the sums.
     pub(super) fn run_global_pass(
@@ -95,7 +103,7 @@ impl Ppm {
         let Some(g) = &mut self.global else {
             return PassOutcome::Aborted;
         };
-        let pass = g.shard.pass(g.done);
+        let pass = g.passes.pass(g.done);
         g.stream = pass + 1;
         if self.interrupted() || (self.stochastic && !self.trace_stochastic_eye_pass(scene)) {
             return PassOutcome::Aborted;

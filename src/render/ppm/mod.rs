@@ -58,7 +58,7 @@ pub use kd_tree::KdTree;
 use points::VisiblePoints;
 
 use crate::render::rng::stream_rng;
-use crate::render::shard::{PassSums, Shard};
+use crate::render::shard::PassSums;
 use crate::scene::Scene;
 use crate::settings::{IndexKind, RadiusSchedule};
 
@@ -99,9 +99,6 @@ pub struct PpmOptions {
     /// pixel), so that an epoch can hand a warm restart its statistics ([`warm`]); classic
     /// PPM keeps its points anyway.
     pub warm_restarts: bool,
-    /// With the global radius schedule: which of the render's passes this process renders
-    /// (every pass when it is `0/1`); ignored with per-point statistics.
-    pub shard: Shard,
 }
 
 impl Default for PpmOptions {
@@ -110,7 +107,6 @@ impl Default for PpmOptions {
             force_stochastic: false,
             batch_photons: DEFAULT_BATCH_PHOTONS,
             warm_restarts: false,
-            shard: Shard::default(),
         }
     }
 }
@@ -325,7 +321,7 @@ impl Ppm {
             kept_grid: None,
             prior_light: Vec::new(),
             global: (scene.params.radius_schedule == RadiusSchedule::Global)
-                .then(|| global::Global::new(options.shard, scene.params.alpha, cam.width, cam.height)),
+                .then(|| global::Global::new(scene.params.alpha, cam.width, cam.height)),
             // On the global schedule every pass depends on (seed, pass) alone: its choices are
             // the pilot's one pass, too few for a variance.
             seen: if stochastic && scene.params.supersample_light_seen {

@@ -14,7 +14,7 @@ pub mod part;
 pub mod sums;
 
 pub use folder::{FolderMerge, ScanReport};
-pub use part::{MergeError, Part, PartError};
+pub use part::{MergeError, Part, PartError, PartHeader, RenderKey};
 pub use sums::PassSums;
 
 /// Which of a render's passes one process renders: pass `i` when `i mod count == index`.
@@ -65,6 +65,50 @@ impl Shard {
             0
         } else {
             (total - self.index).div_ceil(self.count)
+        }
+    }
+}
+
+/// The passes of a render one process renders: a shard's, or a list of them (a part's own,
+/// which `render --from PART` renders again).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum PassSet {
+    /// Pass `i` when `i mod N = K`.
+    Shard(Shard),
+    /// These passes, ascending and distinct.
+    List(std::sync::Arc<[u32]>),
+}
+
+impl Default for PassSet {
+    /// Every pass.
+    fn default() -> Self {
+        PassSet::Shard(Shard::default())
+    }
+}
+
+impl PassSet {
+    /// Its `j`-th pass.
+    pub fn pass(&self, j: u32) -> u64 {
+        match self {
+            PassSet::Shard(s) => s.pass(j),
+            PassSet::List(l) => l.get(j as usize).map_or(u64::MAX, |&p| p as u64),
+        }
+    }
+
+    /// How many of the passes `0..total` are its own.
+    pub fn passes_of(&self, total: u32) -> u32 {
+        match self {
+            PassSet::Shard(s) => s.passes_of(total),
+            PassSet::List(l) => l.iter().take_while(|&&p| p < total).count() as u32,
+        }
+    }
+}
+
+impl std::fmt::Display for PassSet {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            PassSet::Shard(s) => write!(f, "{s}"),
+            PassSet::List(l) => write!(f, "passes {}", sums::passes_text(l)),
         }
     }
 }

@@ -246,53 +246,153 @@ impl Part {
         image.write().to_file(path).map_err(|e| e.to_string())
     }
 
-    /// Reads a part file; the error says why it is not one (not an EXR, half written, not a
-    /// part, a damaged pass list…).
+    /// Reads a part file; the error says why it is not one (not a file, not an EXR, half
+    /// written, not a part, a damaged pass list…). The header is read and checked first
+    /// ([`PartHeader::read`]), so a damaged one costs nothing more.
     pub fn read(path: &Path) -> Result<Part, PartError> {
+        let header = PartHeader::read(path)?;
         let error = |message: String| PartError {
             path: path.to_owned(),
             message,
         };
-        if !path.is_file() {
-            return Err(error("no such file".into()));
-        }
         let image = exr::prelude::read_first_flat_layer_from_file(path)
             .map_err(|e| error(format!("not a readable EXR image (half written?): {e}")))?;
         let layer = &image.layer_data;
-        let mut metadata =
-            exr_text_attributes(layer.attributes.other.iter().chain(image.attributes.other.iter()));
-        metadata.sort();
-        metadata.dedup_by(|a, b| a.0 == b.0);
-        let get = |key: &str| metadata.iter().find(|(k, _)| k == key).map(|(_, v)| v.as_str());
-        if get(PART) != Some("1") {
-            return Err(error(
-                "not a part file (no caustic:part attribute: render it with --shard K/N)".into(),
-            ));
+        let (w, h) = header.size;
+        if (layer.size.0, layer.size.1) != (w as usize, h as usize) {
+            return Err(error("it changed while it was read".into()));
         }
-        let total_passes = get(TOTAL_PASSES)
-            .and_then(|v| v.parse::<u32>().ok())
-            .ok_or_else(|| error(format!("its {TOTAL_PASSES} is missing or not a number")))?;
-        let passes = get(PASS_LIST)
-            .and_then(parse_passes)
-            .ok_or_else(|| error(format!("its {PASS_LIST} is missing or damaged")))?;
-        if passes.last().is_some_and(|&p| p >= total_passes) {
-            return Err(error(format!(
-                "it holds pass {} of a render of {total_passes} passes",
-                passes.last().copied().unwrap_or(0)
-            )));
-        }
-        let photons = get(PART_PHOTONS)
-            .and_then(|v| v.parse::<u64>().ok())
-            .ok_or_else(|| error(format!("its {PART_PHOTONS} is missing or not a number")))?;
-        let (w, h) = (layer.size.0, layer.size.1);
-        let (rgb, lum2) = read_sums(&layer.channel_data, w * h).map_err(error)?;
-        let sums = PassSums::from_parts((w as u32, h as u32), rgb, lum2, passes, photons)
+        let (rgb, lum2) = read_sums(&layer.channel_data, layer.size.0 * layer.size.1).map_err(error)?;
+        let sums = PassSums::from_parts((w, h), rgb, lum2, header.passes, header.photons)
             .ok_or_else(|| error("its sums do not match its size".into()))?;
         Ok(Part {
             sums,
-            total_passes,
-            metadata,
+            total_passes: header.total_passes,
+            metadata: header.metadata,
         })
+    }
+}
+
+/// A part file's header, read without its pixels: the render it belongs to ([`RenderKey`]),
+/// the passes it holds and its size. What `render --from PART` and a watched folder need
+/// before deciding to read the sums.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PartHeader {
+    /// The provenance and part keys (string attributes), sorted by key.
+    pub metadata: Metadata,
+    /// The passes it holds, ascending.
+    pub passes: Vec<u32>,
+    /// The passes of the whole render.
+    pub total_passes: u32,
+    /// Photons its passes emitted.
+    pub photons: u64,
+    /// Image width and height.
+    pub size: (u32, u32),
+}
+
+/// What makes parts parts of one render: they merge only when all of it agrees.
+#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct RenderKey {
+    /// The program that wrote it.
+    pub software: String,
+    /// Image width and height.
+    pub size: (u32, u32),
+    /// The render settings.
+    pub settings: String,
+    /// The scene text's hash.
+    pub scene_hash: String,
+    /// The passes of the whole render.
+    pub total_passes: u32,
+}
+
+impl PartHeader {
+    /// Reads and checks the header of the part file at `path`.
+    pub fn read(path: &Path) -> Result<PartHeader, PartError> {
+        let error = |message: String| PartError {
+            path: path.to_owned(),
+            message,
+        };
+        let file = crate::input_file::open(path).map_err(|why| error(format!("the file {why}")))?;
+        Self::parse(std::io::BufReader::new(file)).map_err(error)
+    }
+
+    /// Reads and checks a part file's header from `reader` (the start of the file).
+    pub fn parse(reader: impl std::io::Read) -> Result<PartHeader, String> {
+        let meta = exr::meta::MetaData::read_from_buffered(reader, false)
+            .map_err(|e| format!("not a readable EXR image (half written?): {e}"))?;
+        let header = meta.headers.first().ok_or("the EXR file holds no image")?;
+        let mut metadata = exr_text_attributes(
+            header
+                .own_attributes
+                .other
+                .iter()
+                .chain(header.shared_attributes.other.iter()),
+        );
+        metadata.sort();
+        metadata.dedup_by(|a, b| a.0 == b.0);
+        let get = |key: &str| metadata.iter().find(|(k, _)| k == key).map(|(_, v)| v.as_str());
+        match get(PART) {
+            Some("1") => {}
+            None => {
+                return Err("not a part file (no caustic:part attribute: render it with --shard K/N)".into())
+            }
+            Some(v) => {
+                return Err(format!(
+                    "its {PART} is {v:?}: a part file of another format (this program reads format 1)"
+                ))
+            }
+        }
+        let total_passes = get(TOTAL_PASSES)
+            .and_then(|v| v.parse::<u32>().ok())
+            .ok_or_else(|| format!("its {TOTAL_PASSES} is missing or not a number"))?;
+        crate::settings::limits::passes(total_passes).map_err(|e| format!("its {TOTAL_PASSES} {e}"))?;
+        let passes = parse_passes(
+            get(PASS_LIST).ok_or_else(|| format!("its {PASS_LIST} is missing"))?,
+            total_passes,
+        )
+        .map_err(|e| format!("its {PASS_LIST} is damaged: {e}"))?;
+        let photons = get(PART_PHOTONS)
+            .and_then(|v| v.parse::<u64>().ok())
+            .ok_or_else(|| format!("its {PART_PHOTONS} is missing or not a number"))?;
+        let (w, h) = (header.layer_size.0, header.layer_size.1);
+        let side = |v: usize| {
+            u32::try_from(v)
+                .ok()
+                .and_then(|v| crate::settings::limits::image_side(v).ok())
+        };
+        let (Some(w), Some(h)) = (side(w), side(h)) else {
+            return Err(format!(
+                "its image is {w}x{h} pixels; a part's sides are 1 to {} pixels",
+                crate::settings::limits::IMAGE_SIDE.end()
+            ));
+        };
+        Ok(PartHeader {
+            metadata,
+            passes,
+            total_passes,
+            photons,
+            size: (w, h),
+        })
+    }
+
+    /// The value of attribute `key`.
+    pub fn get(&self, key: &str) -> Option<&str> {
+        self.metadata
+            .iter()
+            .find(|(k, _)| k == key)
+            .map(|(_, v)| v.as_str())
+    }
+
+    /// The render it belongs to.
+    pub fn render_key(&self) -> RenderKey {
+        let field = |key: &str| self.get(key).unwrap_or("(none)").to_owned();
+        RenderKey {
+            software: field(provenance::SOFTWARE),
+            size: self.size,
+            settings: field(SETTINGS),
+            scene_hash: field(SCENE_HASH),
+            total_passes: self.total_passes,
+        }
     }
 }
 

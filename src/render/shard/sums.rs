@@ -248,23 +248,36 @@ pub fn passes_text(passes: &[u32]) -> String {
     out.join(",")
 }
 
-/// The pass list [`passes_text`] wrote; `None` unless it is ascending runs of whole numbers.
-pub fn parse_passes(text: &str) -> Option<Vec<u32>> {
+/// The pass list [`passes_text`] wrote, of a render of `total` passes: ascending runs of whole
+/// numbers below `total`. Each run is checked before it is expanded, so the list costs at most
+/// 4 bytes for each of the render's passes, whatever the text claims; the error says what is
+/// wrong.
+pub fn parse_passes(text: &str, total: u32) -> Result<Vec<u32>, String> {
     let mut passes: Vec<u32> = Vec::new();
     for run in text.split(',').filter(|r| !r.is_empty()) {
+        let number = |s: &str| {
+            s.parse::<u32>()
+                .map_err(|_| format!("{s:?} is not a pass number"))
+        };
         let (a, b) = match run.split_once('-') {
-            Some((a, b)) => (a.parse().ok()?, b.parse().ok()?),
+            Some((a, b)) => (number(a)?, number(b)?),
             None => {
-                let a = run.parse().ok()?;
+                let a = number(run)?;
                 (a, a)
             }
         };
-        if a > b || passes.last().is_some_and(|&l| l >= a) || b - a > 100_000_000 {
-            return None;
+        if a > b {
+            return Err(format!("the run {run} runs backwards"));
+        }
+        if passes.last().is_some_and(|&l| l >= a) {
+            return Err(format!("the run {run} is not after the pass before it"));
+        }
+        if b >= total {
+            return Err(format!("it holds pass {b} of a render of {total} passes"));
         }
         passes.extend(a..=b);
     }
-    Some(passes)
+    Ok(passes)
 }
 
 #[cfg(test)]
@@ -299,11 +312,22 @@ mod tests {
     fn pass_lists_round_trip_as_runs() {
         for passes in [vec![], vec![3], vec![0, 1, 2, 3, 7, 9, 10]] {
             let text = passes_text(&passes);
-            assert_eq!(parse_passes(&text), Some(passes), "{text}");
+            assert_eq!(parse_passes(&text, 11), Ok(passes), "{text}");
         }
         assert_eq!(passes_text(&[0, 1, 2, 5]), "0-2,5");
-        assert_eq!(parse_passes("3,1"), None);
-        assert_eq!(parse_passes("x"), None);
+        assert!(parse_passes("3,1", 10).is_err());
+        assert!(parse_passes("x", 10).is_err());
+        assert!(parse_passes("3-1", 10).is_err());
+        assert!(parse_passes("0-9", 9)
+            .expect_err("past the total")
+            .contains("pass 9"));
+    }
+
+    #[test]
+    fn a_pass_list_bomb_is_refused_before_it_is_expanded() {
+        // Three runs of 10^8 passes claimed by a render of 1000 passes: refused at once.
+        let text = "0-99999999,100000000-199999999,200000000-299999999";
+        assert!(parse_passes(text, 1000).is_err());
     }
 
     #[test]

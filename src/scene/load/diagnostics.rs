@@ -51,8 +51,8 @@ impl Ctx<'_> {
             ));
         };
         let path = base.join(file);
-        if !path.is_file() {
-            return Err(self.err(span, format!("{what}: file '{}' does not exist", path.display())));
+        if let Err(why) = crate::input_file::regular_file(&path) {
+            return Err(self.err(span, format!("{what}: '{}' {why}", path.display())));
         }
         Ok(path)
     }

@@ -24,11 +24,12 @@ use diagnostics::{v3, Ctx, Result, Table};
 pub use diagnostics::SceneError;
 
 pub(super) fn load_file(path: &Path) -> Result<Scene> {
-    let text = std::fs::read_to_string(path).map_err(|e| SceneError {
-        path: path.to_owned(),
-        line: 0,
-        message: format!("cannot read the scene file: {e}"),
-    })?;
+    let text =
+        crate::input_file::read_text(path, crate::input_file::MAX_TEXT_BYTES).map_err(|e| SceneError {
+            path: path.to_owned(),
+            line: 0,
+            message: format!("the scene file {e}"),
+        })?;
     let base = path.parent().map(Path::to_owned).unwrap_or_default();
     load_str(&text, path, Some(&base))
 }
