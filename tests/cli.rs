@@ -642,3 +642,27 @@ fn tessellation_bench_compares_exact_and_tessellated_renders() {
         text(&flat)
     );
 }
+
+#[test]
+fn errors_carry_no_backtrace_even_with_rust_backtrace_set() {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_caustic"))
+        .args([
+            "render",
+            "scenes/nope.toml",
+            "--out",
+            "/tmp/caustic-never-written.png",
+        ])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .env("RUST_BACKTRACE", "1")
+        .env("RUST_LIB_BACKTRACE", "1")
+        .output()
+        .expect("run caustic");
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.starts_with("Error: scenes/nope.toml:0: the scene file does not exist"),
+        "{err}"
+    );
+    assert!(!err.to_lowercase().contains("backtrace"), "{err}");
+    assert!(err.lines().count() <= 4, "{err}");
+}

@@ -6,7 +6,7 @@ use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 
 use caustic::render::render_whitted;
-use caustic::scene::Scene;
+use caustic::scene::{RendererKind, Scene};
 use glam::{DVec2, DVec3};
 
 fn scenes_dir() -> PathBuf {
@@ -124,6 +124,26 @@ fn bad_scene_files_are_reported_clearly() {
         (
             scene_text("").replace("power = 100", "power = inf"),
             "expected a finite number, found inf",
+        ),
+        // A light bright enough to make an image of infinities is refused at load.
+        (
+            scene_text("").replace("power = 100", "power = 1e308"),
+            "lights[0] (point): 'power' must be positive and at most 1e12 in every colour channel",
+        ),
+        (
+            scene_text("").replace("power = 100", "power = 1e11\ncolor = [1e9, 1, 1]"),
+            "'power' must be positive and at most 1e12 in every colour channel (with 'color' applied), got 100000000000000000000",
+        ),
+        (
+            scene_text("").replace(
+                "type = \"point\"\nposition = [0, 3, 3]",
+                "type = \"sphere\"\ncenter = [0, 3, 3]\nradius = 1e-200",
+            ),
+            "lights[0] (sphere): 'power' over the light's area makes a radiance of",
+        ),
+        (
+            scene_text("[render]\nambient = [1e30, 0, 0]\n"),
+            "'ambient' makes a radiance of 1e30",
         ),
         (
             scene_text("").replace("fov = 40", "fov = \"wide\""),
@@ -479,4 +499,41 @@ fn the_inline_patch_example_is_the_shipped_scene_and_faces_up() {
     let n = patch.normal(0.5, 0.5).expect("a normal");
     assert!(n.dot(glam::DVec3::Y) > 0.99, "normal {n}");
     assert!((patch.eval(0.0, 1.0) - glam::DVec3::new(1.0, 1.5, -1.0)).length() < 1e-12);
+}
+
+#[test]
+fn the_brightest_light_allowed_renders_a_finite_image() {
+    // A terawatt point light a hundredth of its radius from the sphere, seen by every renderer.
+    let text = scene_text("")
+        .replace("power = 100", "power = 1e12")
+        .replace("position = [0, 3, 3]", "position = [0, 0, 1.01]");
+    let scene = Scene::from_str(&text, Path::new("bright.toml"), None).expect("loads");
+    for kind in [RendererKind::Whitted, RendererKind::Ppm, RendererKind::Path] {
+        let mut scene = scene.clone();
+        scene.params.renderer = kind;
+        scene.params.photons_per_pass = 2000;
+        // The ray tracer makes one frame and waits; the others stop after two passes.
+        let passes = if kind == RendererKind::Whitted { 1 } else { 2 };
+        let frame = render_frames(scene, passes);
+        assert!(
+            frame.radiance.iter().flatten().all(|c| c.is_finite()),
+            "{kind:?} made a non-finite pixel"
+        );
+        let brightest = frame.radiance.iter().flatten().fold(0.0f32, |m, &c| m.max(c));
+        assert!(brightest > 1e6, "{kind:?}: the light is seen ({brightest})");
+    }
+}
+
+/// The last frame of `passes` passes of `scene` on a headless render session.
+fn render_frames(scene: Scene, passes: u32) -> caustic::render::session::Frame {
+    use caustic::render::session::{RenderSession, SessionOptions};
+    let options = SessionOptions {
+        max_passes: Some(passes),
+        every_frame: true,
+        ..Default::default()
+    };
+    let session = RenderSession::start_with(scene, options, None);
+    let last = session.frames().iter().last();
+    assert!(session.failure().is_none(), "{:?}", session.failure());
+    last.expect("a frame")
 }

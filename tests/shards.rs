@@ -266,7 +266,7 @@ fn the_command_line_shards_merges_refuses_and_renders_a_merge_again() {
     // A missing part, and flags that report on a whole render, are refused.
     let missing = caustic(&["merge", &d("part_0.exr"), &d("nope.exr"), "--out", &d("m.exr")]);
     assert!(
-        text(&missing).contains("nope.exr: no such file"),
+        text(&missing).contains("nope.exr: the file does not exist"),
         "{}",
         text(&missing)
     );
@@ -338,4 +338,217 @@ fn a_watched_folder_merges_new_parts_ignores_hidden_and_redundant_ones_and_rebui
     assert!(folder.scan(dir.path()).expect("scans").changed);
     assert!(folder.generation() > generation);
     assert_eq!(folder.merged().map(|p| &p.sums), Some(&all.sums));
+}
+
+/// Renders `scenes/inline_patch.toml` at 32 pixels with `flags` into `out` (asserting success).
+fn render_part(flags: &[&str], out: &str) {
+    let mut args = vec![
+        "render",
+        "--width",
+        "32",
+        "--photons",
+        "20000",
+        "--min-photons-per-pixel",
+        "0",
+        "--out",
+        out,
+    ];
+    args.extend(flags);
+    let run = caustic(&args);
+    assert!(run.status.success(), "{flags:?}: {}", text(&run));
+}
+
+#[test]
+fn render_from_a_part_renders_exactly_its_passes() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = |name: &str| dir.path().join(name).display().to_string();
+    // Shard 0 of 2 of a 4-pass render: passes 0 and 2.
+    render_part(
+        &["scenes/inline_patch.toml", "--shard", "0/2", "--passes", "4"],
+        &d("p02.exr"),
+    );
+    let original = Part::read(Path::new(&d("p02.exr"))).expect("reads");
+    assert_eq!(original.sums.passes(), [0, 2]);
+    // Rendered again: the same passes, the same sums.
+    let run = caustic(&["render", "--from", &d("p02.exr"), "--out", &d("again.exr")]);
+    assert!(run.status.success(), "{}", text(&run));
+    let again = Part::read(Path::new(&d("again.exr"))).expect("reads");
+    assert_eq!(again.sums, original.sums);
+    assert_eq!(again.total_passes, 4);
+    // A shard of the part's render takes the part's total, so it merges with its sibling.
+    let run = caustic(&[
+        "render",
+        "--from",
+        &d("p02.exr"),
+        "--shard",
+        "1/2",
+        "--out",
+        &d("p13.exr"),
+    ]);
+    assert!(run.status.success(), "{}", text(&run));
+    let merge = caustic(&["merge", &d("p02.exr"), &d("p13.exr"), "--out", &d("all.exr")]);
+    assert!(merge.status.success(), "{}", text(&merge));
+    assert!(text(&merge).contains("4 of 4 passes"), "{}", text(&merge));
+    // Other passes than the part's are refused, saying why.
+    let run = caustic(&[
+        "render",
+        "--from",
+        &d("p02.exr"),
+        "--passes",
+        "3",
+        "--out",
+        &d("x.exr"),
+    ]);
+    assert!(!run.status.success());
+    assert!(
+        text(&run).contains("the part's own passes (0,2 of 4)"),
+        "{}",
+        text(&run)
+    );
+    let run = caustic(&["render", "--from", &d("p02.exr"), "--out", &d("x.png")]);
+    assert!(
+        !run.status.success() && text(&run).contains("use .exr"),
+        "{}",
+        text(&run)
+    );
+    assert!(!Path::new(&d("x.exr")).exists() && !Path::new(&d("x.png")).exists());
+}
+
+#[test]
+fn merge_names_what_each_bad_path_is() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = |name: &str| dir.path().join(name);
+    let scene = sheet(16, true);
+    let good = part(&scene, shard_sums(&scene, Shard { index: 0, count: 2 }, 2), 2);
+    good.write(&d("good.exr"), false).expect("writes");
+    std::fs::create_dir(d("folder.exr")).expect("folder");
+    let fifo = std::process::Command::new("mkfifo").arg(d("fifo.exr")).status();
+    assert!(fifo.is_ok_and(|s| s.success()), "mkfifo");
+    std::os::unix::fs::symlink(d("loop_b.exr"), d("loop_a.exr")).expect("link");
+    std::os::unix::fs::symlink(d("loop_a.exr"), d("loop_b.exr")).expect("link");
+    // A part of a later format, and a pass list that claims 3·10⁸ passes of a 2-pass render.
+    let with = |key: &str, value: &str, name: &str| {
+        let mut p = good.clone();
+        for (k, v) in p.metadata.iter_mut() {
+            if k == key {
+                *v = value.to_owned();
+            }
+        }
+        p.write(&d(name), false).expect("writes");
+    };
+    with("caustic:part", "2", "v2.exr");
+    with(
+        "caustic:pass_list",
+        "0-99999999,100000000-199999999,200000000-299999999",
+        "bomb.exr",
+    );
+    with("caustic:total_passes", "4000000000", "long.exr");
+    for (name, message) in [
+        ("missing.exr", "missing.exr: the file does not exist"),
+        ("folder.exr", "folder.exr: the file is a folder, not a file"),
+        (
+            "fifo.exr",
+            "fifo.exr: the file is not a regular file (a device, FIFO or socket)",
+        ),
+        (
+            "loop_a.exr",
+            "loop_a.exr: the file is a symbolic link that cannot be followed",
+        ),
+        (
+            "v2.exr",
+            "its caustic:part is \"2\": a part file of another format",
+        ),
+        (
+            "bomb.exr",
+            "its caustic:pass_list is damaged: it holds pass 99999999 of a render of 2 passes",
+        ),
+        (
+            "long.exr",
+            "its caustic:total_passes must be between 1 and 10000000",
+        ),
+    ] {
+        let start = std::time::Instant::now();
+        let out = d("out.exr").display().to_string();
+        let run = caustic(&[
+            "merge",
+            &d("good.exr").display().to_string(),
+            &d(name).display().to_string(),
+            "--out",
+            &out,
+        ]);
+        assert!(!run.status.success(), "{name}");
+        assert!(text(&run).contains(message), "{name}: {}", text(&run));
+        assert!(
+            start.elapsed().as_secs() < 10,
+            "{name} took {:?}",
+            start.elapsed()
+        );
+        assert!(!d("out.exr").exists());
+    }
+}
+
+#[test]
+fn a_watched_folder_follows_the_render_most_parts_belong_to_or_the_one_chosen() {
+    use caustic::render::shard::FolderMerge;
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scene = sheet(24, true);
+    let mut other = sheet(24, true);
+    other.params.seed = 99;
+    let total = 4;
+    let write = |scene: &Scene, k: u32, name: &str| {
+        let sums = shard_sums(scene, Shard { index: k, count: 2 }, total);
+        part(scene, sums, total)
+            .write(&dir.path().join(name), true)
+            .expect("writes");
+    };
+    // A part of another render sorts before the real parts, and holds passes they hold.
+    write(&other, 0, "a_other_scene.exr");
+    write(&scene, 0, "p0.exr");
+    write(&scene, 1, "p1.exr");
+    let mut folder = FolderMerge::new();
+    let report = folder.scan(dir.path()).expect("scans");
+    assert!(report.changed);
+    let merged = folder.merged().expect("merged");
+    assert!(merged.is_complete(), "the two real parts are merged");
+    assert_eq!(merged.sums, shard_sums(&scene, Shard::default(), total));
+    assert_eq!(folder.first_part(), Some(dir.path().join("p0.exr").as_path()));
+    assert_eq!(report.skipped.len(), 1, "{report:?}");
+    assert!(
+        report.skipped[0].starts_with("a_other_scene.exr: not merged: a part of another render")
+            && report.skipped[0].contains("seed 1 and 99"),
+        "{report:?}"
+    );
+    // Told once.
+    assert_eq!(folder.scan(dir.path()).expect("scans"), Default::default());
+    // The renders in the folder, most parts first; choosing the other shows it.
+    let renders = folder.renders();
+    assert_eq!(
+        renders.iter().map(|r| (r.parts, r.passes)).collect::<Vec<_>>(),
+        [(2, 4), (1, 2)]
+    );
+    folder.choose(Some(renders[1].key.clone()));
+    let report = folder.scan(dir.path()).expect("scans");
+    assert!(report.changed && report.skipped.len() == 2, "{report:?}");
+    assert_eq!(
+        folder.merged().map(|p| p.sums.passes().to_vec()),
+        Some(vec![0, 2])
+    );
+    folder.choose(None);
+    assert!(folder.scan(dir.path()).expect("scans").changed);
+    assert!(folder.merged().is_some_and(Part::is_complete));
+    // A later part of the other render that overtakes: the folder follows the majority.
+    write(&other, 1, "b_other.exr");
+    std::fs::copy(
+        dir.path().join("b_other.exr"),
+        dir.path().join("c_other_copy.exr"),
+    )
+    .expect("copy");
+    let report = folder.scan(dir.path()).expect("scans");
+    assert!(report.changed, "{report:?}");
+    assert_eq!(folder.renders()[0].parts, 3);
+    assert!(folder.merged().is_some_and(Part::is_complete));
+    assert_eq!(
+        folder.merged().map(|p| p.sums.clone()),
+        Some(shard_sums(&other, Shard::default(), total))
+    );
 }

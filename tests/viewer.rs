@@ -750,8 +750,26 @@ fn watching_a_folder_merges_each_new_part_and_skips_what_does_not_belong() {
     step_until(
         &mut h,
         "the foreign part's message",
-        |v| matches!(v.status(), Some(Status::Error(s)) if s.contains("part_x.exr: not merged: render settings differ: alpha 0.7 and 0.5")),
+        |v| matches!(v.status(), Some(Status::Error(s)) if s.contains("part_x.exr: not merged: a part of another render (ball.toml, 96x72, 6 passes") && s.contains("): render settings differ: alpha 0.7 and 0.5")),
     );
+    // The folder now holds two renders: the one of most parts is shown, the other can be chosen.
+    step_until(&mut h, "two renders listed", |v| {
+        v.watching().is_some_and(|w| w.renders.len() == 2)
+    });
+    h.run_steps(2);
+    h.get_by_label("Render shown").click();
+    h.run_steps(2);
+    h.get_by_label_contains("— 1 parts").click();
+    step_until(&mut h, "the chosen render", |v| {
+        v.frame().is_some_and(|f| f.pass == 2)
+    });
+    assert_eq!(viewer(&h).watching().map(|w| w.passes), Some(2));
+    h.get_by_label("Render shown").click();
+    h.run_steps(2);
+    h.get_by_label("The render most parts belong to").click();
+    step_until(&mut h, "the render of most parts again", |v| {
+        v.frame().is_some_and(|f| f.pass == 4)
+    });
     // Half a file (a copy in progress) too.
     let whole = std::fs::read(dir.path().join("part_1.exr")).expect("read");
     std::fs::write(dir.path().join("part_y.exr"), &whole[..whole.len() / 2]).expect("write");

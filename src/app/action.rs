@@ -37,6 +37,8 @@ pub enum Action {
     WatchFolder(PathBuf),
     /// Stop watching the render folder and render the scene again.
     StopWatching,
+    /// Show this render of the watched folder (`None`: the one most parts belong to).
+    WatchRender(Option<crate::render::shard::RenderKey>),
     /// Show the open dialog for a reference image (.exr, .pfm).
     PickReference,
     /// Compare with this reference image.

@@ -24,6 +24,7 @@ impl Viewer {
             Action::PickWatchFolder => self.pick_watch_folder(),
             Action::WatchFolder(dir) => self.watch_folder(dir),
             Action::StopWatching => self.stop_watching(),
+            Action::WatchRender(key) => self.watch_render(key),
             Action::OpenReference(path) => self.open_reference(path),
             Action::CloseReference => self.close_reference(),
             Action::ShowReference(on) => self.show_reference(on),

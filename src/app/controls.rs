@@ -754,10 +754,40 @@ fn replace_question(ctx: &egui::Context, id: &'static str, text: &str) -> Option
 }
 
 /// The watched render folder: passes done out of the total, parts, error estimate.
+/// Which of the folder's renders to show, when it holds parts of more than one.
+fn render_choice_ui(w: &super::watch::WatchSummary, ui: &mut egui::Ui, out: &mut Vec<Action>) {
+    let shown = w.shown.as_ref();
+    let label = |r: &crate::render::shard::RenderInFolder| format!("{} — {} parts", r.label, r.parts);
+    let current = shown
+        .and_then(|(k, _)| w.renders.iter().find(|r| &r.key == k))
+        .map_or("(none yet)".to_owned(), label);
+    egui::ComboBox::from_label("Render shown")
+        .selected_text(current)
+        .show_ui(ui, |ui| {
+            if ui
+                .selectable_label(shown.is_some_and(|(_, chosen)| !chosen), "The render most parts belong to")
+                .clicked()
+            {
+                out.push(Action::WatchRender(None));
+            }
+            for r in &w.renders {
+                let selected = shown.is_some_and(|(k, chosen)| *chosen && k == &r.key);
+                if ui.selectable_label(selected, label(r)).clicked() {
+                    out.push(Action::WatchRender(Some(r.key.clone())));
+                }
+            }
+        })
+        .response
+        .on_hover_text("The folder holds parts of more than one render: the one most parts belong to is shown unless you choose another");
+}
+
 fn watching_ui(w: &super::watch::WatchSummary, ui: &mut egui::Ui, out: &mut Vec<Action>) {
     ui.heading("Render folder");
     ui.label(RichText::new(w.dir.display().to_string()).weak())
         .on_hover_text("The folder whose parts are merged as they land");
+    if w.renders.len() > 1 {
+        render_choice_ui(w, ui, out);
+    }
     if w.total == 0 {
         ui.label("Waiting for the first part...");
     } else {

@@ -10,13 +10,13 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use crossbeam_channel::{unbounded, Receiver};
+use crossbeam_channel::{unbounded, Receiver, Sender};
 
 use crate::render::frame::StatRow;
 use crate::render::integrator::photon_mapping::frame_stats;
 use crate::render::ppm::PpmStats;
 use crate::render::session::Frame;
-use crate::render::shard::FolderMerge;
+use crate::render::shard::{FolderMerge, RenderInFolder, RenderKey};
 
 /// How often the folder is scanned.
 pub const SCAN_INTERVAL: Duration = Duration::from_millis(250);
@@ -36,8 +36,12 @@ pub struct WatchSummary {
     pub photons: u64,
     /// The estimated relative error of the image (at least two passes).
     pub relative_error: Option<f64>,
-    /// The file that fixed which render is shown.
+    /// The first file merged of the render shown.
     pub first_part: Option<PathBuf>,
+    /// Every render with parts in the folder, the one of most parts first.
+    pub renders: Vec<RenderInFolder>,
+    /// The render shown, and whether the user chose it (else it is the one of most parts).
+    pub shown: Option<(RenderKey, bool)>,
 }
 
 /// What the watching thread sends after a scan that changed something.
@@ -56,6 +60,7 @@ pub struct WatchUpdate {
 pub struct FolderWatch {
     dir: PathBuf,
     updates: Receiver<WatchUpdate>,
+    choices: Sender<Option<RenderKey>>,
     stop: Arc<AtomicBool>,
 }
 
@@ -64,6 +69,7 @@ impl FolderWatch {
     /// for a repaint).
     pub fn start(dir: &Path, wake: impl Fn() + Send + 'static) -> Self {
         let (tx, updates) = unbounded();
+        let (choices, chosen) = unbounded::<Option<RenderKey>>();
         let stop = Arc::new(AtomicBool::new(false));
         let (thread_stop, thread_dir) = (stop.clone(), dir.to_owned());
         let _ = std::thread::Builder::new()
@@ -72,11 +78,21 @@ impl FolderWatch {
                 let started = Instant::now();
                 let mut merge = FolderMerge::new();
                 let mut last_error = None;
+                let mut last_renders = Vec::new();
                 while !thread_stop.load(Ordering::Relaxed) {
+                    for key in chosen.try_iter() {
+                        merge.choose(key);
+                    }
                     let update = scan(&mut merge, &thread_dir, started);
                     let error_changed = update.error != last_error;
                     last_error = update.error.clone();
-                    if update.frame.is_some() || !update.skipped.is_empty() || error_changed {
+                    let renders_changed = update.summary.renders != last_renders;
+                    last_renders = update.summary.renders.clone();
+                    if update.frame.is_some()
+                        || !update.skipped.is_empty()
+                        || error_changed
+                        || renders_changed
+                    {
                         if tx.send(update).is_err() {
                             break;
                         }
@@ -88,8 +104,15 @@ impl FolderWatch {
         Self {
             dir: dir.to_owned(),
             updates,
+            choices,
             stop,
         }
+    }
+
+    /// Shows render `key` of the folder from the next scan on (`None`: the one most parts
+    /// belong to).
+    pub fn choose(&self, key: Option<RenderKey>) {
+        let _ = self.choices.send(key);
     }
 
     /// The folder.
@@ -123,6 +146,8 @@ pub fn scan(merge: &mut FolderMerge, dir: &Path, started: Instant) -> WatchUpdat
         photons: merge.merged().map_or(0, |p| p.sums.photons()),
         relative_error: merge.merged().and_then(|p| p.sums.relative_error()),
         first_part: merge.first_part().map(Path::to_owned),
+        renders: merge.renders(),
+        shown: merge.shown().map(|(k, chosen)| (k.clone(), chosen)),
     };
     let frame = match merge.merged() {
         Some(part) if report.changed => Some(merged_frame(part, &summary, merge.generation(), started)),

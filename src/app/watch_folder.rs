@@ -66,7 +66,16 @@ impl Viewer {
             photons: 0,
             relative_error: None,
             first_part: None,
+            renders: Vec::new(),
+            shown: None,
         });
+    }
+
+    /// Shows render `key` of the watched folder (`None`: the one most parts belong to).
+    pub fn watch_render(&mut self, key: Option<crate::render::shard::RenderKey>) {
+        if let Some(w) = &self.watch {
+            w.choose(key);
+        }
     }
 
     /// Stops watching and renders the scene again.

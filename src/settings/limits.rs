@@ -27,6 +27,15 @@ pub const PASSES: RangeInclusive<u32> = 1..=10_000_000;
 /// render's scene can be saved and recorded in its image.
 pub const SEED: RangeInclusive<u64> = 0..=i64::MAX as u64;
 
+/// The largest power (watts) or intensity (watts per steradian) a light may have in any colour
+/// channel (`power × color`): a terawatt. Far above any scene's light, and far enough below
+/// f32's range (3.4·10³⁸) that no estimate of a finite scene overflows the film.
+pub const MAX_LIGHT_POWER: f64 = 1e12;
+/// The largest radiance an area light's surface may emit (power over π × area), and the largest
+/// ambient radiance: a light too small for its power would make every pixel that sees it
+/// infinite.
+pub const MAX_RADIANCE: f64 = 1e18;
+
 /// A setting's value outside its range: the end of the message.
 pub type Invalid = String;
 
@@ -62,6 +71,28 @@ pub fn samples(n: u32) -> Result<u32, Invalid> {
 /// Passes of a render.
 pub fn passes(n: u32) -> Result<u32, Invalid> {
     within(n, PASSES, "")
+}
+
+/// A light's power or intensity in its brightest colour channel.
+pub fn light_power(p: f64) -> Result<f64, Invalid> {
+    if p.is_finite() && p > 0.0 && p <= MAX_LIGHT_POWER {
+        Ok(p)
+    } else {
+        Err(format!(
+            "must be positive and at most {MAX_LIGHT_POWER:e} in every colour channel (with 'color' applied), got {p}"
+        ))
+    }
+}
+
+/// The radiance an area light emits, or ambient light.
+pub fn radiance(l: f64) -> Result<f64, Invalid> {
+    if (0.0..=MAX_RADIANCE).contains(&l) {
+        Ok(l)
+    } else {
+        Err(format!(
+            "makes a radiance of {l:e}; at most {MAX_RADIANCE:e} keeps the image finite"
+        ))
+    }
 }
 
 /// Image width or height.

@@ -177,6 +177,7 @@ impl RenderParams {
                 Err(format!("must be finite and not negative, got {ambient}")),
             )?;
         }
+        check("ambient", limits::radiance(ambient.max_element()).map(drop))?;
         Ok(())
     }
 

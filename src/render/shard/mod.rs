@@ -13,7 +13,7 @@ pub mod folder;
 pub mod part;
 pub mod sums;
 
-pub use folder::{FolderMerge, ScanReport};
+pub use folder::{FolderMerge, RenderInFolder, ScanReport};
 pub use part::{MergeError, Part, PartError, PartHeader, RenderKey};
 pub use sums::PassSums;
 

@@ -288,6 +288,8 @@ pub struct PartHeader {
     pub photons: u64,
     /// Image width and height.
     pub size: (u32, u32),
+    /// The render it belongs to.
+    pub key: RenderKey,
 }
 
 /// What makes parts parts of one render: they merge only when all of it agrees.
@@ -366,12 +368,21 @@ impl PartHeader {
                 crate::settings::limits::IMAGE_SIDE.end()
             ));
         };
+        let field = |key: &str| get(key).unwrap_or("(none)").to_owned();
+        let key = RenderKey {
+            software: field(provenance::SOFTWARE),
+            size: (w, h),
+            settings: field(SETTINGS),
+            scene_hash: field(SCENE_HASH),
+            total_passes,
+        };
         Ok(PartHeader {
-            metadata,
             passes,
             total_passes,
             photons,
             size: (w, h),
+            key,
+            metadata,
         })
     }
 
@@ -381,18 +392,6 @@ impl PartHeader {
             .iter()
             .find(|(k, _)| k == key)
             .map(|(_, v)| v.as_str())
-    }
-
-    /// The render it belongs to.
-    pub fn render_key(&self) -> RenderKey {
-        let field = |key: &str| self.get(key).unwrap_or("(none)").to_owned();
-        RenderKey {
-            software: field(provenance::SOFTWARE),
-            size: self.size,
-            settings: field(SETTINGS),
-            scene_hash: field(SCENE_HASH),
-            total_passes: self.total_passes,
-        }
     }
 }
 
@@ -429,7 +428,7 @@ fn read_sums(
 }
 
 /// What differs between two `[render]` tables: the first keys whose lines differ.
-fn settings_difference(a: &str, b: &str) -> String {
+pub(super) fn settings_difference(a: &str, b: &str) -> String {
     let lines = |t: &str| -> Vec<(String, String)> {
         t.lines()
             .filter_map(|l| l.split_once('='))

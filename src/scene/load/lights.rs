@@ -9,6 +9,7 @@ use crate::scene::format::LightDesc;
 use crate::scene::light::Light;
 use crate::scene::material::{Material, MaterialKind};
 use crate::scene::SceneObject;
+use crate::settings::limits;
 
 /// The keys a `[[lights]]` table gave, for [`Table::only`].
 fn given_keys(d: &LightDesc) -> [(&'static str, bool); 12] {
@@ -38,11 +39,24 @@ pub(super) fn light(ctx: &Ctx, k: usize, desc: &Spanned<LightDesc>) -> Result<Li
     };
     let given = given_keys(d);
     let color = d.color.as_ref().map(v3).unwrap_or(DVec3::ONE);
-    if color.cmplt(DVec3::ZERO).any() || color == DVec3::ZERO {
-        return Err(t.err(format!("'color' must be non-negative and not black, got {color}")));
+    if !color.is_finite() || color.cmplt(DVec3::ZERO).any() || color == DVec3::ZERO {
+        return Err(t.err(format!(
+            "'color' must be finite, non-negative and not black, got {color}"
+        )));
     }
-    let power =
-        |t: &Table| -> Result<DVec3> { Ok(color * t.positive("power", t.required("power", d.power)?.0)?) };
+    // The brightest channel of `field` × color, within the stated limit.
+    let scaled = |t: &Table, field: &str, value: f64| -> Result<DVec3> {
+        let v = color * t.positive(field, value)?;
+        limits::light_power(v.max_element()).map_err(|e| t.err(format!("'{field}' {e}")))?;
+        Ok(v)
+    };
+    let power = |t: &Table| -> Result<DVec3> { scaled(t, "power", t.required("power", d.power)?.0) };
+    // An area light's power over π × its area: the radiance its surface emits.
+    let area_light = |t: &Table, power: DVec3, area: f64| -> Result<DVec3> {
+        limits::radiance(power.max_element() / (std::f64::consts::PI * area))
+            .map_err(|e| t.err(format!("'power' over the light's area {e}")))?;
+        Ok(power)
+    };
     match d.kind.as_str() {
         "point" => {
             t.only("point", &given, &["position", "power", "intensity", "color"])?;
@@ -51,7 +65,7 @@ pub(super) fn light(ctx: &Ctx, k: usize, desc: &Spanned<LightDesc>) -> Result<Li
                 (Some(_), None) => Ok(Light::point(position, power(&t)?)),
                 (None, Some(i)) => Ok(Light::Point {
                     position,
-                    intensity: color * t.positive("intensity", i.0)?,
+                    intensity: scaled(&t, "intensity", i.0)?,
                 }),
                 _ => Err(t.err("needs exactly one of 'power' or 'intensity'")),
             }
@@ -81,17 +95,24 @@ pub(super) fn light(ctx: &Ctx, k: usize, desc: &Spanned<LightDesc>) -> Result<Li
             t.only("sphere", &given, &["center", "radius", "power", "color"])?;
             let center = v3(t.required("center", d.center.as_ref())?);
             let radius = t.positive("radius", t.required("radius", d.radius)?.0)?;
-            Ok(Light::sphere(center, radius, power(&t)?))
+            let area = 4.0 * std::f64::consts::PI * radius * radius;
+            Ok(Light::sphere(center, radius, area_light(&t, power(&t)?, area)?))
         }
         "quad" => {
             t.only("quad", &given, &["corner", "edge_u", "edge_v", "power", "color"])?;
             let corner = v3(t.required("corner", d.corner.as_ref())?);
             let edge_u = v3(t.required("edge_u", d.edge_u.as_ref())?);
             let edge_v = v3(t.required("edge_v", d.edge_v.as_ref())?);
-            if edge_u.cross(edge_v).length() == 0.0 {
+            let area = edge_u.cross(edge_v).length();
+            if area == 0.0 {
                 return Err(t.err("'edge_u' and 'edge_v' are parallel (or zero): the light has no area"));
             }
-            Ok(Light::quad(corner, edge_u, edge_v, power(&t)?))
+            Ok(Light::quad(
+                corner,
+                edge_u,
+                edge_v,
+                area_light(&t, power(&t)?, area)?,
+            ))
         }
         other => Err(t.err(format!(
             "unknown light type '{other}' (expected point, spot, sphere or quad)"
