@@ -396,3 +396,44 @@ fn a_surface_from_geomdl_matches_geomdls_own_evaluation() {
     }
     assert_eq!(checked, 121);
 }
+
+#[test]
+fn inputs_past_the_stated_limits_are_refused_early() {
+    use caustic::settings::limits::{MAX_KNOTS, MAX_PATCHES};
+    let dir = tempfile::tempdir().expect("temp dir");
+    // One surface whose 1,056 x 1,056 control points all name the first point: 2 MB of text
+    // that would make 1.1 million patches.
+    let n = 1_056;
+    let knots: Vec<String> = (0..n + 4).map(|k| k.to_string()).collect();
+    let text = format!(
+        "v 0 0 0\ncstype bspline\ndeg 3 3\nsurf 3 {n} 3 {n} {}\nparm u {k}\nparm v {k}\nend\n",
+        vec!["1"; n * n].join(" "),
+        k = knots.join(" ")
+    );
+    let start = std::time::Instant::now();
+    let err = parse_freeform_obj(&text, Path::new("bomb.obj")).expect_err("refused");
+    assert!(
+        err.to_string().contains(&format!("bomb.obj:4: the surface makes 1108809 Bézier patches, and the file 0 before it; a scene holds at most {MAX_PATCHES}")),
+        "{err}"
+    );
+    assert!(start.elapsed().as_secs() < 20, "{:?}", start.elapsed());
+    // A parm line of more knots than are read.
+    let long = vec!["0"; MAX_KNOTS + 1].join(" ");
+    let text = format!("v 0 0 0\ncstype bspline\ndeg 3 3\nsurf 0 1 0 1 1\nparm u {long}\nend\n");
+    let err = parse_freeform_obj(&text, Path::new("knots.obj")).expect_err("refused");
+    assert!(
+        err.to_string().contains(&format!(
+            "knots.obj:5: 'parm' gives 1000001 values; at most {MAX_KNOTS}"
+        )),
+        "{err}"
+    );
+    // A .bpt file that declares more patches than a scene holds.
+    let bpt = dir.path().join("many.bpt");
+    std::fs::write(&bpt, "600000\n3 3\n").expect("write");
+    let err = caustic::geometry::load_bpt(&bpt).expect_err("refused");
+    assert!(
+        err.to_string()
+            .contains("many.bpt:1: the file declares 600000 patches; a scene holds at most 500000"),
+        "{err}"
+    );
+}

@@ -74,7 +74,7 @@ fn malformed_bpt_files_are_reported_with_line_numbers() {
     let missing = load_bpt(Path::new("/nonexistent/teapot.bpt")).expect_err("missing file");
     assert!(missing
         .to_string()
-        .starts_with("/nonexistent/teapot.bpt:0: cannot read the file"));
+        .starts_with("/nonexistent/teapot.bpt:0: the file does not exist"));
 }
 
 #[test]

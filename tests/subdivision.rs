@@ -62,3 +62,53 @@ fn prepared_leaves_tile_each_patch_and_bound_it() {
         }
     }
 }
+
+#[test]
+fn the_leaf_budget_bounds_a_patch_and_leaves_the_shipped_scenes_as_they_were() {
+    use caustic::geometry::patch::{leaf_budget, MIN_PATCH_LEAVES};
+    // A crumpled patch asks for hundreds of leaves; held to a budget it gets at most that
+    // many, which still tile it.
+    let mut r = rng(57);
+    let crumpled = caustic::geometry::BezierPatch::new(std::array::from_fn(|_| {
+        glam::DVec3::new(r.random(), r.random(), r.random())
+    }));
+    let free = subdivide(&crumpled, 0, &SubdivisionParams::default());
+    assert!(free.len() > 300, "{} leaves", free.len());
+    for budget in [MIN_PATCH_LEAVES, 10, 100] {
+        let params = SubdivisionParams {
+            max_leaves: budget,
+            ..Default::default()
+        };
+        let held = subdivide(&crumpled, 0, &params);
+        assert!(
+            held.len() <= budget && held.len() + 3 > budget,
+            "{} of {budget}",
+            held.len()
+        );
+        let area: f64 = held
+            .iter()
+            .map(|l| (l.window.u1 - l.window.u0) * (l.window.v1 - l.window.v0))
+            .sum();
+        assert!((area - 1.0).abs() < 1e-12, "the leaves tile the patch: {area}");
+    }
+    assert_eq!(leaf_budget(10_000), MIN_PATCH_LEAVES);
+    // No shipped scene's patch asks for more than its share.
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    for entry in std::fs::read_dir(&dir).expect("scenes").flatten() {
+        let path = entry.path();
+        if path.extension().is_none_or(|e| e != "toml") {
+            continue;
+        }
+        let scene = caustic::scene::Scene::load(&path).expect("loads");
+        let patches = scene.geometry.patches();
+        let budget = leaf_budget(patches.len());
+        for (k, (p, _)) in patches.iter().enumerate() {
+            let n = subdivide(p, k as u32, &SubdivisionParams::default()).len();
+            assert!(
+                n <= budget,
+                "{}: patch {k} asks for {n} leaves, its share is {budget}",
+                path.display()
+            );
+        }
+    }
+}

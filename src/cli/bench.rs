@@ -138,6 +138,7 @@ pub fn bench(what: BenchCommand, json: bool) -> Result<()> {
                 flatness,
                 max_size,
                 max_depth,
+                ..Default::default()
             };
             let rays = IntersectRays { size, repeat, order };
             bench_intersect(rays, method, per_ray_depth, params, &mut out)

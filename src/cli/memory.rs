@@ -47,6 +47,40 @@ pub(super) fn resident_mib() -> Option<(f64, f64)> {
     Some((field("VmRSS:")?, field("VmHWM:")?))
 }
 
+/// Where the prepared geometry's bytes go, in all and per Bézier patch.
+fn geometry_memory(scene: &caustic::scene::Scene, out: &mut BenchOutput) {
+    let stats = scene.geometry.stats();
+    let parts = scene.geometry.memory();
+    let total: usize = parts.iter().map(|(_, b)| b).sum();
+    let per_patch = |b: usize| b as f64 / stats.patches.max(1) as f64;
+    out.say(format!(
+        "Geometry: {} patches as {} leaves, {} BVH nodes: {:.1} MiB{}",
+        stats.patches,
+        stats.patch_leaves,
+        stats.bvh_nodes,
+        total as f64 / (1 << 20) as f64,
+        if stats.patches > 0 {
+            format!(", {:.0} bytes a patch", per_patch(total))
+        } else {
+            String::new()
+        }
+    ));
+    for (what, bytes) in &parts {
+        out.say(format!(
+            "  {what:<45} {:>9.2} MiB {:>8.0} bytes a patch",
+            *bytes as f64 / (1 << 20) as f64,
+            per_patch(*bytes)
+        ));
+        out.push(
+            "geometry_bytes",
+            serde_json::json!({ "part": what, "bytes": bytes, "bytes_per_patch": per_patch(*bytes) }),
+        );
+    }
+    out.set("patches", stats.patches);
+    out.set("patch_leaves", stats.patch_leaves);
+    out.set("geometry_bytes_per_patch", per_patch(total));
+}
+
 /// Renders and prints the memory samples.
 pub fn bench_memory(args: MemoryArgs, out: &mut BenchOutput) -> Result<()> {
     if args.passes == 0 || args.every == 0 {
@@ -85,6 +119,7 @@ pub fn bench_memory(args: MemoryArgs, out: &mut BenchOutput) -> Result<()> {
     out.set("aperture", scene.camera.aperture);
     out.set("photons_per_pass", args.photons);
     out.set("resident_mib_before", before);
+    geometry_memory(&scene, out);
     out.say(format!(
         "{:>8} {:>10} {:>14} {:>10}",
         "pass", "seconds", "resident MiB", "peak MiB"

@@ -14,6 +14,7 @@ use std::path::{Path, PathBuf};
 use glam::DVec3;
 
 use super::bezier::BezierPatch;
+use crate::settings::limits::MAX_PATCHES;
 
 /// A malformed `.bpt` file: which file, which line, what was expected.
 #[derive(Debug, thiserror::Error)]
@@ -27,13 +28,15 @@ pub struct BptError {
     pub message: String,
 }
 
-/// Reads a `.bpt` file.
+/// Reads a `.bpt` file (whole: at most [`crate::input_file::MAX_TEXT_BYTES`]; the text is
+/// then read in place, a line at a time).
 pub fn load_bpt(path: &Path) -> Result<Vec<BezierPatch>, BptError> {
-    let text = std::fs::read_to_string(path).map_err(|e| BptError {
-        path: path.to_owned(),
-        line: 0,
-        message: format!("cannot read the file: {e}"),
-    })?;
+    let text =
+        crate::input_file::read_text(path, crate::input_file::MAX_TEXT_BYTES).map_err(|why| BptError {
+            path: path.to_owned(),
+            line: 0,
+            message: format!("the file {why}"),
+        })?;
     parse_bpt(&text, path)
 }
 
@@ -65,6 +68,12 @@ pub fn parse_bpt(text: &str, path: &Path) -> Result<Vec<BezierPatch>, BptError> 
     })?;
     if count == 0 {
         return Err(err(line, "the file declares 0 patches".to_owned()));
+    }
+    if count > MAX_PATCHES {
+        return Err(err(
+            line,
+            format!("the file declares {count} patches; a scene holds at most {MAX_PATCHES}"),
+        ));
     }
     let mut patches = Vec::with_capacity(count.min(1 << 16));
     for k in 1..=count {

@@ -3,8 +3,13 @@
 //! Boehm's algorithm (W. Boehm, "Inserting new knots into B-spline curves", CAD 12(4), 1980)
 //! inserts a knot without changing the curve. Inserting every distinct knot of the domain until
 //! it has multiplicity 3 (the degree) makes the control polygon of each knot span the Bézier
-//! control polygon of that span (Piegl & Tiller, *The NURBS Book*, §5.6). A surface is a tensor
-//! product: its rows are converted along `u`, then the resulting columns along `v`.
+//! control polygon of that span. Done one insertion at a time, each shifting the whole vector,
+//! that costs time quadratic in the knots; instead the range's two ends are inserted (a
+//! constant number of insertions), the curve outside the range dropped, and the clamped curve
+//! left is decomposed span by span as Piegl & Tiller's algorithm A5.6 (*The NURBS Book*, §5.6,
+//! "DecomposeCurve") does, which touches each control point a bounded number of times: linear
+//! in the knots. A surface is a tensor product: its rows are converted along `u`, then the
+//! resulting columns along `v`.
 //!
 //! [`de_boor`] evaluates a curve directly (de Boor 1972): the tests check the conversion
 //! against it.
@@ -128,6 +133,19 @@ impl Knots {
         (self.values[DEGREE], self.values[n])
     }
 
+    /// How many Bézier spans the range `[start, end]` holds: one more than its distinct knots
+    /// strictly inside it.
+    pub fn spans_in(&self, start: f64, end: f64) -> usize {
+        let mut inside: Vec<f64> = self
+            .values
+            .iter()
+            .copied()
+            .filter(|&t| t > start && t < end)
+            .collect();
+        inside.dedup();
+        inside.len() + 1
+    }
+
     /// Checks that `[start, end]` is a non-empty part of the domain.
     pub fn check_range(&self, start: f64, end: f64, axis: char) -> Result<(), BsplineError> {
         let (low, high) = self.domain();
@@ -196,6 +214,80 @@ fn multiplicity(knots: &[f64], t: f64) -> usize {
     knots.iter().filter(|&&u| u == t).count()
 }
 
+/// The curve (`knots`, `points`) over `[start, end]` (within its domain) as a clamped curve:
+/// each end inserted to multiplicity 3 (at most six insertions), then the knots and points
+/// outside the range dropped, the ends given multiplicity 4.
+fn clamped_to<T: Lerp>(knots: &[f64], points: &[T], start: f64, end: f64) -> (Vec<f64>, Vec<T>) {
+    let (mut u, mut p) = (knots.to_vec(), points.to_vec());
+    for t in [start, end] {
+        while multiplicity(&u, t) < DEGREE {
+            insert_knot(&mut u, &mut p, t);
+        }
+    }
+    // With `start` at knots first..=last (multiplicity ≥ 3), the curve from `start` on has the
+    // points from last - 3; symmetrically up to `end`.
+    let last_start = u.iter().rposition(|&x| x == start).unwrap_or(DEGREE);
+    let first_end = u.iter().position(|&x| x == end).unwrap_or(u.len() - DEGREE - 1);
+    let first_point = last_start.saturating_sub(DEGREE);
+    let last_point = first_end.saturating_sub(1).min(p.len() - 1);
+    let mut knots = vec![start; DEGREE + 1];
+    knots.extend_from_slice(&u[last_start + 1..first_end]);
+    knots.extend(std::iter::repeat_n(end, DEGREE + 1));
+    (knots, p[first_point..=last_point].to_vec())
+}
+
+/// The Bézier segments of a clamped cubic curve (its first and last four knots equal): Piegl &
+/// Tiller's algorithm A5.6, which raises each interior knot to multiplicity 3 within a
+/// four-point window as it walks the knots once. Interior knots of multiplicity 4 or more (a
+/// break in the curve) start a new segment from the points after them.
+fn decompose<T: Lerp>(u: &[f64], points: &[T]) -> Vec<Segment<T>> {
+    let p = DEGREE;
+    let m = u.len() - 1;
+    let mut out = Vec::new();
+    let mut q: [T; 4] = std::array::from_fn(|i| points[i]);
+    let mut next: [T; 4] = q;
+    let (mut a, mut b) = (p, p + 1);
+    while b < m {
+        let i = b;
+        while b < m && u[b + 1] == u[b] {
+            b += 1;
+        }
+        let mult = (b - i + 1).min(p);
+        if mult < p {
+            // Insert u[b] (p - mult) times into the window q.
+            let numer = u[b] - u[a];
+            let alphas: [f64; DEGREE] = std::array::from_fn(|j| {
+                if j < p - mult {
+                    numer / (u[a + mult + 1 + j] - u[a])
+                } else {
+                    0.0
+                }
+            });
+            let r = p - mult;
+            for j in 1..=r {
+                let s = mult + j;
+                for k in (s..=p).rev() {
+                    q[k] = q[k - 1].lerp_to(q[k], alphas[k - s]);
+                }
+                if b < m {
+                    // The new segment's first points come out of this one's last.
+                    next[r - j] = q[p];
+                }
+            }
+        }
+        out.push((q, (u[a], u[b])));
+        if b < m {
+            for k in (p - mult)..=p {
+                next[k] = points[b - p + k];
+            }
+            q = next;
+            a = b;
+            b += 1;
+        }
+    }
+    out
+}
+
 /// One Bézier segment of a curve: its four control points and its parameter interval.
 pub type Segment<T> = ([T; 4], (f64, f64));
 
@@ -207,26 +299,8 @@ pub fn bezier_segments<T: Lerp>(
     start: f64,
     end: f64,
 ) -> Vec<([T; 4], (f64, f64))> {
-    let mut u = knots.values.clone();
-    let mut p = points.to_vec();
-    // Every distinct knot inside the range, and the range's ends, to multiplicity 3.
-    let mut breaks: Vec<f64> = u.iter().copied().filter(|&t| t > start && t < end).collect();
-    breaks.dedup();
-    breaks.insert(0, start);
-    breaks.push(end);
-    for &t in &breaks {
-        while multiplicity(&u, t) < DEGREE {
-            insert_knot(&mut u, &mut p, t);
-        }
-    }
-    // Span [u_k, u_k+1] now has Bézier points p[k-3..=k].
-    let mut out = Vec::with_capacity(breaks.len() - 1);
-    for pair in breaks.windows(2) {
-        let k = u.iter().rposition(|&x| x == pair[0]).unwrap_or(DEGREE);
-        let k = k.min(p.len() - 1).max(DEGREE);
-        out.push(([p[k - 3], p[k - 2], p[k - 1], p[k]], (pair[0], pair[1])));
-    }
-    out
+    let (u, p) = clamped_to(&knots.values, points, start, end);
+    decompose(&u, &p)
 }
 
 /// A point of the cubic B-spline curve (`points`, `knots`) at `t` in its domain, by de Boor's
@@ -293,7 +367,7 @@ impl BsplineSurface {
             .map(|row| bezier_segments(row, &self.u_knots, r.u0, r.u1))
             .collect();
         let u_spans = rows.first().map_or(0, Vec::len);
-        let mut out = Vec::new();
+        let mut out = Vec::with_capacity(u_spans * self.v_knots.spans_in(r.v0, r.v1));
         for su in 0..u_spans {
             // The column of 4-point groups along v for this u span, converted along v.
             let column: Vec<[DVec3; 4]> = rows.iter().map(|row| row[su].0).collect();
@@ -306,5 +380,60 @@ impl BsplineSurface {
             }
         }
         out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A point of a cubic Bézier segment.
+    fn bezier(q: &[DVec3; 4], t: f64) -> DVec3 {
+        let s = 1.0 - t;
+        q[0] * s * s * s + q[1] * 3.0 * s * s * t + q[2] * 3.0 * s * t * t + q[3] * t * t * t
+    }
+
+    #[test]
+    fn segments_follow_the_curve_whatever_the_knots() {
+        // Unclamped ends, interior knots of multiplicity 1 to 4 (a break), zero-length spans,
+        // and ranges that start and end between knots or on them.
+        let cases: [(&[f64], (f64, f64)); 5] = [
+            (&[0., 1., 2., 3., 4., 5., 6., 7., 8., 9.], (3.0, 6.0)),
+            (
+                &[0., 0., 0., 0., 1., 1., 2., 3., 3., 3., 4., 4., 4., 4.],
+                (0.0, 4.0),
+            ),
+            (
+                &[0., 0., 0., 0., 1., 2., 2., 2., 2., 3., 4., 4., 4., 4.],
+                (0.0, 4.0),
+            ),
+            (&[0., 1., 2., 3., 4., 4., 5., 6., 7., 8., 9.], (3.25, 5.75)),
+            (&[0., 0., 0., 0., 0.5, 1., 1.5, 2., 2., 2., 2.], (0.5, 1.5)),
+        ];
+        for (values, (start, end)) in cases {
+            let n = values.len() - 4;
+            let points: Vec<DVec3> = (0..n)
+                .map(|k| DVec3::new(k as f64, ((k * 7) % 5) as f64, ((k * 3) % 4) as f64))
+                .collect();
+            let knots = Knots::new(values.to_vec(), n, 'u').expect("valid");
+            let segments = bezier_segments(&points, &knots, start, end);
+            assert_eq!(segments.len(), knots.spans_in(start, end), "{values:?}");
+            assert_eq!(segments.first().map(|s| s.1 .0), Some(start));
+            assert_eq!(segments.last().map(|s| s.1 .1), Some(end));
+            for (q, (a, b)) in &segments {
+                for t in [0.1, 0.5, 0.9] {
+                    let x = a + t * (b - a);
+                    let expected = de_boor(&points, &knots, x);
+                    let got = bezier(q, t);
+                    assert!(
+                        (got - expected).length() < 1e-9,
+                        "{values:?} at {x}: {got} vs {expected}"
+                    );
+                }
+            }
+            for pair in segments.windows(2) {
+                assert_eq!(pair[0].1 .1, pair[1].1 .0, "segments meet");
+            }
+        }
     }
 }

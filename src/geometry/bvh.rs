@@ -232,6 +232,13 @@ struct BuildItem {
 }
 
 impl Bvh {
+    /// Bytes its vectors hold (their capacities).
+    pub fn memory(&self) -> usize {
+        self.nodes.capacity() * std::mem::size_of::<BvhNode>()
+            + self.order.capacity() * std::mem::size_of::<u32>()
+            + self.pairs.capacity() * std::mem::size_of::<NodePair>()
+    }
+
     /// Builds a hierarchy over primitives with the given bounds (index `i` is primitive `i`).
     pub fn build(bounds: &[Aabb]) -> Self {
         let mut items: Vec<BuildItem> = bounds
@@ -267,19 +274,22 @@ impl Bvh {
             interior += (n.count == 0) as u32;
         }
         let child = |node: usize| Child::of(&self.nodes[node], pair_of[node]);
-        self.pairs = (0..self.nodes.len())
-            .filter(|&i| self.nodes[i].count == 0)
-            .map(|i| {
-                let n = &self.nodes[i];
-                let (a, b) = (&self.nodes[i + 1].bounds, &self.nodes[n.offset as usize].bounds);
-                NodePair {
-                    lo: [0, 1, 2].map(|k| [a.min[k], b.min[k]]),
-                    hi: [0, 1, 2].map(|k| [a.max[k], b.max[k]]),
-                    child: [child(i + 1), child(n.offset as usize)],
-                    axis: n.axis,
-                }
-            })
-            .collect();
+        let mut pairs = Vec::with_capacity(interior as usize);
+        pairs.extend(
+            (0..self.nodes.len())
+                .filter(|&i| self.nodes[i].count == 0)
+                .map(|i| {
+                    let n = &self.nodes[i];
+                    let (a, b) = (&self.nodes[i + 1].bounds, &self.nodes[n.offset as usize].bounds);
+                    NodePair {
+                        lo: [0, 1, 2].map(|k| [a.min[k], b.min[k]]),
+                        hi: [0, 1, 2].map(|k| [a.max[k], b.max[k]]),
+                        child: [child(i + 1), child(n.offset as usize)],
+                        axis: n.axis,
+                    }
+                }),
+        );
+        self.pairs = pairs;
     }
 
     /// Bounds of everything, or the empty box.

@@ -30,6 +30,7 @@ use glam::DVec3;
 use super::bezier::BezierPatch;
 use super::bspline::{BsplineSurface, Knots, DEGREE};
 use super::patch::Window;
+use crate::settings::limits::{MAX_KNOTS, MAX_PATCHES};
 
 /// A free-form OBJ file that cannot be read: which file, which line, what was wrong.
 #[derive(Debug, thiserror::Error)]
@@ -46,14 +47,16 @@ pub struct FreeformError {
 /// A Bézier patch and its `(u,v)` window in the parameters of the surface it came from.
 pub type DomainPatch = (BezierPatch, Window);
 
-/// Reads every bicubic free-form surface of an OBJ file as Bézier patches.
+/// Reads every bicubic free-form surface of an OBJ file as Bézier patches, a line at a time:
+/// what the reader keeps beyond the patches is the `v` points (40 bytes each) and the open
+/// surface's indices, whatever else the file holds.
 pub fn load_freeform_obj(path: &Path) -> Result<Vec<DomainPatch>, FreeformError> {
-    let text = std::fs::read_to_string(path).map_err(|e| FreeformError {
+    let file = crate::input_file::open(path).map_err(|why| FreeformError {
         path: path.to_owned(),
         line: 0,
-        message: format!("cannot read the file: {e}"),
+        message: format!("the file {why}"),
     })?;
-    parse_freeform_obj(&text, path)
+    read_freeform_obj(std::io::BufReader::new(file), path)
 }
 
 /// A `v` line: the point, its weight and the line it stands on.
@@ -82,25 +85,58 @@ struct OpenSurface {
     degree: Option<(Vec<String>, usize)>,
 }
 
-/// The logical lines of an OBJ file: comments removed, `\` continuations joined, each with the
-/// number of its first physical line.
-fn logical_lines(text: &str) -> Vec<(usize, String)> {
-    let mut out = Vec::new();
-    let mut pending: Option<(usize, String)> = None;
-    for (i, raw) in text.lines().enumerate() {
-        let line = raw.split('#').next().unwrap_or("").trim_end();
-        let (start, mut joined) = pending.take().unwrap_or((i + 1, String::new()));
-        if let Some(head) = line.strip_suffix('\\') {
-            joined.push_str(head);
-            joined.push(' ');
-            pending = Some((start, joined));
-        } else {
-            joined.push_str(line);
-            out.push((start, joined));
+/// The logical lines of an OBJ file, one at a time: comments removed, `\` continuations
+/// joined, each with the number of its first physical line. One line's buffers are reused for
+/// the next, so reading costs the longest logical line, not the file.
+struct LogicalLines<R> {
+    reader: R,
+    /// Physical lines read so far.
+    physical: usize,
+    raw: Vec<u8>,
+    joined: String,
+}
+
+impl<R: std::io::BufRead> LogicalLines<R> {
+    fn new(reader: R) -> Self {
+        Self {
+            reader,
+            physical: 0,
+            raw: Vec::new(),
+            joined: String::new(),
         }
     }
-    out.extend(pending);
-    out
+
+    /// The next logical line and its first physical line's number; `Err` names the line that
+    /// could not be read.
+    fn next_line(&mut self) -> Result<Option<(usize, &str)>, (usize, String)> {
+        self.joined.clear();
+        let start = self.physical + 1;
+        loop {
+            self.raw.clear();
+            let n = self
+                .reader
+                .read_until(b'\n', &mut self.raw)
+                .map_err(|e| (self.physical + 1, format!("cannot read the file: {e}")))?;
+            if n == 0 {
+                // The end: a pending continuation is a line of its own.
+                return Ok((!self.joined.is_empty()).then_some((start, self.joined.as_str())));
+            }
+            self.physical += 1;
+            let text = std::str::from_utf8(&self.raw)
+                .map_err(|_| (self.physical, "the line is not UTF-8 text".to_owned()))?;
+            let line = text.split('#').next().unwrap_or("").trim_end();
+            match line.strip_suffix('\\') {
+                Some(head) => {
+                    self.joined.push_str(head);
+                    self.joined.push(' ');
+                }
+                None => {
+                    self.joined.push_str(line);
+                    return Ok(Some((start, self.joined.as_str())));
+                }
+            }
+        }
+    }
 }
 
 struct Reader<'a> {
@@ -116,6 +152,14 @@ struct Reader<'a> {
 
 /// Parses OBJ text; `path` only names the source in errors.
 pub fn parse_freeform_obj(text: &str, path: &Path) -> Result<Vec<DomainPatch>, FreeformError> {
+    read_freeform_obj(text.as_bytes(), path)
+}
+
+/// Reads OBJ text from `input` a line at a time; `path` only names the source in errors.
+pub fn read_freeform_obj(
+    input: impl std::io::BufRead,
+    path: &Path,
+) -> Result<Vec<DomainPatch>, FreeformError> {
     let mut reader = Reader {
         path,
         vertices: Vec::new(),
@@ -125,21 +169,26 @@ pub fn parse_freeform_obj(text: &str, path: &Path) -> Result<Vec<DomainPatch>, F
         in_curve: false,
         patches: Vec::new(),
     };
-    let lines = logical_lines(text);
-    for (line, content) in &lines {
+    let mut lines = LogicalLines::new(input);
+    let mut last_line = 1;
+    while let Some((line, content)) = lines
+        .next_line()
+        .map_err(|(line, message)| reader.err(line, message))?
+    {
+        last_line = line;
         let mut words = content.split_whitespace();
         let Some(keyword) = words.next() else {
             continue;
         };
         let args: Vec<&str> = words.collect();
-        reader.statement(*line, keyword, &args)?;
+        reader.statement(line, keyword, &args)?;
     }
     if let Some(open) = &reader.surface {
         return Err(reader.err(open.line, "the surface has no 'end' statement".to_owned()));
     }
     if reader.patches.is_empty() {
         return Err(reader.err(
-            lines.last().map_or(1, |l| l.0),
+            last_line,
             "no free-form surfaces ('surf' … 'end') in the file; a polygon mesh is an object of type \"mesh\"".to_owned(),
         ));
     }
@@ -269,6 +318,15 @@ impl Reader<'_> {
             [axis, "closed", rest @ ..] | [axis, rest @ ..] => (*axis, rest),
             [] => return Err(self.err(line, "'parm' takes 'u' or 'v' and its values".to_owned())),
         };
+        if values.len() > MAX_KNOTS {
+            return Err(self.err(
+                line,
+                format!(
+                    "'parm' gives {} values; at most {MAX_KNOTS} are read",
+                    values.len()
+                ),
+            ));
+        }
         let values = self.numbers(line, "parm", values)?;
         let Some(open) = self.surface.as_mut() else {
             return Ok(());
@@ -400,6 +458,16 @@ impl Reader<'_> {
             v_knots,
             range: r,
         };
+        let spans = surface.u_knots.spans_in(r.u0, r.u1) * surface.v_knots.spans_in(r.v0, r.v1);
+        if self.patches.len() + spans > MAX_PATCHES {
+            return Err(self.err(
+                line,
+                format!(
+                    "the surface makes {spans} Bézier patches, and the file {} before it; a scene holds at most {MAX_PATCHES}",
+                    self.patches.len()
+                ),
+            ));
+        }
         let patches = surface.to_bezier();
         let finite = |(p, w): &DomainPatch| {
             p.points.iter().all(|q| q.is_finite()) && (w.u1 - w.u0).is_finite() && (w.v1 - w.v0).is_finite()
@@ -411,7 +479,11 @@ impl Reader<'_> {
                     .to_owned(),
             ));
         }
-        self.patches.extend(patches);
+        if self.patches.is_empty() {
+            self.patches = patches;
+        } else {
+            self.patches.extend(patches);
+        }
         Ok(())
     }
 }

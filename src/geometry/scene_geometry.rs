@@ -179,6 +179,11 @@ impl GeometryBuilder {
         self.meshes.push((mesh, object));
         ShapeRef::Mesh(self.meshes.len() as u32 - 1)
     }
+    /// Bézier patches added so far.
+    pub fn patch_count(&self) -> usize {
+        self.patches.len()
+    }
+
     /// Adds a Bézier patch tagged with `object`; its hits report `(u,v)` in `[0,1]²`.
     pub fn add_patch(&mut self, patch: BezierPatch, object: u32) -> ShapeRef {
         self.add_patch_in(patch, Window::FULL, object)
@@ -200,9 +205,14 @@ impl GeometryBuilder {
             .map(|(p, _)| p.bounds().diagonal().length())
             .collect();
         let mut leaves = Vec::new();
-        if let PatchMethod::Prepared(params) = self.patch_method {
+        let mut patch_method = self.patch_method;
+        if let PatchMethod::Prepared(params) = &mut patch_method {
+            // Each patch's share of the scene's leaves: an edit re-prepares it within the same.
+            params.max_leaves = params
+                .max_leaves
+                .min(super::patch::leaf_budget(self.patches.len()));
             for (k, (patch, _)) in self.patches.iter().enumerate() {
-                leaves.extend(subdivide(patch, k as u32, &params));
+                leaves.extend(subdivide(patch, k as u32, params));
             }
         }
         let mut primitives = Vec::new();
@@ -240,20 +250,27 @@ impl GeometryBuilder {
         }
         let bvh = Bvh::build(&bounds);
         let flat_spheres = flat_spheres(&bvh, &primitives, &self.spheres);
+        // Grown by pushing: give back the spare capacity (up to half of a large scene's).
+        let (mut patches, mut patch_domains) = (self.patches, self.patch_domains);
+        leaves.shrink_to_fit();
+        primitives.shrink_to_fit();
+        bounds.shrink_to_fit();
+        patches.shrink_to_fit();
+        patch_domains.shrink_to_fit();
         SceneGeometry {
             primitive_bounds: bounds,
             spheres: self.spheres,
             quads: self.quads,
             planes: self.planes,
             meshes: self.meshes,
-            patches: self.patches,
-            patch_domains: self.patch_domains,
+            patches,
+            patch_domains,
             patch_scales,
             leaves,
             primitives,
             bvh,
             flat_spheres,
-            patch_method: self.patch_method,
+            patch_method,
         }
     }
 }
@@ -506,6 +523,37 @@ impl SceneGeometry {
             patches: self.patches.len(),
             patch_leaves: self.leaves.len(),
         }
+    }
+
+    /// Where the geometry's memory goes: bytes held by each of its parts (its vectors'
+    /// capacities times their elements' sizes), in the order the patches' data then the BVH's.
+    pub fn memory(&self) -> Vec<(&'static str, usize)> {
+        /// What a vector holds, its spare capacity included.
+        #[allow(clippy::ptr_arg)]
+        fn bytes<T>(v: &Vec<T>) -> usize {
+            v.capacity() * std::mem::size_of::<T>()
+        }
+        let meshes: usize = self
+            .meshes
+            .iter()
+            .map(|(m, _)| bytes(&m.positions) + bytes(&m.normals) + bytes(&m.texcoords) + bytes(&m.indices))
+            .sum();
+        vec![
+            (
+                "patches (control points, domains, scales)",
+                bytes(&self.patches) + bytes(&self.patch_domains) + bytes(&self.patch_scales),
+            ),
+            ("patch leaves (sub-patches and their tests)", bytes(&self.leaves)),
+            (
+                "primitive list and bounds",
+                bytes(&self.primitives) + bytes(&self.primitive_bounds),
+            ),
+            ("BVH nodes, node pairs and order", self.bvh.memory()),
+            (
+                "spheres, quads, planes, meshes",
+                bytes(&self.spheres) + bytes(&self.quads) + bytes(&self.planes) + meshes,
+            ),
+        ]
     }
 
     /// Whether the scene holds any Bézier patch.

@@ -36,6 +36,12 @@ pub const MAX_LIGHT_POWER: f64 = 1e12;
 /// infinite.
 pub const MAX_RADIANCE: f64 = 1e18;
 
+/// The most Bézier patches a scene may hold, from every source together (inline, `.bpt`, OBJ
+/// free-form): prepared, a patch takes at most about 4 KB, so 2 GB at most.
+pub const MAX_PATCHES: usize = 500_000;
+/// The most knots one `parm` line of an OBJ free-form surface may give.
+pub const MAX_KNOTS: usize = 1_000_000;
+
 /// A setting's value outside its range: the end of the message.
 pub type Invalid = String;
 

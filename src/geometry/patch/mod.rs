@@ -163,6 +163,11 @@ pub struct SubdivisionParams {
     pub max_size: f64,
     /// Depth limit (a patch becomes at most `4^max_depth` leaves).
     pub max_depth: u32,
+    /// The most leaves one patch may become. When the criteria above ask for more, the leaves
+    /// furthest from them are split first until the budget is spent: a leaf that is not flat
+    /// enough still intersects exactly (Newton falls back to splitting it per ray), only more
+    /// slowly. [`leaf_budget`] sets it from a scene's patch count.
+    pub max_leaves: usize,
 }
 
 impl Default for SubdivisionParams {
@@ -171,42 +176,175 @@ impl Default for SubdivisionParams {
             flatness: 0.05,
             max_size: 0.35,
             max_depth: 6,
+            max_leaves: usize::MAX,
         }
     }
+}
+
+/// Leaves a scene's patches may become in all, whatever their number: about 28 MB of leaves
+/// and their BVH nodes.
+pub const SCENE_LEAVES: usize = 32_768;
+
+/// The fewest leaves a patch may be held to: four keeps a prepared patch within 4 KB (a leaf
+/// and its share of the BVH take about 850 bytes, the patch itself 430).
+pub const MIN_PATCH_LEAVES: usize = 4;
+
+/// The leaves each of `patches` patches may become: an equal share of [`SCENE_LEAVES`], at
+/// least [`MIN_PATCH_LEAVES`]. A scene of a few hundred patches is not held back at all.
+pub fn leaf_budget(patches: usize) -> usize {
+    (SCENE_LEAVES / patches.max(1)).max(MIN_PATCH_LEAVES)
 }
 
 /// Relative padding of leaf bounds: rounding in the slab test can never lose a seam point.
 const BOUNDS_PAD: f64 = 1e-9;
 
 /// Subdivides `patch` into leaves that are flat and small enough for a Newton solve started in
-/// their middle to converge to the only root (for all but grazing rays).
+/// their middle to converge to the only root (for all but grazing rays), within
+/// [`SubdivisionParams::max_leaves`].
 pub fn subdivide(patch: &BezierPatch, patch_index: u32, params: &SubdivisionParams) -> Vec<PatchLeaf> {
     let scale = patch.bounds().diagonal().length();
-    let mut leaves = Vec::new();
-    let mut stack = vec![(*patch, Window::FULL, 0u32)];
-    while let Some((sub, window, depth)) = stack.pop() {
+    let leaf = |piece: Piece| piece.leaf(patch_index, scale);
+    match depth_first(patch, params, scale) {
+        Some(pieces) => pieces.into_iter().map(leaf).collect(),
+        None => worst_first(patch, params, scale).into_iter().map(leaf).collect(),
+    }
+}
+
+/// A piece of a patch on its way to becoming a leaf.
+struct Piece {
+    sub: BezierPatch,
+    window: Window,
+    depth: u32,
+    deviation: f64,
+    /// How far it is from flat and small enough: at most 1 when it is both.
+    excess: f64,
+}
+
+impl Piece {
+    fn new(sub: BezierPatch, window: Window, depth: u32, params: &SubdivisionParams, scale: f64) -> Self {
         let diag = sub.bounds().diagonal().length();
         let deviation = sub.bilinear_deviation();
         let flat = deviation <= params.flatness * diag;
         let small = diag <= params.max_size * scale;
-        if depth >= params.max_depth || (flat && small) {
-            leaves.push(PatchLeaf {
-                patch: patch_index,
-                window,
-                bounds: sub.bounds().padded(BOUNDS_PAD * scale.max(f64::MIN_POSITIVE)),
-                sub_patch: sub,
-                scale,
-                deviation,
-                normals: NormalCone::of(&sub),
-                slab: Slab::of(&sub),
-            });
+        let excess = if flat && small {
+            0.0
         } else {
-            for (child, w) in sub.split_quad().into_iter().zip(window.quarters()) {
-                stack.push((child, w, depth + 1));
+            (deviation / (params.flatness * diag).max(f64::MIN_POSITIVE))
+                .max(diag / (params.max_size * scale).max(f64::MIN_POSITIVE))
+                .max(1.0 + f64::EPSILON)
+        };
+        Self {
+            sub,
+            window,
+            depth,
+            deviation,
+            excess,
+        }
+    }
+
+    /// Whether it is a leaf as it is: flat and small enough, or as deep as allowed.
+    fn done(&self, params: &SubdivisionParams) -> bool {
+        self.excess == 0.0 || self.depth >= params.max_depth
+    }
+
+    fn split(&self, params: &SubdivisionParams, scale: f64) -> [Piece; 4] {
+        let children = self.sub.split_quad();
+        let windows = self.window.quarters();
+        std::array::from_fn(|k| Piece::new(children[k], windows[k], self.depth + 1, params, scale))
+    }
+
+    fn leaf(self, patch: u32, scale: f64) -> PatchLeaf {
+        PatchLeaf {
+            patch,
+            window: self.window,
+            bounds: self
+                .sub
+                .bounds()
+                .padded(BOUNDS_PAD * scale.max(f64::MIN_POSITIVE)),
+            sub_patch: self.sub,
+            scale,
+            deviation: self.deviation,
+            normals: NormalCone::of(&self.sub),
+            slab: Slab::of(&self.sub),
+        }
+    }
+}
+
+/// The pieces the criteria ask for, depth first; `None` as soon as they are more than
+/// [`SubdivisionParams::max_leaves`].
+fn depth_first(patch: &BezierPatch, params: &SubdivisionParams, scale: f64) -> Option<Vec<Piece>> {
+    let mut pieces = Vec::new();
+    let mut stack = vec![Piece::new(*patch, Window::FULL, 0, params, scale)];
+    while let Some(piece) = stack.pop() {
+        if pieces.len() + stack.len() + 1 > params.max_leaves {
+            return None;
+        }
+        if piece.done(params) {
+            pieces.push(piece);
+        } else {
+            stack.extend(piece.split(params, scale));
+        }
+    }
+    Some(pieces)
+}
+
+/// At most [`SubdivisionParams::max_leaves`] pieces: the piece furthest from the criteria is
+/// split first (ties: the one found first), while splitting it stays within the budget.
+fn worst_first(patch: &BezierPatch, params: &SubdivisionParams, scale: f64) -> Vec<Piece> {
+    use std::cmp::Reverse;
+    use std::collections::BinaryHeap;
+    /// A piece's place in the queue: its excess (larger first), then the order it was found.
+    #[derive(PartialEq)]
+    struct Key(f64, Reverse<usize>);
+    impl Eq for Key {}
+    impl PartialOrd for Key {
+        fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+            Some(self.cmp(other))
+        }
+    }
+    impl Ord for Key {
+        fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+            self.0.total_cmp(&other.0).then(self.1.cmp(&other.1))
+        }
+    }
+    /// Pieces that are leaves as they are, and the others queued by their key.
+    #[derive(Default)]
+    struct Pieces {
+        found: Vec<Option<Piece>>,
+        done: Vec<Piece>,
+        queue: BinaryHeap<Key>,
+    }
+    impl Pieces {
+        fn add(&mut self, piece: Piece, params: &SubdivisionParams) {
+            if piece.done(params) {
+                self.done.push(piece);
+            } else {
+                self.queue.push(Key(piece.excess, Reverse(self.found.len())));
+                self.found.push(Some(piece));
             }
         }
     }
-    leaves
+    let mut pieces = Pieces::default();
+    pieces.add(Piece::new(*patch, Window::FULL, 0, params, scale), params);
+    // Splitting one piece into four adds three.
+    while pieces.done.len() + pieces.queue.len() + 3 <= params.max_leaves {
+        let Some(Key(_, Reverse(k))) = pieces.queue.pop() else {
+            break;
+        };
+        let Some(piece) = pieces.found[k].take() else {
+            break;
+        };
+        for child in piece.split(params, scale) {
+            pieces.add(child, params);
+        }
+    }
+    let Pieces {
+        mut found,
+        mut done,
+        queue,
+    } = pieces;
+    done.extend(queue.into_iter().filter_map(|Key(_, Reverse(k))| found[k].take()));
+    done
 }
 
 /// A point of a prepared patch: the patch's index in the scene geometry and its own `(u,v)`

@@ -128,7 +128,16 @@ fn add_shape(t: &Table, d: &ObjectDesc, label: &str, builder: &mut GeometryBuild
                 &given,
                 &["file", "builtin", "patches", "domains", "transform"],
             )?;
-            for (p, domain) in patch_list(t, d, label)? {
+            let list = patch_list(t, d, label)?;
+            let limit = crate::settings::limits::MAX_PATCHES;
+            if builder.patch_count() + list.len() > limit {
+                return Err(t.err(format!(
+                    "its {} patches make the scene's {}; a scene holds at most {limit}",
+                    list.len(),
+                    builder.patch_count() + list.len()
+                )));
+            }
+            for (p, domain) in list {
                 builder.add_patch_in(p.transformed(&m), domain, id);
             }
         }
