@@ -53,3 +53,18 @@ fn kept_freeform_inputs_load_or_fail_cleanly() {
 fn kept_texture_inputs_decode_or_fail_cleanly() {
     assert!(replay("texture", inputs::texture) >= 3);
 }
+
+#[test]
+fn kept_part_header_inputs_read_or_fail_cleanly() {
+    assert!(replay("part_header", inputs::part_header) >= 2);
+}
+
+#[test]
+fn kept_pass_list_inputs_parse_or_fail_cleanly() {
+    assert!(replay("pass_list", inputs::pass_list) >= 3);
+}
+
+#[test]
+fn kept_farm_names_quote_and_stay_values() {
+    assert!(replay("farm_quote", inputs::farm_quote) >= 5);
+}

@@ -185,6 +185,15 @@ fn bad_scene_files_are_reported_clearly() {
             scene_text("[[objects]]\ntype = \"patches\"\nfile = \"broken.bpt\"\nmaterial = \"m\"\n"),
             "broken.bpt:2: patch 1: expected degrees '3 3'",
         ),
+        // A patches file that is a folder, or a link to a device, is named as what it is.
+        (
+            scene_text("[[objects]]\ntype = \"patches\"\nfile = \"folder.bpt\"\nmaterial = \"m\"\n"),
+            "folder.bpt' is a folder, not a file",
+        ),
+        (
+            scene_text("[[objects]]\ntype = \"patches\"\nfile = \"zero.bpt\"\nmaterial = \"m\"\n"),
+            "zero.bpt' is not a regular file (a device, FIFO or socket)",
+        ),
         (
             scene_text("[[objects]]\ntype = \"patches\"\nbuiltin = \"kettle\"\nmaterial = \"m\"\n"),
             "unknown 'builtin' patches 'kettle'",
@@ -236,6 +245,8 @@ fn bad_scene_files_are_reported_clearly() {
         ),
     ];
     std::fs::write(dir.path().join("broken.bpt"), "1\n3 4\n").expect("write");
+    std::fs::create_dir(dir.path().join("folder.bpt")).expect("folder");
+    std::os::unix::fs::symlink("/dev/zero", dir.path().join("zero.bpt")).expect("link");
     std::fs::write(dir.path().join("not-an-image.png"), "hello").expect("write");
     let path = dir.path().join("bad.toml");
     for (text, expected) in cases {

@@ -119,3 +119,112 @@ pub fn texture(data: &[u8]) {
         assert!(texels.iter().all(|t| t.is_finite()));
     }
 }
+
+/// A part file's header (the start of an EXR file): read it; one it accepts holds ascending
+/// passes below its total, within the stated limits.
+pub fn part_header(data: &[u8]) {
+    let Ok(header) = caustic::render::shard::PartHeader::parse(data) else {
+        return;
+    };
+    let limits = &caustic::settings::limits::PASSES;
+    assert!(limits.contains(&header.total_passes), "{}", header.total_passes);
+    assert!(header.passes.windows(2).all(|w| w[0] < w[1]));
+    assert!(header.passes.last().is_none_or(|&p| p < header.total_passes));
+    let side = caustic::settings::limits::IMAGE_SIDE;
+    assert!(side.contains(&header.size.0) && side.contains(&header.size.1));
+}
+
+/// A part's pass list: the first four bytes are the render's total (within the limit), the
+/// rest the list's text. One it accepts is ascending, below the total, and written again as
+/// runs reads back the same.
+pub fn pass_list(data: &[u8]) {
+    use caustic::render::shard::sums::{parse_passes, passes_text};
+    let (Some(total), Some(text)) = (data.get(..4), data.get(4..)) else {
+        return;
+    };
+    let total = u32::from_le_bytes([total[0], total[1], total[2], total[3]]) % 10_000_001;
+    let Ok(text) = std::str::from_utf8(text) else {
+        return;
+    };
+    let Ok(passes) = parse_passes(text, total) else {
+        return;
+    };
+    assert!(passes.windows(2).all(|w| w[0] < w[1]));
+    assert!(passes.last().is_none_or(|&p| p < total));
+    assert_eq!(parse_passes(&passes_text(&passes), total).as_ref(), Ok(&passes));
+}
+
+/// The value a POSIX shell makes of `word` (single quotes, backslash outside quotes, plain
+/// characters), or `None` if anything in it is special to the shell outside quotes.
+fn shell_value(word: &str) -> Option<String> {
+    let mut out = String::new();
+    let mut chars = word.chars();
+    while let Some(c) = chars.next() {
+        match c {
+            '\'' => loop {
+                match chars.next()? {
+                    '\'' => break,
+                    q => out.push(q),
+                }
+            },
+            '\\' => out.push(chars.next()?),
+            c if c.is_ascii_alphanumeric() || "/._-=:,+@%".contains(c) => out.push(c),
+            _ => return None,
+        }
+    }
+    Some(out)
+}
+
+/// A name for a farm: quoted as one shell word it reads back as itself; in a comment it holds
+/// no line break; as the image and folder of a Kubernetes manifest it stays a value of the
+/// two Jobs, and a Slurm script is written or refused without a panic.
+pub fn farm_quote(data: &[u8]) {
+    use caustic::farm::quote::{comment, shell_word};
+    use std::os::unix::ffi::OsStrExt;
+    let value = std::ffi::OsStr::from_bytes(data);
+    match shell_word(value) {
+        Ok(word) => {
+            let text = value.to_str().expect("only UTF-8 is quoted");
+            assert_eq!(shell_value(&word).as_deref(), Some(text), "{word}");
+        }
+        Err(_) => assert!(value.to_str().is_none() || data.contains(&0)),
+    }
+    let line = comment(value);
+    assert!(
+        !line.contains(['\n', '\r', '\u{85}', '\u{2028}', '\u{2029}', '\u{b}', '\u{c}']),
+        "{line}"
+    );
+    let Some(text) = value.to_str() else {
+        return;
+    };
+    let mut job = caustic::farm::Job {
+        scene: "/data/scene.toml".into(),
+        shards: 2,
+        passes: 4,
+        out: format!("/data/{text}").into(),
+        threads: 1,
+        program: "caustic".into(),
+        image: Some(text.to_owned()),
+        partition: Some(text.to_owned()),
+        volume_claim: "caustic-data".into(),
+        name: "caustic".into(),
+        wait: false,
+        render_args: Vec::new(),
+    };
+    let _ = caustic::farm::slurm::slurm_script(&job);
+    if text.is_empty() {
+        job.image = Some("i".into());
+    }
+    if let Ok(manifest) = caustic::farm::kubernetes::kubernetes_manifest(&job) {
+        let docs: Vec<serde_yaml_ng::Value> = serde_yaml_ng::Deserializer::from_str(&manifest)
+            .map(|d| <serde_yaml_ng::Value as serde::Deserialize>::deserialize(d).expect("parses"))
+            .collect();
+        assert_eq!(docs.len(), 2, "{manifest}");
+        for doc in &docs {
+            assert_eq!(doc["kind"].as_str(), Some("Job"));
+            let container = &doc["spec"]["template"]["spec"]["containers"][0];
+            assert_eq!(container["image"].as_str(), job.image.as_deref(), "{manifest}");
+            assert_eq!(container.as_mapping().map(|m| m.len()), Some(5), "{manifest}");
+        }
+    }
+}
