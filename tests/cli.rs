@@ -354,7 +354,7 @@ fn convergence_bench_writes_its_csv_and_plot_and_reuses_the_reference() {
     assert_eq!(lines.next(), Some("configuration,pass,seconds,rmse,rel_mse"));
     let body: Vec<&str> = lines.collect();
     assert!(body.iter().all(|l| l.split(',').count() == 5), "{rows}");
-    for name in ["old defaults (photons only)", "new defaults"] {
+    for name in ["photons-only,", "default,"] {
         assert!(
             body.iter().any(|l| l.starts_with(name)),
             "no rows of {name}: {rows}"

@@ -173,8 +173,9 @@ fn each_slider_sends_its_command() {
         .click();
     h.step();
     h.step();
-    let radius = viewer(&h).params.manual_radius;
-    assert_eq!(initial_radius(&h), Some(radius));
+    let radius = viewer(&h).params.manual.get("initial_radius").copied();
+    assert!(radius.is_some_and(|r| r > 0.0), "the slider's value: {radius:?}");
+    assert_eq!(initial_radius(&h), radius);
     set_slider(&mut h, "Initial radius", 0.01);
     assert_eq!(initial_radius(&h), Some(0.01));
     // Exposure is the viewer's own: no command.

@@ -6,11 +6,11 @@ use egui_plot::{Line, Plot, PlotPoints};
 
 use super::action::Action;
 use super::keys::HELP;
-use super::params::{PanelParams, Ranges, ALPHA_RANGE, DEPTH_RANGE, PHOTONS_RANGE};
+use super::params::{PanelParams, Ranges};
+use super::setting_ui;
 use super::settings::{DisplayMode, Zoom};
 use super::state::{Status, ViewerState};
 use crate::scene::RendererKind;
-use crate::settings::{IndexKind, RadiusSchedule};
 
 /// Seconds as `1.23 s` or `4 min 05 s`.
 fn duration(secs: f64) -> String {
@@ -250,7 +250,7 @@ pub fn side_panel_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Acti
     }
     let mut p = viewer.params.clone();
     render_section_ui(viewer, &mut p, ui, out);
-    photon_mapping_section_ui(&mut p, viewer.ranges, ui);
+    renderer_section_ui(&mut p, viewer.ranges, ui);
     camera_section_ui(&mut p, viewer.ranges, ui);
     if p != viewer.params {
         out.push(Action::SetParams(p));
@@ -316,103 +316,17 @@ fn render_section_ui(viewer: &ViewerState, p: &mut PanelParams, ui: &mut egui::U
     }
 }
 
-/// Photon mapping's parameters (enabled when it is the renderer).
-fn photon_mapping_section_ui(p: &mut PanelParams, ranges: Ranges, ui: &mut egui::Ui) {
-    let photon_mapping = p.render.renderer == RendererKind::Ppm;
+/// The settings only the current renderer reads, under its heading (none for the path tracer).
+fn renderer_section_ui(p: &mut PanelParams, ranges: Ranges, ui: &mut egui::Ui) {
+    let kind = p.render.renderer;
+    let heading = match kind {
+        RendererKind::Ppm => "Photon mapping",
+        RendererKind::Whitted => "Ray tracing",
+        RendererKind::Path => return,
+    };
     ui.separator();
-    ui.heading("Photon mapping");
-    ui.add_enabled_ui(photon_mapping, |ui| {
-        ui.add(egui::Slider::new(&mut p.render.alpha, ALPHA_RANGE.0..=ALPHA_RANGE.1).text("Alpha"))
-            .on_hover_text("Fraction of new photons kept per pass (Hachisuka 2008); radius shrinks faster when smaller. 0.7 is the paper's choice. Applies from the next pass, without restarting.");
-        ui.add(
-            egui::Slider::new(&mut p.render.photons_per_pass, PHOTONS_RANGE.0..=PHOTONS_RANGE.1)
-                .logarithmic(true)
-                .text("Photons per pass"),
-        )
-        .on_hover_text("Photons traced per pass (with photons sent where the camera looks, divided by how many times more of them arrive). Applies from the next pass, without restarting.");
-        ui.add(
-            egui::Slider::new(&mut p.render.min_photons_per_pixel, 0.0..=32.0)
-                .step_by(0.5)
-                .text("Min photons per pixel"),
-        )
-        .on_hover_text("When the eye pass is traced anew every pass (anti-aliasing, depth of field), each pass traces at least this many photons per pixel so the eye pass stays a small share of it. 0: exactly the photons per pass. Applies from the next pass, without restarting.");
-        let mut auto = p.auto_radius();
-        if ui
-            .checkbox(&mut auto, "Automatic initial radius")
-            .on_hover_text("Start from twice a pixel's footprint at the median visible distance. Changing it restarts.")
-            .changed()
-        {
-            p.set_auto_radius(auto);
-        }
-        if ui
-            .add_enabled(
-                !auto,
-                egui::Slider::new(&mut p.manual_radius, ranges.radius.0..=ranges.radius.1)
-                    .logarithmic(true)
-                    .text("Initial radius"),
-            )
-            .on_hover_text("Starting search radius in scene units. Changing it restarts.")
-            .changed()
-        {
-            p.set_auto_radius(false);
-        }
-        let mut auto_indirect = p.render.indirect_radius_scale.is_none();
-        if ui
-            .checkbox(&mut auto_indirect, "Automatic indirect radius")
-            .on_hover_text("Photons that have bounced off a diffuse surface (indirect light) are gathered over a wider radius, chosen after the first pass so that each point gathers about 32 of them per pass (1× to 4× the initial radius). Changing it restarts.")
-            .changed()
-        {
-            p.set_auto_indirect_scale(auto_indirect);
-        }
-        let range = crate::settings::limits::RADIUS_SCALE;
-        if ui
-            .add_enabled(
-                !auto_indirect,
-                egui::Slider::new(&mut p.manual_indirect_scale, *range.start()..=16.0)
-                    .logarithmic(true)
-                    .text("Indirect radius ×"),
-            )
-            .on_hover_text("The indirect light's initial radius over the initial radius; 1 gathers all photons in one estimate (the paper's PPM). Changing it restarts.")
-            .changed()
-        {
-            p.set_auto_indirect_scale(false);
-        }
-        ui.checkbox(&mut p.render.adaptive_radius, "Adaptive radius")
-            .on_hover_text("After the first pass, points where photons are dense (the inside of a caustic) restart with a radius up to 4× narrower, so that a pass still hands them about 64 photons: sharp light is not blurred by the initial radius for dozens of passes. Points where they are sparse (fewer than 2 a pass, no denser light within two pixels) restart up to 2× wider (no wider than the indirect radius): light spread thin is less noisy. Off: every point starts at the initial radius. Restarts.");
-        ui.checkbox(&mut p.render.direct_light, "Direct light by light sampling")
-            .on_hover_text("Direct light from every light by shadow rays at the visible points (area lights: one sample per pass); photons carry only caustics and indirect light. Off: photons carry everything. Restarts.");
-        ui.checkbox(&mut p.render.guided_emission, "Photons where the camera looks")
-            .on_hover_text("Each light learns which of its photons reach what the camera sees and sends more there (weighted: the image converges to the same result). Off: lights emit as they shine. Restarts.");
-        ui.horizontal(|ui| {
-            ui.label("Stratified");
-            ui.checkbox(&mut p.render.stratified_eye_rays, "eye rays")
-                .on_hover_text("When eye rays are jittered (anti-aliasing, depth of field), place each pixel's rays over passes by low-discrepancy sequences: the outlines of lights and the lens blur settle sooner. Off: independent random jitter. Restarts.");
-            ui.checkbox(&mut p.render.stratified_photons, "photons")
-                .on_hover_text("Choose photons' directions by a low-discrepancy sequence over the render's photons, so each pass covers the light's directions evenly: caustics and light carried by photons are less noisy. Off: independent random directions. Restarts.");
-        });
-        ui.checkbox(&mut p.render.supersample_light_seen, "Supersampled lamp outlines")
-            .on_hover_text("Where the light a pixel sees directly changes within it (a lamp's outline, its images in mirrors and glass), the pixel traces 16 more eye rays a pass for that light, and where it varied most over the first 8 passes (a texture's or a shadow's edge, a floor seen through glass) 4 more (at most a quarter more eye rays in all): outlines settle about 16 times sooner. Off: one eye ray per pixel a pass. Restarts.");
-        schedule_and_index_ui(p, ui);
-    });
-}
-
-/// How the radius shrinks and which index finds the visible points.
-fn schedule_and_index_ui(p: &mut PanelParams, ui: &mut egui::Ui) {
-    ui.horizontal(|ui| {
-        ui.label("Radius").on_hover_text("How the search radius shrinks pass by pass. Restarts.");
-        ui.selectable_value(&mut p.render.radius_schedule, RadiusSchedule::PerPoint, "Per point")
-            .on_hover_text("Each point's photon count and flux carry from pass to pass and its radius shrinks with the photons it gathered (Hachisuka et al. 2008)");
-        ui.selectable_value(&mut p.render.radius_schedule, RadiusSchedule::Global, "Global schedule")
-            .on_hover_text("Every pass is an independent estimate at one shrinking radius (Knaus & Zwicker 2011): the passes of a render can be split across machines and merged (render --shard, caustic merge). α and the radii are fixed by a pilot pass; changing α restarts");
-    });
-    ui.horizontal(|ui| {
-        ui.label("Index")
-            .on_hover_text("Spatial index over visible points; the image is the same, the speed differs");
-        ui.selectable_value(&mut p.render.index, IndexKind::HashGrid, "Hash grid")
-            .on_hover_text("Hashed uniform grid (fastest here)");
-        ui.selectable_value(&mut p.render.index, IndexKind::KdTree, "kd-tree")
-            .on_hover_text("The seed report's kd-tree");
-    });
+    ui.heading(heading);
+    setting_ui::settings_ui(p, ranges, ui, setting_ui::only(kind));
 }
 
 /// The lens and the depth of paths.
@@ -433,8 +347,7 @@ fn camera_section_ui(p: &mut PanelParams, ranges: Ranges, ui: &mut egui::Ui) {
             .text("Focal distance"),
     )
     .on_hover_text("Distance from the lens to the plane in focus. Restarts.");
-    ui.add(egui::Slider::new(&mut p.render.max_depth, DEPTH_RANGE.0..=DEPTH_RANGE.1).text("Max depth"))
-        .on_hover_text("Most mirror/glass bounces followed by eye rays and photons. Restarts.");
+    setting_ui::settings_ui(p, ranges, ui, setting_ui::shared);
 }
 
 fn statistics_ui(viewer: &ViewerState, ui: &mut egui::Ui) {

@@ -11,7 +11,8 @@
 //!   projection and geometry, the editing state and undo history, the mouse over the image,
 //!   and camera moves (drawn by [`crate::gpu::wireframe`]).
 //! - [`image_view`]: texture, fit / 1:1 / zoom / pan, probe.
-//! - [`params`]: parameters and the session commands their changes send.
+//! - [`params`]: parameters and the session commands their changes send; [`setting_ui`]:
+//!   each render setting's control, from the table of settings.
 //! - [`error_plot`]: the error estimate (and the true error against a reference) plotted
 //!   against time; [`reference`], [`difference`]: the reference image, the difference views
 //!   and the A/B toggle.
@@ -42,6 +43,7 @@ pub mod reference;
 mod reference_files;
 pub mod save;
 mod scene_file;
+pub mod setting_ui;
 pub mod settings;
 pub mod state;
 pub mod tev_send;

@@ -1,5 +1,6 @@
-//! What the side panel edits — the render parameters, the lens, pause — their slider
-//! ranges, and the commands a change sends to the render session.
+//! What the side panel edits — the render parameters, the lens, pause — the scene's scale for
+//! their sliders, and the commands a change sends to the render session. Which controls the
+//! render parameters have comes from the table of settings ([`super::setting_ui`]).
 
 use crate::render::session::Command;
 use crate::scene::{Camera, Scene};
@@ -10,10 +11,8 @@ use crate::settings::RenderParams;
 pub struct PanelParams {
     /// The render parameters the session receives whole ([`Command::SetParams`]).
     pub render: RenderParams,
-    /// The initial radius the slider shows (used when the automatic radius is off).
-    pub manual_radius: f64,
-    /// The indirect radius scale the slider shows (used when the automatic scale is off).
-    pub manual_indirect_scale: f64,
+    /// What the slider of each automatic setting shows (its value when automatic is off).
+    pub manual: std::collections::BTreeMap<&'static str, f64>,
     /// Lens radius (0 = pinhole).
     pub aperture: f64,
     /// Distance to the plane in focus.
@@ -25,53 +24,25 @@ pub struct PanelParams {
 /// Slider ranges scaled to the scene's size.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ranges {
-    /// Initial radius range.
-    pub radius: (f64, f64),
+    /// Half the diagonal of the scene's bounded geometry (at most four focal distances): what
+    /// sliders of lengths are fractions of.
+    pub extent: f64,
     /// Aperture range (from 0).
     pub aperture_max: f64,
     /// Focal distance range.
     pub focal: (f64, f64),
 }
 
-/// Photons-per-pass slider range.
-pub const PHOTONS_RANGE: (u64, u64) = (1_000, 10_000_000);
-/// α slider range (α = 1 keeps the radius; the paper uses 0.7).
-pub const ALPHA_RANGE: (f64, f64) = (0.05, 1.0);
-/// Depth slider range: all the session accepts.
-pub const DEPTH_RANGE: (u32, u32) = (
-    *crate::settings::limits::MAX_DEPTH.start(),
-    *crate::settings::limits::MAX_DEPTH.end(),
-);
-
 impl PanelParams {
     /// The scene file's values.
     pub fn from_scene(scene: &Scene) -> Self {
         Self {
             render: scene.params.clone(),
-            manual_radius: scene
-                .params
-                .initial_radius
-                .unwrap_or(Ranges::for_scene(scene).default_radius()),
-            manual_indirect_scale: scene.params.indirect_radius_scale.unwrap_or(2.0),
+            manual: Default::default(),
             aperture: scene.camera.aperture,
             focal_distance: scene.camera.focal_distance,
             paused: false,
         }
-    }
-
-    /// Whether the initial radius comes from the pixel footprint.
-    pub fn auto_radius(&self) -> bool {
-        self.render.initial_radius.is_none()
-    }
-
-    /// Switches the automatic initial radius on or off (off: the slider's value).
-    pub fn set_auto_radius(&mut self, auto: bool) {
-        self.render.initial_radius = (!auto).then_some(self.manual_radius);
-    }
-
-    /// Switches the automatic indirect radius scale on or off (off: the slider's value).
-    pub fn set_auto_indirect_scale(&mut self, auto: bool) {
-        self.render.indirect_radius_scale = (!auto).then_some(self.manual_indirect_scale);
     }
 
     /// `camera` with this lens.
@@ -128,17 +99,12 @@ impl Ranges {
         };
         let extent = extent.min(4.0 * cam.focal_distance);
         Self {
-            radius: (extent * 1e-5, extent * 0.2),
+            extent,
             aperture_max: (extent * 0.1).max(cam.aperture * 2.0),
             focal: (
                 (extent * 1e-3).min(cam.focal_distance * 0.5),
                 (extent * 20.0).max(cam.focal_distance * 2.0),
             ),
         }
-    }
-
-    /// A starting value for a manual radius.
-    pub fn default_radius(&self) -> f64 {
-        (self.radius.0 * self.radius.1).sqrt()
     }
 }

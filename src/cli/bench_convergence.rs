@@ -6,10 +6,9 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use anyhow::{bail, Context, Result};
-use clap::ValueEnum;
 
 use super::bench_output::BenchOutput;
-use super::render_session;
+use super::runs::render_session;
 use super::shared_args::{CurveFiles, Threads};
 use caustic::bench::error_curves::{errors, write_csv, Checkpoint, Curve};
 use caustic::bench::plot::write_plot;
@@ -17,119 +16,79 @@ use caustic::bench::reference::{default_cache_dir, ReferenceRecord};
 use caustic::render::ppm::Ppm;
 use caustic::render::session::SessionOptions;
 use caustic::scene::{RendererKind, Scene};
+use caustic::settings::setting::Kind;
 use caustic::settings::RenderParams;
-use caustic::settings::{IndexKind, RadiusSchedule};
 
-/// A configuration measured: the scene's parameters with one thing changed.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum Config {
-    /// The defaults before light sampling, balanced passes, guided emission, stratified eye
-    /// rays and photons, supersampled outlines and the wider indirect estimate: photons carry
-    /// all light in one estimate, lights emit as they shine at random, a pass traces exactly
-    /// the scene's photons per pass and eye rays are jittered independently (the baseline).
-    PhotonsOnly,
-    /// The defaults: direct light by light sampling, guided emission, stratified eye rays and
-    /// photons, an automatic wider radius for indirect light, α 0.7, automatic radius, hash grid.
-    Default,
-    /// The defaults with lights emitting as they shine (no guided emission).
-    Unguided,
-    /// The defaults with eye rays jittered independently (no stratification over passes).
-    Unstratified,
-    /// The defaults with photons' directions drawn independently at random (no Sobol
-    /// sequence over the render's photons).
-    UnstratifiedPhotons,
-    /// The defaults with one eye ray per pixel a pass for the light seen directly (no
-    /// supersampled lamp outlines).
-    Unsupersampled,
-    /// The defaults with one estimate for all photons (no wider indirect radius).
-    OneEstimate,
-    /// The defaults with every point starting at the initial radius (no adaptive radius).
-    FixedRadius,
-    /// α = 0.5.
-    #[value(name = "alpha-0.5")]
-    Alpha05,
-    /// α = 2/3 (Knaus & Zwicker's asymptotically best choice).
-    #[value(name = "alpha-0.667")]
-    Alpha067,
-    /// α = 0.9.
-    #[value(name = "alpha-0.9")]
-    Alpha09,
-    /// An initial radius four times the automatic one.
-    #[value(name = "radius-x4")]
-    RadiusX4,
-    /// The seed report's kd-tree instead of the hash grid.
-    KdTree,
-    /// The path tracer (one sample per pixel a pass), against the same photon-mapped
-    /// reference.
-    #[value(name = "path")]
-    PathTracer,
-    /// The defaults with the global radius schedule (Knaus & Zwicker 2011): every pass an
-    /// independent estimate, as sharded renders need.
-    GlobalSchedule,
+/// A configuration measured: the scene's settings changed as its text says, through the table
+/// of settings — `default`, `photons-only` (photon mapping as the paper has it: every switch
+/// off, one estimate, exactly the photons per pass), or `KEY=VALUE` changes joined by `+`
+/// (`alpha=0.5`, `guided_emission=off+adaptive_radius=off`, `renderer=path`); an
+/// `initial_radius` of `4x` is four times the automatic radius. Every configuration starts
+/// from the scene's settings with photon mapping's switches and automatic settings at the
+/// program's defaults, so that `default` measures them on whatever the scene sets.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Config {
+    /// As given (the table's, the CSV's and the plot's label).
+    text: String,
+    /// The changes, key and value.
+    changes: Vec<(&'static str, String)>,
 }
 
+/// The changes `photons-only` stands for.
+const PHOTONS_ONLY: &str = "direct_light=off+guided_emission=off+min_photons_per_pixel=0+stratified_eye_rays=off+stratified_photons=off+supersample_light_seen=off+indirect_radius_scale=1+adaptive_radius=off";
+
 impl Config {
-    /// Name in tables, the CSV and the plot's legend.
-    fn label(self) -> &'static str {
-        match self {
-            Config::PhotonsOnly => "old defaults (photons only)",
-            Config::Default => "new defaults",
-            Config::Unguided => "default without guided emission",
-            Config::Unstratified => "default without stratified eye rays",
-            Config::UnstratifiedPhotons => "default without stratified photons",
-            Config::Unsupersampled => "default without supersampled outlines",
-            Config::OneEstimate => "default with one estimate for all photons",
-            Config::FixedRadius => "default without adaptive radius",
-            Config::Alpha05 => "alpha 0.5",
-            Config::Alpha067 => "alpha 2/3",
-            Config::Alpha09 => "alpha 0.9",
-            Config::RadiusX4 => "initial radius x4",
-            Config::KdTree => "kd-tree",
-            Config::PathTracer => "path tracer",
-            Config::GlobalSchedule => "default, global radius schedule",
+    /// Parses a configuration (as `--configs` gives it), checking each key against the table.
+    pub fn parse(text: &str) -> Result<Config, String> {
+        let spelled = match text {
+            "default" => "",
+            "photons-only" => PHOTONS_ONLY,
+            other => other,
+        };
+        let mut changes = Vec::new();
+        for change in spelled.split('+').filter(|c| !c.is_empty()) {
+            let (key, value) = change
+                .split_once('=')
+                .ok_or_else(|| format!("{change:?}: expected KEY=VALUE, default or photons-only"))?;
+            let setting = caustic::settings::find_setting(key.trim())
+                .ok_or_else(|| format!("{key:?} is not a render setting (see scenes/FORMAT.md)"))?;
+            changes.push((setting.key, value.trim().to_owned()));
         }
+        Ok(Config {
+            text: text.to_owned(),
+            changes,
+        })
     }
 
-    /// The scene's parameters with this configuration's change; `auto_radius` is the radius
+    /// Name in tables, the CSV and the plot's legend.
+    fn label(&self) -> &str {
+        &self.text
+    }
+
+    /// The scene's parameters with this configuration's changes; `auto_radius` is the radius
     /// photon mapping picks by itself.
-    fn params(self, base: &RenderParams, auto_radius: f64) -> RenderParams {
-        let mut p = RenderParams {
-            direct_light: true,
-            guided_emission: true,
-            stratified_eye_rays: true,
-            stratified_photons: true,
-            supersample_light_seen: true,
-            indirect_radius_scale: None,
-            adaptive_radius: true,
-            ..base.clone()
-        };
-        match self {
-            Config::PhotonsOnly => {
-                p.direct_light = false;
-                p.guided_emission = false;
-                p.min_photons_per_pixel = 0.0;
-                p.stratified_eye_rays = false;
-                p.stratified_photons = false;
-                p.supersample_light_seen = false;
-                p.indirect_radius_scale = Some(1.0);
-                p.adaptive_radius = false;
+    fn params(&self, base: &RenderParams, auto_radius: f64) -> Result<RenderParams> {
+        let defaults = RenderParams::default();
+        let mut p = base.clone();
+        for s in caustic::settings::SETTINGS {
+            let switch = matches!(s.kind, Kind::Bool | Kind::Auto);
+            if s.renderers == [RendererKind::Ppm] && switch {
+                if let Some(v) = defaults.get(s.key) {
+                    p.set(s.key, &v).map_err(anyhow::Error::msg)?;
+                }
             }
-            Config::Default => {}
-            Config::Unguided => p.guided_emission = false,
-            Config::Unstratified => p.stratified_eye_rays = false,
-            Config::UnstratifiedPhotons => p.stratified_photons = false,
-            Config::Unsupersampled => p.supersample_light_seen = false,
-            Config::OneEstimate => p.indirect_radius_scale = Some(1.0),
-            Config::FixedRadius => p.adaptive_radius = false,
-            Config::Alpha05 => p.alpha = 0.5,
-            Config::Alpha067 => p.alpha = 2.0 / 3.0,
-            Config::Alpha09 => p.alpha = 0.9,
-            Config::RadiusX4 => p.initial_radius = Some(4.0 * auto_radius),
-            Config::KdTree => p.index = IndexKind::KdTree,
-            Config::PathTracer => p.renderer = RendererKind::Path,
-            Config::GlobalSchedule => p.radius_schedule = RadiusSchedule::Global,
         }
-        p
+        for (key, value) in &self.changes {
+            let value = match value.strip_suffix('x').map(str::parse::<f64>) {
+                Some(Ok(k)) if *key == "initial_radius" => (k * auto_radius).to_string(),
+                _ => value.clone(),
+            };
+            p.set_text(key, &value)
+                .map_err(|e| anyhow::anyhow!("configuration {}: '{key}' {e}", self.text))?;
+        }
+        p.validate()
+            .map_err(|e| anyhow::anyhow!("configuration {}: {e}", self.text))?;
+        Ok(p)
     }
 }
 
@@ -158,12 +117,14 @@ pub struct ConvergenceArgs {
     /// Where reference renders are cached (default: ~/.cache/caustic/references).
     #[arg(long)]
     reference_dir: Option<PathBuf>,
-    /// Configurations to measure, the first being the baseline.
+    /// Configurations to measure, the first being the baseline: `default`, `photons-only`, or
+    /// changes of the render settings `KEY=VALUE` joined by `+` (any key of scenes/FORMAT.md's
+    /// [render] table; `initial_radius=4x`: four times the automatic radius).
     #[arg(
         long,
-        value_enum,
         value_delimiter = ',',
-        default_value = "photons-only,default,unguided,unstratified,unstratified-photons,unsupersampled,one-estimate,fixed-radius,alpha-0.5,alpha-0.667,alpha-0.9,radius-x4"
+        value_parser = Config::parse,
+        default_value = "photons-only,default,guided_emission=off,stratified_eye_rays=off,stratified_photons=off,supersample_light_seen=off,indirect_radius_scale=1,adaptive_radius=off,alpha=0.5,alpha=0.667,alpha=0.9,initial_radius=4x"
     )]
     configs: Vec<Config>,
     /// Rows (configuration, pass, seconds, RMSE, relMSE) and the plot of RMSE against seconds.
@@ -175,7 +136,7 @@ pub struct ConvergenceArgs {
 
 /// Runs the measurement and prints the table.
 pub fn bench_convergence(args: ConvergenceArgs, out: &mut BenchOutput) -> Result<()> {
-    let mut scene = super::photon_scene(args.scene.as_deref())?;
+    let mut scene = super::runs::photon_scene(args.scene.as_deref())?;
     check(
         &args.width,
         args.seconds,
@@ -220,7 +181,7 @@ pub fn bench_convergence(args: ConvergenceArgs, out: &mut BenchOutput) -> Result
             _ => args.seconds,
         };
         let mut configured = scene.clone();
-        configured.params = config.params(&scene.params, auto_radius);
+        configured.params = config.params(&scene.params, auto_radius)?;
         eprintln!("  {} ({seconds} s)...", config.label());
         curves.push(measure(configured, config.label(), seconds, &reference)?);
     }
@@ -289,7 +250,7 @@ pub(super) fn reference(
         out.set("reference", record.path_in(&dir).display().to_string());
         return Ok(pixels);
     }
-    let bar = super::progress_bar(
+    let bar = super::runs::progress_bar(
         passes as u64,
         "{msg} [{bar:40}] pass {pos}/{len}, {elapsed} (eta {eta})",
         "reference".into(),

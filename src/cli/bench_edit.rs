@@ -69,7 +69,7 @@ pub fn bench_edit(args: EditArgs, out: &mut BenchOutput) -> Result<()> {
     if !(args.target > 0.0 && args.limit > 0.0 && args.distance.is_finite()) {
         bail!("--target and --limit must be positive, --distance finite");
     }
-    let mut scene = super::scene_or_built_in(
+    let mut scene = super::runs::scene_or_built_in(
         args.scene.as_deref(),
         caustic::assets::INLINE_PATCH_SCENE,
         "inline_patch",

@@ -9,7 +9,7 @@ use anyhow::{bail, Result};
 use clap::Args;
 
 use super::bench_output::BenchOutput;
-use super::{load_scene, photon_scene, ppm_stats, render_session};
+use super::runs::{load_scene, photon_scene, ppm_stats, render_session};
 use caustic::bench::timings::{interleaved, Timings};
 use caustic::render::render_whitted;
 use caustic::render::session::SessionOptions;

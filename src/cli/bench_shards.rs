@@ -9,7 +9,7 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 
 use super::bench_output::BenchOutput;
-use super::load_scene;
+use super::runs::load_scene;
 use super::shard::{merge_parts, shard_part};
 use super::shared_args::Threads;
 use caustic::render::shard::{PassSet, Shard};

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 
-use super::load_scene;
+use super::runs::load_scene;
 use super::shared_args::Overwrite;
 use caustic::files::write_atomically;
 use caustic::geometry::freeform::{write_freeform_obj, DomainPatch};

@@ -7,8 +7,8 @@ use std::path::PathBuf;
 use anyhow::{bail, Result};
 
 use super::bench_output::BenchOutput;
+use super::runs::{load_scene, render_session};
 use super::shared_args::Threads;
-use super::{load_scene, render_session};
 use caustic::render::session::SessionOptions;
 use caustic::scene::RendererKind;
 

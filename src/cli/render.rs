@@ -9,8 +9,8 @@ use std::time::Duration;
 use anyhow::{bail, Result};
 
 use super::render_report::Report;
+use super::runs::{load_scene, render_session};
 use super::shared_args::{Overwrite, Threads};
-use super::{load_scene, render_session};
 use caustic::render::compare::Reference;
 use caustic::render::error::pixel_error_estimate;
 use caustic::render::provenance::{software, Recorded};
@@ -20,8 +20,7 @@ use caustic::render::shard::{PartHeader, PassSet};
 use caustic::render::{image_metadata, Image, Layer};
 use caustic::scene::{RendererKind, Scene};
 use caustic::settings::limits;
-use caustic::settings::RenderParams;
-use caustic::settings::{IndexKind, RadiusSchedule};
+use caustic::settings::{RadiusSchedule, SettingFlags};
 use caustic::tev::TevStream;
 
 /// `caustic render`'s flags.
@@ -46,12 +45,6 @@ pub struct RenderArgs {
     /// --width is given too).
     #[arg(long)]
     height: Option<u32>,
-    /// Override the scene's seed (0 to 9223372036854775807, what a scene file can hold).
-    #[arg(long)]
-    seed: Option<u64>,
-    /// Override the scene's renderer.
-    #[arg(long, value_enum)]
-    renderer: Option<RendererKind>,
     /// PNG exposure in stops (EXR is always linear); default 0, or what --from records.
     #[arg(long, allow_negative_numbers = true)]
     exposure: Option<f32>,
@@ -77,144 +70,23 @@ pub struct RenderArgs {
     #[arg(long, value_name = "K/N", value_parser = caustic::render::shard::Shard::parse)]
     shard: Option<caustic::render::shard::Shard>,
     #[command(flatten)]
-    ppm: PpmArgs,
+    run: RunArgs,
+    #[command(flatten)]
+    settings: SettingFlags,
 }
 
-/// Photon-mapping flags of `render`.
+/// `render`'s flags for the run itself (how many passes), beside the render settings.
 #[derive(clap::Args, Clone, Debug)]
-pub struct PpmArgs {
-    /// Photon mapping: passes to run (default 16, or what --from records; with --time-limit
-    /// alone, as many as fit in it); with --shard, the passes of the whole render, of which the
-    /// shard renders its own.
+pub struct RunArgs {
+    /// Photon mapping and the path tracer: passes to run (default 16, or what --from records;
+    /// with --time-limit alone, as many as fit in it); with --shard, the passes of the whole
+    /// render, of which the shard renders its own.
     #[arg(long)]
     passes: Option<u32>,
-    /// Photon mapping: stop after this many seconds even if passes remain; without --passes
-    /// (and not --from an image that records them), render passes until then.
+    /// Photon mapping and the path tracer: stop after this many seconds even if passes remain;
+    /// without --passes (and not --from an image that records them), render passes until then.
     #[arg(long, allow_negative_numbers = true)]
     time_limit: Option<f64>,
-    /// Photon mapping: photons per pass (default: the scene's).
-    #[arg(long)]
-    photons: Option<u64>,
-    /// Photon mapping: least photons per pixel of a pass when the eye pass is traced every
-    /// pass (anti-aliasing, depth of field); 0 for exactly --photons (default: the scene's).
-    #[arg(long, allow_negative_numbers = true)]
-    min_photons_per_pixel: Option<f64>,
-    /// Photon mapping: radius reduction α in (0, 1] (default: the scene's).
-    #[arg(long, allow_negative_numbers = true)]
-    alpha: Option<f64>,
-    /// Photon mapping: initial radius in scene units (default: the scene's, or automatic).
-    #[arg(long, allow_negative_numbers = true)]
-    radius: Option<f64>,
-    /// Photon mapping: spatial index over visible points (default: the scene's, or grid).
-    #[arg(long, value_enum)]
-    index: Option<IndexKind>,
-    /// Photon mapping: direct light by light sampling, photons for caustics and indirect
-    /// light only (default: the scene's `direct_light`, on unless it says otherwise).
-    #[arg(long, value_name = "on|off", action = clap::ArgAction::Set,
-          value_parser = clap::builder::BoolishValueParser::new())]
-    direct_light: Option<bool>,
-    /// Photon mapping: send photons where the camera looks, by each light's emission density
-    /// learned from which photons reached a visible point (default: the scene's
-    /// `guided_emission`, on unless it says otherwise).
-    #[arg(long, value_name = "on|off", action = clap::ArgAction::Set,
-          value_parser = clap::builder::BoolishValueParser::new())]
-    guided_emission: Option<bool>,
-    /// Photon mapping: place each pixel's eye rays over passes by low-discrepancy sequences
-    /// rather than independently at random, when they are jittered (anti-aliasing, depth of
-    /// field) (default: the scene's `stratified_eye_rays`, on unless it says otherwise).
-    #[arg(long, value_name = "on|off", action = clap::ArgAction::Set,
-          value_parser = clap::builder::BoolishValueParser::new())]
-    stratified_eye_rays: Option<bool>,
-    /// Photon mapping: choose photons' directions by Sobol's low-discrepancy sequence over the
-    /// render's photons rather than independently at random (default: the scene's
-    /// `stratified_photons`, on unless it says otherwise).
-    #[arg(long, value_name = "on|off", action = clap::ArgAction::Set,
-          value_parser = clap::builder::BoolishValueParser::new())]
-    stratified_photons: Option<bool>,
-    /// Photon mapping: where the light a pixel sees directly changes within it (a lamp's
-    /// outline, its images in mirrors and glass), trace 16 more eye rays a pass there for that
-    /// light, and 4 more where it varied most over the first 8 passes (a texture's or a
-    /// shadow's edge, a floor seen through glass), when eye rays are jittered (default: the
-    /// scene's `supersample_light_seen`, on unless it says otherwise).
-    #[arg(long, value_name = "on|off", action = clap::ArgAction::Set,
-          value_parser = clap::builder::BoolishValueParser::new())]
-    supersample_light_seen: Option<bool>,
-    /// Photon mapping: initial radius of the indirect light's estimate (photons after a
-    /// diffuse bounce) as a multiple of the initial radius; 1 for one estimate of all photons
-    /// (default: the scene's `indirect_radius_scale`, or chosen from the first pass's photon
-    /// density, 1 to 4).
-    #[arg(long, value_name = "K")]
-    indirect_radius_scale: Option<f64>,
-    /// Photon mapping: after the first pass, narrow the radius (up to 4×) of points where
-    /// photons are dense, such as the inside of a caustic, and widen it (up to 2×) where they
-    /// are sparse and no denser light is near (default: the scene's `adaptive_radius`, on
-    /// unless it says otherwise).
-    #[arg(long, value_name = "on|off", action = clap::ArgAction::Set,
-          value_parser = clap::builder::BoolishValueParser::new())]
-    adaptive_radius: Option<bool>,
-    /// Photon mapping: how the radius shrinks pass by pass: each point's own statistics
-    /// (per-point, Hachisuka et al. 2008) or one global schedule in which every pass is an
-    /// independent estimate (global, Knaus & Zwicker 2011; needed by --shard) (default: the
-    /// scene's `radius_schedule`, or per-point).
-    #[arg(long, value_enum)]
-    pub radius_schedule: Option<RadiusSchedule>,
-}
-
-impl PpmArgs {
-    /// Lays the photon-mapping flags given over the scene's parameters and checks the result
-    /// with [`RenderParams::validate`]; an error names the flag.
-    fn overlay(&self, params: &mut RenderParams) -> Result<()> {
-        if let Some(p) = self.photons {
-            params.photons_per_pass = p;
-        }
-        if let Some(a) = self.alpha {
-            params.alpha = a;
-        }
-        if let Some(n) = self.min_photons_per_pixel {
-            params.min_photons_per_pixel = n;
-        }
-        if let Some(r) = self.radius {
-            params.initial_radius = Some(r);
-        }
-        if let Some(index) = self.index {
-            params.index = index;
-        }
-        if let Some(on) = self.direct_light {
-            params.direct_light = on;
-        }
-        if let Some(on) = self.guided_emission {
-            params.guided_emission = on;
-        }
-        if let Some(on) = self.stratified_eye_rays {
-            params.stratified_eye_rays = on;
-        }
-        if let Some(on) = self.stratified_photons {
-            params.stratified_photons = on;
-        }
-        if let Some(on) = self.supersample_light_seen {
-            params.supersample_light_seen = on;
-        }
-        if let Some(k) = self.indirect_radius_scale {
-            params.indirect_radius_scale = Some(k);
-        }
-        if let Some(on) = self.adaptive_radius {
-            params.adaptive_radius = on;
-        }
-        if let Some(schedule) = self.radius_schedule {
-            params.radius_schedule = schedule;
-        }
-        params.validate().map_err(|e| {
-            let flag = match e.field {
-                "photons_per_pass" => "--photons",
-                "alpha" => "--alpha",
-                "initial_radius" => "--radius",
-                "min_photons_per_pixel" => "--min-photons-per-pixel",
-                "indirect_radius_scale" => "--indirect-radius-scale",
-                field => field,
-            };
-            anyhow::anyhow!("{flag} {}", e.problem)
-        })
-    }
 }
 
 /// Renders a scene to an image with the ray tracer or photon mapping.
@@ -241,11 +113,11 @@ pub fn render(args: RenderArgs) -> Result<()> {
                     .or(recorded.as_ref().and_then(|r| r.passes));
                 (
                     PassSet::Shard(shard),
-                    args.ppm.passes.or(recorded_total).unwrap_or(16),
+                    args.run.passes.or(recorded_total).unwrap_or(16),
                 )
             }
             (None, Some(part)) => {
-                if args.ppm.passes.is_some() {
+                if args.run.passes.is_some() {
                     bail!(
                         "--passes cannot be used with --from a part file: it renders the part's own passes ({} of {}) again; give --shard K/N to render a shard of its render instead",
                         passes_text(&part.passes),
@@ -256,7 +128,6 @@ pub fn render(args: RenderArgs) -> Result<()> {
             }
             (None, None) => unreachable!("one of the two is given"),
         };
-        args.ppm.overlay(&mut scene.params)?;
         return super::shard::render_shard(&mut scene, passes, total, out, args.overwrite.force);
     }
     let reference = match &args.reference {
@@ -281,8 +152,8 @@ pub fn render(args: RenderArgs) -> Result<()> {
         report: &mut report,
     };
     let passes = if scene.params.renderer.progressive() {
-        let asked = args.ppm.passes.or(recorded.as_ref().and_then(|r| r.passes));
-        match (asked, args.ppm.time_limit) {
+        let asked = args.run.passes.or(recorded.as_ref().and_then(|r| r.passes));
+        match (asked, args.run.time_limit) {
             (Some(n), _) => Passes::Count(n),
             (None, Some(limit)) => Passes::UntilTimeLimit(limit),
             (None, None) => Passes::Count(16),
@@ -290,7 +161,7 @@ pub fn render(args: RenderArgs) -> Result<()> {
     } else {
         Passes::Count(1)
     };
-    let rendered = render_passes(&mut scene, passes, &args.ppm, &mut output)?;
+    let rendered = render_passes(&mut scene, passes, &args.run, &mut output)?;
     let layers: Vec<Layer> = rendered
         .layers
         .iter()
@@ -309,20 +180,15 @@ pub fn check_shard_flags(args: &RenderArgs) -> Result<()> {
     if args.reference.is_some() || args.tev.is_some() || args.json {
         bail!("--reference, --tev and --json report on a whole render, not on a part: merge the parts, then compare or view the merged image");
     }
-    if args.ppm.time_limit.is_some() {
+    if args.run.time_limit.is_some() {
         bail!("--time-limit cannot be used for a part: a part holds whole passes, chosen by their number");
     }
-    if let Some(kind) = args.renderer.filter(|&k| k != RendererKind::Ppm) {
-        bail!(
-            "--renderer {}: a part is photon mapped with the global radius schedule",
-            kind.name()
-        );
+    let given = |key: &str| args.settings.get(key).map(|v| v.replace('-', "_"));
+    if let Some(kind) = given("renderer").filter(|k| k != RendererKind::Ppm.name()) {
+        bail!("--renderer {kind}: a part is photon mapped with the global radius schedule");
     }
-    if let Some(schedule) = args.ppm.radius_schedule.filter(|&s| s != RadiusSchedule::Global) {
-        bail!(
-            "--radius-schedule {}: a part's passes follow the global radius schedule",
-            schedule.name()
-        );
+    if let Some(schedule) = given("radius_schedule").filter(|s| s != RadiusSchedule::Global.name()) {
+        bail!("--radius-schedule {schedule}: a part's passes follow the global radius schedule");
     }
     Ok(())
 }
@@ -372,12 +238,9 @@ fn scene_to_render(args: &RenderArgs, report: &mut Report) -> Result<(Scene, Opt
         }
     }
     scene.camera.resize(args.width, args.height);
-    if let Some(s) = args.seed {
-        scene.params.seed = flag_check("--seed", limits::seed(s))?;
-    }
-    if let Some(kind) = args.renderer {
-        scene.params.renderer = kind;
-    }
+    args.settings
+        .apply(&mut scene.params)
+        .map_err(anyhow::Error::msg)?;
     Ok((scene, recorded, exposure))
 }
 
@@ -422,7 +285,7 @@ enum Passes {
 }
 
 /// Renders `passes` (one frame for a renderer that makes one) on a headless session.
-fn render_passes(scene: &mut Scene, passes: Passes, args: &PpmArgs, output: &mut Output) -> Result<Rendered> {
+fn render_passes(scene: &mut Scene, passes: Passes, args: &RunArgs, output: &mut Output) -> Result<Rendered> {
     if let Passes::Count(n) = passes {
         flag_check("--passes", limits::passes(n))?;
     }
@@ -431,7 +294,6 @@ fn render_passes(scene: &mut Scene, passes: Passes, args: &PpmArgs, output: &mut
             bail!("--time-limit must be a positive number of seconds, got {t}");
         }
     }
-    args.overlay(&mut scene.params)?;
     let (w, h) = (scene.camera.width, scene.camera.height);
     let kind = scene.params.renderer;
     let what = format!("{} {w}x{h}", kind.label().to_lowercase());

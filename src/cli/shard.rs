@@ -27,7 +27,7 @@ pub fn render_shard(scene: &mut Scene, passes: PassSet, total: u32, out: &Path, 
     limits::passes(total).map_err(|e| anyhow::anyhow!("--passes {e}"))?;
     let start = Instant::now();
     let count = passes.passes_of(total);
-    let bar = super::progress_bar(
+    let bar = super::runs::progress_bar(
         count as u64,
         "{msg} [{bar:40}] pass {pos}/{len}, {elapsed} (eta {eta})",
         format!(

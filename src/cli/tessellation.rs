@@ -12,7 +12,7 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 
 use super::bench_output::BenchOutput;
-use super::load_scene;
+use super::runs::load_scene;
 use super::shared_args::{CurveFiles, Threads};
 use caustic::bench::plot::{draw_series, write_png, Frame, Series};
 use caustic::files::write_atomically;

@@ -4,13 +4,18 @@
 //! ranges every setting is checked against ([`limits`]). `scene` reads them from files and
 //! `render` runs with them; this module imports neither.
 
+pub mod docs;
+pub mod flags;
 mod index;
 pub mod limits;
 mod params;
 mod renderer;
 mod schedule;
+pub mod setting;
 
+pub use flags::SettingFlags;
 pub use index::IndexKind;
-pub use params::RenderParams;
+pub use params::{find_setting, InvalidParam, RenderParams, SETTINGS};
+pub(crate) use renderer::with_renderers;
 pub use renderer::RendererKind;
 pub use schedule::RadiusSchedule;

@@ -1,137 +1,263 @@
-//! The one set of render parameters. The scene file's `[render]` table, the command line's
-//! flags and the viewer's controls overlay their values onto a [`RenderParams`]; the render
-//! session receives the whole set (the session's `Command::SetParams`), checks it
-//! with [`RenderParams::validate`] (over the ranges in [`super::limits`]) and asks
-//! [`RenderParams::restarts_from`] whether the change discards the accumulation; the
-//! integrators read it each pass.
+//! The one table of render settings: every key of a scene's `[render]` table, with its type,
+//! default, check, unit, help, widget and the renderers that read it, in one entry each
+//! ([`render_settings!`] below). From it come the [`RenderParams`] struct (serde reads it from
+//! files), its defaults and [`RenderParams::validate`], the list [`SETTINGS`] that the command
+//! line's flags ([`super::flags`]), the viewer's widgets, `bench convergence`'s
+//! configurations and FORMAT.md's table are made from, and access by key
+//! ([`RenderParams::get`], [`RenderParams::set`]).
 //!
-//! Adding a setting means a field here (with its default and its check in `validate`), the
-//! control that shows it and the code that uses it.
+//! The render session receives the whole set (the session's `Command::SetParams`) and asks
+//! [`RenderParams::restarts_from`] whether a change discards the accumulation (every setting
+//! not marked live does). Adding a setting is one entry here and the code that reads it.
 
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
 use super::limits;
+use super::setting::{Field, Setting, Value, Widget};
 use super::{IndexKind, RadiusSchedule, RendererKind};
 
-/// Every render setting, with the defaults a scene file's `[render]` table starts from.
-/// Camera settings (pose, lens, image size) belong to the scene's camera.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct RenderParams {
-    /// Renderer.
-    pub renderer: RendererKind,
-    /// Photons per photon-mapping pass (applies from the next pass, no restart).
-    pub photons_per_pass: u64,
-    /// Stochastic PPM traces a new eye pass every pass; each pass then traces at least this
-    /// many photons per pixel, so the eye pass stays a small share of it (pbrt-v4's SPPM
-    /// traces one per pixel by default). A fixed ratio rather than a timing keeps the image
-    /// the same on any machine and thread count. 0: exactly `photons_per_pass`. Applies from
-    /// the next pass, no restart.
-    pub min_photons_per_pixel: f64,
-    /// PPM radius reduction α in (0, 1] (applies from the next update, no restart).
-    pub alpha: f64,
-    /// PPM initial radius in scene units (`None`: from the pixel footprint).
-    pub initial_radius: Option<f64>,
-    /// Photon mapping: the initial radius of the estimate of photons that have bounced off a
-    /// diffuse surface (indirect light), as a multiple of the initial radius. Indirect light
-    /// varies slowly, so where photons are sparse a wider radius gathers many more of them
-    /// for little blur, while direct light and caustics keep the narrow one. `None`
-    /// (default): chosen after the first pass so that a pass hands each point about 32
-    /// indirect photons, between 1× and 4×; 1: one estimate for all photons (the paper's
-    /// PPM).
-    pub indirect_radius_scale: Option<f64>,
-    /// Photon mapping: narrow the radius where photons are dense, widen it where they are
-    /// sparse. After the first pass (gathered over twice the initial radius), a point that
-    /// pass handed many more photons than it needs (the inside of a caustic) restarts its
-    /// estimate with a radius that would have handed it about 64, up to 4× narrower, so that
-    /// sharp light is not blurred by the initial radius for the first dozens of passes; one
-    /// handed fewer than 2 within the initial radius, with no denser light within two pixels,
-    /// with a radius that would have handed it 2, up to 2× wider (no wider than the indirect
-    /// estimate), so that light spread thin is less noisy. On by default; off, every point
-    /// starts at the initial radius (the paper's PPM).
-    pub adaptive_radius: bool,
-    /// Maximum specular bounces of eye rays and photons.
-    pub max_depth: u32,
-    /// Seed of every random number.
-    pub seed: u64,
-    /// Edge-adaptive anti-aliasing in the ray tracer; jittered pixels (stochastic PPM) in
-    /// photon mapping.
-    pub antialias: bool,
-    /// Lens samples per pixel with an open aperture (ray tracer).
-    pub dof_samples: u32,
-    /// Shadow samples per area light per shading point (ray tracer).
-    pub light_samples: u32,
-    /// Ambient radiance added at diffuse surfaces by the ray tracer.
-    pub ambient: DVec3,
-    /// Photon mapping: direct light by light sampling at the visible points — exact shadow
-    /// rays for point and spot lights, one stratified sample per area light per pass — with
-    /// photons deposited only after their first bounce (caustics and indirect light). On by
-    /// default; off, photons carry all the light (classic PPM).
-    pub direct_light: bool,
-    /// Photon mapping: photons sent where the camera looks — each light's emission density
-    /// learned from which of its photons reached a visible point (`ppm::guide`), weighted so
-    /// the image converges to the same result. On by default; off, lights emit as they shine.
-    pub guided_emission: bool,
-    /// Photon mapping: each pixel's eye rays placed over passes by low-discrepancy sequences
-    /// (`render::sequence`: Sobol's over the pixel, R4 over the lens, randomised per pixel)
-    /// instead of independently at random, so the outlines of bright lights, their
-    /// reflections and the lens blur converge nearly as 1/passes rather than 1/√passes. On by
-    /// default; matters only when the eye pass is traced every pass (anti-aliasing, depth of
-    /// field).
-    pub stratified_eye_rays: bool,
-    /// Photon mapping: the numbers that choose each photon's direction come from Sobol's
-    /// low-discrepancy sequence over the render's photons (`render::sequence`, randomised by
-    /// the seed) instead of independently at random (quasi-Monte Carlo photon mapping, Keller,
-    /// Grünschloß & Droske 2012), so each pass's photons cover the light's directions evenly
-    /// and caustics are less noisy; with several lights the sequence picks the light too. On
-    /// by default.
-    pub stratified_photons: bool,
-    /// Photon mapping: where the light a pixel sees directly changes within the pixel (a
-    /// lamp's outline, its images in mirrors and glass), that pixel traces 16 more eye rays a
-    /// pass that only look for that light (`ppm::seen`), so the outline converges as if it had
-    /// 16 times the passes; after 8 passes, the pixels whose light seen varied most between
-    /// them (a texture's or a shadow's edge, a floor seen through glass) trace 4 more. The
-    /// pixels are chosen from the passes so far; a chosen pixel's
-    /// light seen counts only its later passes, so the image converges to the same result.
-    /// On by default; matters only when the eye pass is traced every pass (anti-aliasing,
-    /// depth of field).
-    pub supersample_light_seen: bool,
-    /// Photon mapping: the spatial index over visible points (the image does not depend on it).
-    pub index: IndexKind,
-    /// Photon mapping: how the radius shrinks pass by pass. Per point (default) keeps each
-    /// point's statistics from pass to pass; global (Knaus & Zwicker 2011) makes every pass
-    /// an independent estimate at a radius all points follow, so passes can be split across
-    /// machines and merged. With the global schedule α, the initial radii and the emission
-    /// guide are fixed by a pilot pass every machine repeats.
-    pub radius_schedule: RadiusSchedule,
+/// The photon mapper alone.
+const PPM: &[RendererKind] = &[RendererKind::Ppm];
+/// The ray tracer alone.
+const WHITTED: &[RendererKind] = &[RendererKind::Whitted];
+
+/// Makes [`RenderParams`], its defaults, checks and access by key, and [`SETTINGS`], from one
+/// entry per setting.
+macro_rules! render_settings {
+    ($(
+        $key:ident: $ty:ty = $default:expr;
+        check $check:expr;
+        flag $flag:literal, label $label:literal, default $default_text:literal, unit $unit:literal,
+        renderers $renderers:expr, live $live:literal, widget $widget:expr;
+        help $help:literal;
+    )*) => {
+        /// Every render setting, with the defaults a scene file's `[render]` table starts from.
+        /// Camera settings (pose, lens, image size) belong to the scene's camera.
+        #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+        #[serde(default, deny_unknown_fields)]
+        pub struct RenderParams {
+            $(
+                #[doc = $help]
+                pub $key: $ty,
+            )*
+        }
+
+        impl Default for RenderParams {
+            fn default() -> Self {
+                Self { $($key: $default,)* }
+            }
+        }
+
+        /// Every render setting, in the table's order.
+        pub const SETTINGS: &[Setting] = &[$(
+            Setting {
+                key: stringify!($key),
+                flag: $flag,
+                label: $label,
+                help: $help,
+                default: $default_text,
+                unit: $unit,
+                renderers: $renderers,
+                live: $live,
+                widget: $widget,
+                choices: <$ty as Field>::CHOICES,
+                kind: <$ty as Field>::KIND,
+            },
+        )*];
+
+        impl RenderParams {
+            /// Checks every value against [`super::limits`]; the first one out of range is
+            /// named.
+            pub fn validate(&self) -> Result<(), InvalidParam> {
+                $(
+                    let check: fn(&$ty) -> Result<(), limits::Invalid> = $check;
+                    check(&self.$key).map_err(|problem| InvalidParam {
+                        field: stringify!($key),
+                        problem,
+                    })?;
+                )*
+                Ok(())
+            }
+
+            /// The value of setting `key` (`None`: no such setting).
+            pub fn get(&self, key: &str) -> Option<Value> {
+                match key {
+                    $(stringify!($key) => Some(self.$key.value()),)*
+                    _ => None,
+                }
+            }
+
+            /// Sets `key` to `value` (of its kind; not checked against its range: see
+            /// [`RenderParams::validate`]).
+            pub fn set(&mut self, key: &str, value: &Value) -> Result<(), String> {
+                match key {
+                    $(stringify!($key) => {
+                        self.$key = <$ty as Field>::from_value(value)
+                            .ok_or_else(|| format!("takes {:?} values, not {value:?}", <$ty as Field>::KIND))?;
+                        Ok(())
+                    })*
+                    _ => Err(format!("is not a render setting (the settings: {})", keys())),
+                }
+            }
+
+            /// Sets `key` from text, as a flag or a bench configuration gives it.
+            pub fn set_text(&mut self, key: &str, text: &str) -> Result<(), String> {
+                match key {
+                    $(stringify!($key) => {
+                        self.$key = <$ty as Field>::parse(text)?;
+                        Ok(())
+                    })*
+                    _ => Err(format!("is not a render setting (the settings: {})", keys())),
+                }
+            }
+        }
+    };
 }
 
-impl Default for RenderParams {
-    fn default() -> Self {
-        Self {
-            renderer: RendererKind::Whitted,
-            photons_per_pass: 200_000,
-            min_photons_per_pixel: 4.0,
-            alpha: 0.7,
-            initial_radius: None,
-            indirect_radius_scale: None,
-            adaptive_radius: true,
-            max_depth: 8,
-            seed: 1,
-            antialias: true,
-            dof_samples: 16,
-            light_samples: 16,
-            ambient: DVec3::ZERO,
-            direct_light: true,
-            guided_emission: true,
-            stratified_eye_rays: true,
-            stratified_photons: true,
-            supersample_light_seen: true,
-            index: IndexKind::HashGrid,
-            radius_schedule: RadiusSchedule::PerPoint,
-        }
+/// Every key, for messages.
+fn keys() -> String {
+    SETTINGS.iter().map(|s| s.key).collect::<Vec<_>>().join(", ")
+}
+
+/// The setting of `key`.
+pub fn find_setting(key: &str) -> Option<&'static Setting> {
+    SETTINGS.iter().find(|s| s.key == key)
+}
+
+/// Checks nothing (choices and switches are valid by their type).
+fn any<T>(_: &T) -> Result<(), limits::Invalid> {
+    Ok(())
+}
+
+render_settings! {
+    renderer: RendererKind = RendererKind::Whitted;
+    check any;
+    flag "renderer", label "Renderer", default "\"whitted\"", unit "",
+    renderers RendererKind::ALL, live false, widget Widget::Hidden;
+    help "Which renderer makes the image: \"whitted\" (the ray tracer: one fast frame), \"ppm\" (progressive photon mapping) or \"path\" (the path tracer: unbiased, one sample per pixel a pass).";
+
+    photons_per_pass: u64 = 200_000;
+    check |n| limits::photons_per_pass(*n).map(drop);
+    flag "photons", label "Photons per pass", default "200000", unit "photons",
+    renderers PPM, live true, widget Widget::Slider { min: 1_000.0, max: 10_000_000.0, log: true, step: 0.0 };
+    help "Photons traced per pass (with guided emission, divided by how many times more of them arrive where the camera looks). Applies from the next pass, without restarting.";
+
+    min_photons_per_pixel: f64 = 4.0;
+    check |n| limits::photons_per_pixel(*n).map(drop);
+    flag "min-photons-per-pixel", label "Min photons per pixel", default "4", unit "photons a pixel",
+    renderers PPM, live true, widget Widget::Slider { min: 0.0, max: 32.0, log: false, step: 0.5 };
+    help "When the eye pass is traced anew every pass (anti-aliasing or an open aperture), each pass traces at least this many photons per pixel, so the eye pass stays a small share of it: a ratio rather than a timing keeps the image the same on any machine and thread count. 0: exactly the photons per pass. Applies from the next pass, without restarting.";
+
+    alpha: f64 = 0.7;
+    check |a| limits::alpha(*a).map(drop);
+    flag "alpha", label "Alpha", default "0.7", unit "",
+    renderers PPM, live true, widget Widget::Slider { min: 0.05, max: 1.0, log: false, step: 0.0 };
+    help "The radius reduction α in (0, 1]: the fraction of a pass's new photons an estimate keeps (Hachisuka et al. 2008, who use 0.7); the radius shrinks faster when it is smaller. Applies from the next pass, without restarting (with the global radius schedule, it restarts).";
+
+    initial_radius: Option<f64> = None;
+    check |r| r.map_or(Ok(()), |r| limits::radius(r).map(drop));
+    flag "radius", label "Initial radius", default "automatic", unit "scene units",
+    renderers PPM, live false, widget Widget::Auto { automatic: "Automatic initial radius", min: 1e-5, max: 0.2, scene_length: true, manual: 0.0 };
+    help "The search radius photons are gathered over at first, in scene units. Automatic: twice one pixel's footprint at the median distance of the visible points.";
+
+    indirect_radius_scale: Option<f64> = None;
+    check |k| k.map_or(Ok(()), |k| limits::radius_scale(k).map(drop));
+    flag "indirect-radius-scale", label "Indirect radius ×", default "automatic", unit "× initial radius",
+    renderers PPM, live false, widget Widget::Auto { automatic: "Automatic indirect radius", min: 1.0, max: 16.0, scene_length: false, manual: 2.0 };
+    help "The initial radius of the estimate of photons that have bounced off a diffuse surface (indirect light), as a multiple of the initial radius; direct light and caustics keep the narrow radius. Indirect light varies slowly, so where photons are sparse a wider radius gathers many more of them for little blur. Automatic: chosen after the first pass so that a pass hands each point about 32 indirect photons, between 1 and 4 (small closed rooms with dense photons keep 1, sparse scenes widen). 1: one estimate for all photons, as in the paper (1 to 100).";
+
+    adaptive_radius: bool = true;
+    check any;
+    flag "adaptive-radius", label "Adaptive radius", default "true", unit "",
+    renderers PPM, live false, widget Widget::Checkbox;
+    help "After the first pass (gathered over twice the initial radius), a point handed more than 64 photons within the initial radius (the inside of a caustic; all light when one estimate is kept) restarts that estimate with the radius that would have handed it about 64, at most 4× narrower, and a point handed fewer than 2, with no pixel within two of its own handed 4 or more, with the radius that would have handed it 2, at most 2× wider and no wider than the indirect estimate's (not at all with one estimate); the first pass's photons no longer count. Sharp light is then not blurred by the initial radius for dozens of passes, and light spread thin is less noisy. Off: every point starts at the initial radius, as in the paper.";
+
+    direct_light: bool = true;
+    check any;
+    flag "direct-light", label "Direct light by light sampling", default "true", unit "",
+    renderers PPM, live false, widget Widget::Checkbox;
+    help "Direct light by light sampling at the visible points (point and spot lights exactly by shadow rays, spheres and quads one stratified sample per pass); photons then count only after their first bounce and carry caustics and indirect light. Off: photons carry all the light (classic PPM).";
+
+    guided_emission: bool = true;
+    check any;
+    flag "guided-emission", label "Photons where the camera looks", default "true", unit "",
+    renderers PPM, live false, widget Widget::Checkbox;
+    help "Photons are sent where the camera looks: each light learns, pass by pass, which of its emission directions lead photons to a visible point and emits mostly there, with weights that keep the image the same. A pass then traces the photons per pass divided by how many times more photons arrive than unguided (that gain at most 64×), so it lands as many useful photons without the lost ones, and from the 33rd pass on divided by the gain's square root, landing more useful photons in fewer, fuller passes; a light whose map would gain less than 1.5× (a closed room) keeps emitting uniformly. Off: lights emit as they shine.";
+
+    stratified_eye_rays: bool = true;
+    check any;
+    flag "stratified-eye-rays", label "Stratified eye rays", default "true", unit "",
+    renderers PPM, live false, widget Widget::Checkbox;
+    help "When eye rays are jittered (anti-aliasing, depth of field), each pixel's rays are placed over passes by low-discrepancy sequences (Sobol's (0,2)-sequence over the pixel, R4 over the lens, each randomised per pixel) instead of independently at random, so the outlines of bright lights, their reflections and the lens blur settle sooner. Off: independent random jitter.";
+
+    stratified_photons: bool = true;
+    check any;
+    flag "stratified-photons", label "Stratified photons", default "true", unit "",
+    renderers PPM, live false, widget Widget::Checkbox;
+    help "The two numbers that choose each photon's direction come from Sobol's (0,2)-sequence over the render's photons (photon n takes point n, digitally shifted by a value drawn from the seed; with several lights its first number also picks the light, rescaled within that light's share so that every light's photons stay stratified) instead of independently at random, so each pass's photons cover the light's directions evenly and caustics are less noisy (quasi-Monte Carlo photon mapping, Keller, Grünschloß & Droske 2012). Off: independent random directions.";
+
+    supersample_light_seen: bool = true;
+    check any;
+    flag "supersample-light-seen", label "Supersampled lamp outlines", default "true", unit "",
+    renderers PPM, live false, widget Widget::Checkbox;
+    help "When eye rays are jittered: where the light a pixel sees directly (emission seen directly or through mirrors and glass, point and spot lights at its visible point) changes within the pixel by more than 8× the image's mean (a lamp's outline, its images), the pixel traces 16 more eye rays a pass that look only for that light; after 8 passes, the pixels whose light seen varied most between them (more than 8× the image's mean variance: a texture's or a shadow's edge, a floor seen through glass) trace 4 more; at most a quarter more eye rays in all. An outline then settles about 16 times sooner. A chosen pixel's light seen counts only the passes after it was chosen, so the image converges to the same result. Off: one eye ray per pixel a pass.";
+
+    radius_schedule: RadiusSchedule = RadiusSchedule::PerPoint;
+    check any;
+    flag "radius-schedule", label "Radius", default "\"per_point\"", unit "",
+    renderers PPM, live false, widget Widget::Choice;
+    help "How the search radius shrinks pass by pass: \"per_point\" (each point's own statistics, Hachisuka et al. 2008) or \"global\" (every pass an independent estimate at the radius of one schedule, Knaus & Zwicker 2011: passes can be rendered on many machines and merged, see README \"Rendering on a cluster\"; α, the initial radii and the emission guide are then fixed by a pilot pass, and changing α restarts).";
+
+    index: IndexKind = IndexKind::HashGrid;
+    check any;
+    flag "index", label "Index", default "\"grid\"", unit "",
+    renderers PPM, live false, widget Widget::Choice;
+    help "The spatial index over visible points that photons look up: \"grid\" (a hashed uniform grid) or \"kd\" (the seed report's kd-tree). The image is the same; the speed differs.";
+
+    max_depth: u32 = 8;
+    check |d| limits::max_depth(*d).map(drop);
+    flag "max-depth", label "Max depth", default "8", unit "bounces",
+    renderers RendererKind::ALL, live false, widget Widget::Slider { min: 1.0, max: 64.0, log: false, step: 1.0 };
+    help "Most mirror and glass bounces followed by eye rays and photons (1 to 64).";
+
+    seed: u64 = 1;
+    check |s| limits::seed(*s).map(drop);
+    flag "seed", label "Seed", default "1", unit "",
+    renderers RendererKind::ALL, live false, widget Widget::Hidden;
+    help "The seed of every random number: the same seed gives the same image, whatever the thread count (0 to 9223372036854775807: TOML's integers are signed 64-bit).";
+
+    antialias: bool = true;
+    check any;
+    flag "antialias", label "Anti-aliasing", default "true", unit "",
+    renderers &[RendererKind::Whitted, RendererKind::Ppm], live false, widget Widget::Checkbox;
+    help "The ray tracer's edge-adaptive supersampling; photon mapping jitters each pixel's eye rays, tracing a new eye pass every pass (stochastic PPM). The path tracer always jitters.";
+
+    dof_samples: u32 = 16;
+    check |n| limits::samples(*n).map(drop);
+    flag "dof-samples", label "Lens samples", default "16", unit "samples a pixel",
+    renderers WHITTED, live false, widget Widget::Slider { min: 1.0, max: 256.0, log: true, step: 1.0 };
+    help "The ray tracer's lens samples per pixel when the aperture is open (1 to 4096).";
+
+    light_samples: u32 = 16;
+    check |n| limits::samples(*n).map(drop);
+    flag "light-samples", label "Light samples", default "16", unit "samples a point",
+    renderers WHITTED, live false, widget Widget::Slider { min: 1.0, max: 256.0, log: true, step: 1.0 };
+    help "The ray tracer's shadow samples per area light per shading point (1 to 4096).";
+
+    ambient: DVec3 = DVec3::ZERO;
+    check |a| ambient(*a);
+    flag "ambient", label "Ambient", default "[0, 0, 0]", unit "radiance",
+    renderers WHITTED, live false, widget Widget::Hidden;
+    help "Ambient radiance the ray tracer adds at diffuse surfaces (finite, not negative, at most 1e18).";
+}
+
+/// The ambient radiance's check.
+fn ambient(a: DVec3) -> Result<(), limits::Invalid> {
+    if !(a.is_finite() && a.cmpge(DVec3::ZERO).all()) {
+        return Err(format!("must be finite and not negative, got {a}"));
     }
+    limits::radiance(a.max_element()).map(drop)
 }
 
 /// A parameter out of its range: the field's name (as the scene file spells it) and what is
@@ -146,56 +272,17 @@ pub struct InvalidParam {
 }
 
 impl RenderParams {
-    /// Checks every value against [`super::limits`]; the first one out of range is named.
-    pub fn validate(&self) -> Result<(), InvalidParam> {
-        let check = |field: &'static str, result: Result<(), limits::Invalid>| {
-            result.map_err(|problem| InvalidParam { field, problem })
-        };
-        check("alpha", limits::alpha(self.alpha).map(drop))?;
-        check(
-            "photons_per_pass",
-            limits::photons_per_pass(self.photons_per_pass).map(drop),
-        )?;
-        check(
-            "min_photons_per_pixel",
-            limits::photons_per_pixel(self.min_photons_per_pixel).map(drop),
-        )?;
-        if let Some(r) = self.initial_radius {
-            check("initial_radius", limits::radius(r).map(drop))?;
-        }
-        if let Some(k) = self.indirect_radius_scale {
-            check("indirect_radius_scale", limits::radius_scale(k).map(drop))?;
-        }
-        check("max_depth", limits::max_depth(self.max_depth).map(drop))?;
-        check("seed", limits::seed(self.seed).map(drop))?;
-        check("dof_samples", limits::samples(self.dof_samples).map(drop))?;
-        check("light_samples", limits::samples(self.light_samples).map(drop))?;
-        let ambient = self.ambient;
-        if !(ambient.is_finite() && ambient.cmpge(DVec3::ZERO).all()) {
-            check(
-                "ambient",
-                Err(format!("must be finite and not negative, got {ambient}")),
-            )?;
-        }
-        check("ambient", limits::radiance(ambient.max_element()).map(drop))?;
-        Ok(())
-    }
-
     /// Whether going from `old` to these values discards the accumulated image: every change
-    /// does except α and the photon counts, which apply from the next pass (with the global
-    /// radius schedule α and the photon counts restart too: every pass must follow one
+    /// does but those of the live settings (α and the photon counts), which apply from the next
+    /// pass (with the global radius schedule they restart too: every pass must follow one
     /// schedule).
     pub fn restarts_from(&self, old: &RenderParams) -> bool {
         if self.radius_schedule == RadiusSchedule::Global || old.radius_schedule == RadiusSchedule::Global {
             return self != old;
         }
-        let kept = RenderParams {
-            alpha: old.alpha,
-            photons_per_pass: old.photons_per_pass,
-            min_photons_per_pixel: old.min_photons_per_pixel,
-            ..self.clone()
-        };
-        kept != *old
+        SETTINGS
+            .iter()
+            .any(|s| !s.live && self.get(s.key) != old.get(s.key))
     }
 
     /// Photons of a full pass over `pixels` pixels: `photons_per_pass`, raised to

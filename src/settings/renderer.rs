@@ -1,6 +1,6 @@
-//! Which renderer makes the image ([`RendererKind`]): made from the one list of renderers in
-//! `src/render/integrator/renderers.rs`, so the scene format, the command line (`--renderer`) and the viewer's
-//! buttons all come from it.
+//! Which renderer makes the image ([`RendererKind`]): made from the one list of renderers
+//! ([`with_renderers`], here, in the lowest layer), so the scene format, the command line
+//! (`--renderer`), the viewer's buttons and the render layer's integrators all come from it.
 
 use serde::{Deserialize, Serialize};
 
@@ -21,6 +21,10 @@ macro_rules! renderers {
         impl RendererKind {
             /// Every renderer, in the list's order.
             pub const ALL: &'static [RendererKind] = &[$(RendererKind::$variant),*];
+
+            /// Every renderer's name, label and description, in the list's order.
+            pub const CHOICES: &'static [(&'static str, &'static str, &'static str)] =
+                &[$(($name, $label, $about)),*];
 
             /// The name in scene files and on the command line.
             pub fn name(self) -> &'static str {
@@ -55,7 +59,26 @@ macro_rules! renderers {
     (@progressive single) => { false };
 }
 
-include!("../render/integrator/renderers.rs");
+/// The renderers, one line each: the variant of [`RendererKind`], its name in scene files and
+/// on the command line, its label and tooltip in the viewer, whether it renders passes
+/// without end (`progressive`) or one frame per epoch (`single`), and its integrator: a file in
+/// `src/render/integrator/` and the type there that implements `Integrator`.
+///
+/// The list is handed to the macro `$callback`: this module makes `RendererKind` from its
+/// first five columns, and `render::integrator` declares the modules and makes each kind's
+/// integrator. A new renderer is its file there plus one line here.
+macro_rules! with_renderers {
+    ($callback:ident) => {
+        $callback! {
+            Whitted, "whitted", "Ray tracer", "Whitted ray tracer: one fast frame, direct light, mirrors and glass only", single, ray_tracer::RayTracer;
+            Ppm, "ppm", "Photon mapping", "Progressive photon mapping: converges to caustics and indirect light", progressive, photon_mapping::PhotonMapping;
+            Path, "path", "Path tracer", "Unidirectional path tracer with light sampling and MIS: an unbiased cross-check of photon mapping", progressive, path::PathTracer;
+        }
+    };
+}
+pub(crate) use with_renderers;
+
+with_renderers!(renderers);
 
 impl RendererKind {
     /// The kind named `name`.

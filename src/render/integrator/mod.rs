@@ -2,10 +2,11 @@
 //! renders a pass at a time and describes its own image and statistics ([`Frame`],
 //! [`FrameStats`]). The session, the command line and the viewer talk to it through this
 //! interface only; which renderers exist, and whether each renders pass after pass or one
-//! frame per epoch, comes from the one list in `src/render/integrator/renderers.rs` ([`RendererKind`]).
+//! frame per epoch, comes from the one list of renderers in `src/settings/renderer.rs`
+//! ([`RendererKind`]).
 //!
 //! A new renderer is a file here with a type that implements [`Integrator`] and has
-//! `fn new(scene: &Scene, setup: &Setup) -> Self`, plus its line in `src/render/integrator/renderers.rs`.
+//! `fn new(scene: &Scene, setup: &Setup) -> Self`, plus its line in that list.
 
 use crate::render::frame::Frame;
 use crate::render::ppm::{Control, Interrupt, PpmOptions, WarmStart};
@@ -109,7 +110,7 @@ macro_rules! renderers {
     };
 }
 
-include!("renderers.rs");
+crate::settings::with_renderers!(renderers);
 
 #[cfg(test)]
 mod tests {
