@@ -279,7 +279,7 @@ fn next_frame(session: &RenderSession, timeout: Duration) -> Frame {
 fn session_epochs_follow_the_rules_and_never_block() {
     let scene = cornell_small(0.0);
     let lens = cornell_small(0.1);
-    let session = RenderSession::start(scene, PpmOptions::default(), None);
+    let session = RenderSession::start(scene, None);
     let first = next_frame(&session, Duration::from_secs(60));
     assert_eq!(first.epoch, 0);
     // Nobody reads for a while: the renderer keeps going and the channel holds the newest.
@@ -340,7 +340,7 @@ fn session_switches_to_the_ray_tracer_and_reports_a_panic() {
             panic!("boom");
         }
     });
-    let session = RenderSession::start(scene, PpmOptions::default(), Some(waker));
+    let session = RenderSession::start(scene, Some(waker));
     assert_eq!(
         next_frame(&session, Duration::from_secs(60)).stats.renderer(),
         caustic::scene::RendererKind::Ppm
@@ -444,7 +444,7 @@ fn a_new_epoch_starts_with_a_full_size_preview() {
 fn pause_and_resume_lose_nothing() {
     let scene = cornell_small(0.0);
     let reference_scene = scene.clone();
-    let session = RenderSession::start(scene, PpmOptions::default(), None);
+    let session = RenderSession::start(scene, None);
     session.send(Command::Pause);
     std::thread::sleep(Duration::from_millis(300));
     session.send(Command::Resume);

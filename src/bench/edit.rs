@@ -50,7 +50,7 @@ pub fn measure_edit(scene: Scene, plan: &EditPlan, reference: &[[f32; 3]]) -> Re
         every_frame: true,
         ..SessionOptions::interactive()
     };
-    options.ppm.warm_restarts = plan.warm;
+    options.warm_restarts = plan.warm;
     let session = RenderSession::start_with(scene, options, None);
     let frames = session.frames();
     let mut edited_at: Option<Instant> = None;

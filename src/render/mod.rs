@@ -5,6 +5,7 @@
 //! independent passes split across processes and merged ([`shard`]).
 
 pub mod compare;
+pub mod control;
 pub mod error;
 pub mod film;
 pub mod frame;

@@ -8,18 +8,35 @@
 //! A new renderer is a file here with a type that implements [`Integrator`] and has
 //! `fn new(scene: &Scene, setup: &Setup) -> Self`, plus its line in that list.
 
+pub use crate::render::control::{Control, Interrupt};
 use crate::render::frame::Frame;
-use crate::render::ppm::{Control, Interrupt, PpmOptions, WarmStart};
 use crate::scene::Scene;
 use crate::settings::{RenderParams, RendererKind};
 
+/// Work between two looks at the caller's [`Control`] when nobody asks for less: photons, for
+/// photon mapping (a batch: [`crate::render::ppm::DEFAULT_BATCH_PHOTONS`]).
+pub const DEFAULT_BATCH: u64 = crate::render::ppm::DEFAULT_BATCH_PHOTONS;
+
 /// How an integrator is set up, beyond the scene's own settings.
-#[derive(Clone, Default)]
+#[derive(Clone)]
 pub struct Setup {
-    /// Photon-mapping options (batch size, forced stochastic eye passes).
-    pub ppm: PpmOptions,
+    /// Work between two looks at the caller's [`Control`] (photons for photon mapping): small
+    /// batches let a viewer react sooner; the image does not depend on it.
+    pub batch: u64,
+    /// Keep what a warm restart needs ([`Integrator::warm_restart`]).
+    pub warm_restarts: bool,
     /// Asked often during a pass; returning true abandons it.
     pub interrupt: Option<Interrupt>,
+}
+
+impl Default for Setup {
+    fn default() -> Self {
+        Self {
+            batch: DEFAULT_BATCH,
+            warm_restarts: false,
+            interrupt: None,
+        }
+    }
 }
 
 impl Setup {
@@ -70,13 +87,15 @@ pub fn photon_ramp(first: Option<u64>, completed: u32, full: u64) -> u64 {
 /// A renderer: one pass at a time, its image and statistics on request.
 pub trait Integrator: Send {
     /// Renders the next pass of `scene` as `plan` says. `control` is asked between batches of
-    /// work, with the α the pass uses (which it may change); [`Control::Abort`] abandons the
-    /// pass. Returns whether the pass completed (an abandoned pass leaves no trace).
+    /// work, with the render settings as the pass began, which it brings up to date: a live
+    /// setting changed since (α, for photon mapping) applies from there on, for a renderer that
+    /// reads it. [`Control::Abort`] abandons the pass. Returns whether the pass completed (an
+    /// abandoned pass leaves no trace).
     fn render_pass(
         &mut self,
         scene: &Scene,
         plan: &PassPlan,
-        control: &mut dyn FnMut(&mut f64) -> Control,
+        control: &mut dyn FnMut(&mut RenderParams) -> Control,
     ) -> bool;
 
     /// Completed passes.
@@ -85,15 +104,13 @@ pub trait Integrator: Send {
     /// The image so far as a frame of `epoch`, `elapsed_secs` into it.
     fn frame(&self, epoch: u64, elapsed_secs: f64) -> Frame;
 
-    /// What the next epoch may keep after an edit of the scene (a warm restart, see
-    /// [`crate::render::ppm::warm`]); `None` (the default) when the renderer keeps nothing.
-    fn into_warm_start(self: Box<Self>) -> Option<WarmStart> {
-        None
+    /// The renderer of the next epoch, after an edit of the scene alone (`scene` as edited): a
+    /// renderer that can carry what it learned over the edit (photon mapping's warm restart,
+    /// [`crate::render::ppm::warm`]) makes its successor from itself; by default a new one
+    /// starts from nothing.
+    fn warm_restart(self: Box<Self>, scene: &Scene, setup: &Setup) -> Box<dyn Integrator> {
+        make(scene.params.renderer, scene, setup)
     }
-
-    /// Starts this new epoch of the edited `scene` from what the previous one kept (ignored
-    /// by default).
-    fn inherit(&mut self, _scene: &Scene, _warm: WarmStart) {}
 }
 
 /// Declares each renderer's module and makes the integrator of a kind, from the list.

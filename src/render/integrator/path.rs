@@ -27,7 +27,7 @@ use rayon::prelude::*;
 use super::{Integrator, PassPlan, Setup};
 use crate::geometry::{Hit, Ray};
 use crate::render::frame::{Frame, FrameStats, StatRow};
-use crate::render::ppm::Control;
+use super::Control;
 use crate::render::provenance;
 use crate::render::rng::stream_rng;
 use crate::render::sequence;
@@ -266,7 +266,7 @@ impl PathTracer {
 }
 
 impl Integrator for PathTracer {
-    fn render_pass(&mut self, scene: &Scene, plan: &PassPlan, control: &mut dyn FnMut(&mut f64) -> Control) -> bool {
+    fn render_pass(&mut self, scene: &Scene, plan: &PassPlan, control: &mut dyn FnMut(&mut crate::settings::RenderParams) -> Control) -> bool {
         let start = Instant::now();
         let width = self.size.0 as usize;
         let pass = self.stats.passes as u64;
@@ -278,9 +278,10 @@ impl Integrator for PathTracer {
         }
         let mut samples = vec![DVec3::ZERO; self.sums.len()];
         let (mut segments, mut shadow_rays) = (0, 0);
-        let mut alpha = plan.params.alpha;
+        // The path tracer has no live setting: the settings it gets back are left alone.
+        let mut live = plan.params.clone();
         for (batch, rows) in samples.chunks_mut(BATCH_ROWS * width).enumerate() {
-            if control(&mut alpha) == Control::Abort || self.setup.interrupted() {
+            if control(&mut live) == Control::Abort || self.setup.interrupted() {
                 return false;
             }
             let first = (batch * BATCH_ROWS * width) as u64;

@@ -1,9 +1,9 @@
 //! Progressive photon mapping ([`crate::render::ppm`]) as an integrator: a pass at a time, α
 //! and the photon counts taken from each pass's plan.
 
-use super::{Integrator, PassPlan, Setup};
+use super::{Control, Integrator, PassPlan, Setup};
 use crate::render::frame::{Frame, FrameStats, StatRow};
-use crate::render::ppm::{Control, PassOutcome, Ppm, PpmStats};
+use crate::render::ppm::{PassOutcome, Ppm, PpmOptions, PpmStats};
 use crate::render::provenance;
 use crate::scene::Scene;
 use crate::settings::RendererKind;
@@ -17,7 +17,12 @@ pub struct PhotonMapping {
 impl PhotonMapping {
     /// A new render of `scene`.
     pub fn new(scene: &Scene, setup: &Setup) -> Self {
-        let mut ppm = Ppm::new(scene, setup.ppm);
+        let options = PpmOptions {
+            batch_photons: setup.batch,
+            warm_restarts: setup.warm_restarts,
+            ..Default::default()
+        };
+        let mut ppm = Ppm::new(scene, options);
         ppm.set_interrupt(setup.interrupt.clone());
         Self {
             ppm,
@@ -27,7 +32,12 @@ impl PhotonMapping {
 }
 
 impl Integrator for PhotonMapping {
-    fn render_pass(&mut self, scene: &Scene, plan: &PassPlan, control: &mut dyn FnMut(&mut f64) -> Control) -> bool {
+    fn render_pass(
+        &mut self,
+        scene: &Scene,
+        plan: &PassPlan,
+        control: &mut dyn FnMut(&mut crate::settings::RenderParams) -> Control,
+    ) -> bool {
         let ppm = &mut self.ppm;
         ppm.alpha = plan.params.alpha;
         let (w, h) = ppm.size();
@@ -40,19 +50,26 @@ impl Integrator for PhotonMapping {
         } else {
             plan.pass_photons(ppm.stats().passes, full, ppm.is_warm())
         };
-        ppm.run_pass(scene, control) == PassOutcome::Completed
+        // Between batches the settings come up to date; α is the one photon mapping reads.
+        let mut live = plan.params.clone();
+        let mut between_batches = |alpha: &mut f64| {
+            let go_on = control(&mut live);
+            *alpha = live.alpha;
+            go_on
+        };
+        ppm.run_pass(scene, &mut between_batches) == PassOutcome::Completed
     }
 
     fn passes(&self) -> u32 {
         self.ppm.stats().passes
     }
 
-    fn into_warm_start(self: Box<Self>) -> Option<crate::render::ppm::WarmStart> {
-        self.ppm.into_warm_start()
-    }
-
-    fn inherit(&mut self, scene: &Scene, warm: crate::render::ppm::WarmStart) {
-        self.ppm.inherit(scene, warm);
+    fn warm_restart(self: Box<Self>, scene: &Scene, setup: &Setup) -> Box<dyn Integrator> {
+        let mut next = PhotonMapping::new(scene, setup);
+        if let Some(kept) = self.ppm.into_warm_start() {
+            next.ppm.inherit(scene, kept);
+        }
+        Box::new(next)
     }
 
     fn frame(&self, epoch: u64, elapsed_secs: f64) -> Frame {

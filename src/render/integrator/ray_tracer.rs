@@ -2,7 +2,7 @@
 
 use super::{Integrator, PassPlan, Setup};
 use crate::render::frame::{Frame, FrameStats, StatRow};
-use crate::render::ppm::Control;
+use super::Control;
 use crate::render::whitted::{render_whitted_until, WhittedStats};
 use crate::scene::Scene;
 use crate::settings::RendererKind;
@@ -52,7 +52,7 @@ pub fn frame_stats(stats: &WhittedStats) -> FrameStats {
 }
 
 impl Integrator for RayTracer {
-    fn render_pass(&mut self, scene: &Scene, _plan: &PassPlan, _control: &mut dyn FnMut(&mut f64) -> Control) -> bool {
+    fn render_pass(&mut self, scene: &Scene, _plan: &PassPlan, _control: &mut dyn FnMut(&mut crate::settings::RenderParams) -> Control) -> bool {
         let setup = &self.setup;
         match render_whitted_until(scene, &|_| {}, &|| setup.interrupted()) {
             Some(traced) => {

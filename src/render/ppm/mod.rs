@@ -57,6 +57,7 @@ pub use hash_grid::HashGrid;
 pub use kd_tree::KdTree;
 use points::VisiblePoints;
 
+pub use crate::render::control::{Control, Interrupt};
 use crate::render::rng::stream_rng;
 use crate::render::shard::PassSums;
 use crate::scene::Scene;
@@ -118,16 +119,6 @@ pub enum PassOutcome {
     Completed,
     /// Abandoned between two batches at the caller's request; nothing of it was kept.
     Aborted,
-}
-
-/// What the caller wants between two photon batches (it may also change α, which the
-/// callback receives by reference and which applies to this pass's update).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Control {
-    /// Go on.
-    Continue,
-    /// Drop this pass.
-    Abort,
 }
 
 /// A progressive photon mapping render in progress.
@@ -258,10 +249,6 @@ pub struct PixelLayers {
     /// Photons the pixel's slots gathered, both estimates (`N`, after the shrinking).
     pub gathered: Arc<[f32]>,
 }
-
-/// Asked often during a pass (from any thread); returning true abandons the pass. The render
-/// session sets one that turns true when a restart is waiting.
-pub type Interrupt = Arc<dyn Fn() -> bool + Send + Sync>;
 
 impl Ppm {
     /// A new render of `scene`; its render parameters give α, photons per pass, radius, seed,

@@ -49,8 +49,9 @@ pub(super) fn preview(
         },
         first_pass_photons: None,
     };
-    let completed =
-        integrator.render_pass(scene, &small_plan, &mut |_| crate::render::ppm::Control::Continue);
+    let completed = integrator.render_pass(scene, &small_plan, &mut |_| {
+        crate::render::control::Control::Continue
+    });
     (scene.camera.width, scene.camera.height) = (w, h);
     if !completed {
         return None;
@@ -66,7 +67,7 @@ pub(super) fn pass(
     scene: &Scene,
     plan: &PassPlan,
     step: Step,
-    control: &mut dyn FnMut(&mut f64) -> crate::render::ppm::Control,
+    control: &mut dyn FnMut(&mut crate::settings::RenderParams) -> crate::render::control::Control,
 ) -> Option<Frame> {
     integrator
         .render_pass(scene, plan, control)

@@ -4,15 +4,18 @@
 use std::time::Duration;
 
 use super::command::{apply_to_scene, valid, Command};
-use crate::render::ppm::PpmOptions;
 use crate::scene::Scene;
 use crate::settings::RenderParams;
 
 /// How a session renders, beyond the scene's own settings.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SessionOptions {
-    /// Photon-mapping options (index, direct light, batch size).
-    pub ppm: PpmOptions,
+    /// Work between two looks at the command channel (photons, for photon mapping): small
+    /// batches let a viewer's change apply sooner; the image does not depend on it.
+    pub batch: u64,
+    /// Renderers keep what a warm restart after an edit of the scene needs
+    /// ([`crate::render::integrator::Integrator::warm_restart`]).
+    pub warm_restarts: bool,
     /// Photons in the first pass of every epoch, doubling pass by pass up to the photons per
     /// pass (`None`: full passes from the start). A viewer uses it to show a new epoch's first
     /// image sooner; PPM weighs every photon alike, so only the pass boundaries move.
@@ -45,17 +48,32 @@ pub const INTERACTIVE_FIRST_PASS_PHOTONS: u64 = 16_384;
 /// A new cold interactive epoch first shows a preview at this fraction of the resolution.
 pub const INTERACTIVE_PREVIEW_DIVISOR: u32 = 4;
 
+impl Default for SessionOptions {
+    /// Batches of the integrators' default size, no warm restarts, full passes from the start,
+    /// no preview, no limits.
+    fn default() -> Self {
+        Self {
+            batch: crate::render::integrator::DEFAULT_BATCH,
+            warm_restarts: false,
+            first_pass_photons: None,
+            start_paused: false,
+            preview_divisor: None,
+            max_passes: None,
+            time_limit: None,
+            every_frame: false,
+            threads: None,
+        }
+    }
+}
+
 impl SessionOptions {
     /// The viewer's options (and `bench edit`'s, which measures what the viewer shows): small
     /// batches, a photon ramp, a low-resolution preview of a cold epoch, and warm restarts
     /// after edits.
     pub fn interactive() -> Self {
         SessionOptions {
-            ppm: PpmOptions {
-                batch_photons: INTERACTIVE_BATCH_PHOTONS,
-                warm_restarts: true,
-                ..Default::default()
-            },
+            batch: INTERACTIVE_BATCH_PHOTONS,
+            warm_restarts: true,
             first_pass_photons: Some(INTERACTIVE_FIRST_PASS_PHOTONS),
             preview_divisor: Some(INTERACTIVE_PREVIEW_DIVISOR),
             ..Default::default()
@@ -211,11 +229,11 @@ impl SessionState {
     }
 
     /// Opens a new epoch: the gathered commands are applied to `scene`. Returns whether the
-    /// epoch starts warm ([`PpmOptions::warm_restarts`] and only the scene was edited); a
+    /// epoch starts warm ([`SessionOptions::warm_restarts`] and only the scene was edited); a
     /// warm epoch has no preview.
     pub fn restart(&mut self, scene: &mut Scene) -> bool {
         apply_to_scene(scene, std::mem::take(&mut self.pending));
-        let warm = self.options.ppm.warm_restarts && !self.cold_due;
+        let warm = self.options.warm_restarts && !self.cold_due;
         self.restart_due = false;
         self.cold_due = false;
         scene.params = self.params.clone();

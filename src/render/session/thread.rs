@@ -13,9 +13,9 @@ use crossbeam_channel::{bounded, unbounded, Receiver, Sender, TryRecvError};
 use super::command::Command;
 use super::integrator::{pass, plan, preview, Step};
 use super::state::{Next, SessionOptions, SessionState};
+use crate::render::control::{Control, Interrupt};
 use crate::render::frame::Frame;
 use crate::render::integrator::{make, Setup};
-use crate::render::ppm::{Control, Interrupt, PpmOptions};
 use crate::scene::Scene;
 use crate::settings::RenderParams;
 
@@ -36,16 +36,9 @@ pub type Waker = Box<dyn Fn() + Send + Sync>;
 
 impl RenderSession {
     /// Starts rendering `scene` on a new thread (named `caustic-render`), in the global rayon
-    /// pool, with full photon passes from the start.
-    pub fn start(scene: Scene, options: PpmOptions, waker: Option<Waker>) -> Self {
-        Self::start_with(
-            scene,
-            SessionOptions {
-                ppm: options,
-                ..Default::default()
-            },
-            waker,
-        )
+    /// pool, with the default options: full passes from the start, no limits.
+    pub fn start(scene: Scene, waker: Option<Waker>) -> Self {
+        Self::start_with(scene, SessionOptions::default(), waker)
     }
 
     /// Starts rendering `scene` with session options (see [`SessionOptions`]).
@@ -205,7 +198,8 @@ fn run(
         Arc::new(move || flag.load(Ordering::Acquire))
     };
     let setup = Setup {
-        ppm: options.ppm,
+        batch: options.batch,
+        warm_restarts: options.warm_restarts,
         interrupt: Some(interrupted),
     };
     let mut state = SessionState::new(&scene, options);
@@ -227,11 +221,12 @@ fn run(
             Next::Wait => None,
             Next::Restart => {
                 let warm = state.restart(&mut scene);
-                let previous =
-                    std::mem::replace(&mut integrator, make(scene.params.renderer, &scene, &setup));
-                if let Some(kept) = warm.then(|| previous.into_warm_start()).flatten() {
-                    integrator.inherit(&scene, kept);
-                }
+                integrator = if warm {
+                    integrator.warm_restart(&scene, &setup)
+                } else {
+                    drop(integrator);
+                    make(scene.params.renderer, &scene, &setup)
+                };
                 epoch_start = Instant::now();
                 None
             }
@@ -243,10 +238,10 @@ fn run(
             Next::Pass | Next::Trace => {
                 // Between batches: commands apply (α among them); a restart or the end
                 // drops the pass.
-                let mut control = |alpha: &mut f64| {
+                let mut control = |live: &mut crate::settings::RenderParams| {
                     interrupt.store(false, Ordering::Release);
                     drain(&mut state, &commands);
-                    *alpha = state.params.alpha;
+                    live.clone_from(&state.params);
                     if state.must_abort() {
                         Control::Abort
                     } else {
