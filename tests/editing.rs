@@ -48,8 +48,7 @@ fn flat_frame() -> Frame {
         width: SIZE.0,
         height: SIZE.1,
         radiance: vec![[0.2f32; 3]; n].into(),
-        radius: vec![0.0f32; n].into(),
-        gathered: vec![0.0f32; n].into(),
+        layers: Vec::new(),
         preview: false,
     }
 }

@@ -488,7 +488,7 @@ fn settings_survive_storage_and_bad_stored_values_are_repaired() {
     let settings = ViewerSettings {
         exposure_stops: 1.5,
         zoom: Zoom::Scale(2.0),
-        display: DisplayMode::Radius,
+        display: DisplayMode::Layer(0),
         show_side_panel: false,
         last_directory: Some(PathBuf::from("/some/where")),
         show_wireframe: false,

@@ -157,7 +157,9 @@ fn the_session_restarts_warm_after_an_edit_and_cold_after_a_setting() {
             break f;
         }
     };
-    let kept = first.stats.ppm.as_ref().map_or(0.0, |p| p.kept_share);
+    let kept = first.stats.json["photon_mapping"]["kept_share"]
+        .as_f64()
+        .unwrap_or(0.0);
     assert!(
         !first.preview,
         "a warm epoch opens with a full pass, not a preview"
@@ -175,6 +177,6 @@ fn the_session_restarts_warm_after_an_edit_and_cold_after_a_setting() {
     };
     assert!(first.preview, "a cold epoch opens with the preview");
     let f = next_frame(&session);
-    assert_eq!(f.stats.ppm.as_ref().map(|p| p.kept_share), Some(0.0));
+    assert_eq!(f.stats.json["photon_mapping"]["kept_share"].as_f64(), Some(0.0));
     session.shutdown();
 }

@@ -161,15 +161,16 @@ fn view_menu_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Action>) 
     }
     ui.separator();
     let mut display = viewer.settings.display;
-    for mode in DisplayMode::ALL {
+    let layers = viewer.layer_labels();
+    for mode in DisplayMode::all(&layers) {
         let enabled = viewer.reference().is_some() || !mode.needs_reference();
         let hover = if enabled {
-            "What the image shows; the probe always reports radiance, radius and photons (D cycles)"
+            "What the image shows; the probe always reports radiance and every layer (D cycles)"
         } else {
             "Open a reference image first (File > Open reference...)"
         };
         ui.add_enabled_ui(enabled, |ui| {
-            ui.radio_value(&mut display, mode, mode.label())
+            ui.radio_value(&mut display, mode, mode.label(&layers))
                 .on_hover_text(hover)
                 .on_disabled_hover_text(hover);
         });
@@ -216,13 +217,17 @@ pub fn status_ui(viewer: &ViewerState, ui: &mut egui::Ui) {
             .as_ref()
             .and_then(|p| Some((p, viewer.frame.as_ref()?.pixel(p.x, p.y)?)));
         match probed {
-            Some((p, ([r, g, b], radius, photons))) => {
+            Some((p, ([r, g, b], layers))) => {
+                let layers: String = layers
+                    .iter()
+                    .map(|(layer, v)| format!("  {} {v:.*}", layer.label, layer.decimals))
+                    .collect();
                 ui.monospace(format!(
-                    "({:4}, {:4})  RGB {:.4} {:.4} {:.4}  radius {radius:.4}  photons {photons:.0}",
+                    "({:4}, {:4})  RGB {:.4} {:.4} {:.4}{layers}",
                     p.x, p.y, r, g, b
                 ))
                 .on_hover_text(
-                    "Linear radiance, PPM search radius and accumulated photon count under the cursor",
+                    "Linear radiance and the renderer's per-pixel layers (photon mapping: search radius, photons) under the cursor",
                 );
             }
             None => {

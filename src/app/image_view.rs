@@ -90,10 +90,13 @@ pub fn display_bytes(
         let (bytes, legend) = difference_bytes(&frame.radiance, r, kind);
         return (bytes, Some(legend));
     }
-    let bytes = match mode {
-        DisplayMode::Radius => false_colour_image(&frame.radius),
-        DisplayMode::PhotonCount => false_colour_image(&frame.gathered),
-        _ => srgb8(&frame.radiance, exposure_stops),
+    let layer = match mode {
+        DisplayMode::Layer(k) => frame.layers.get(k as usize),
+        _ => None,
+    };
+    let bytes = match layer {
+        Some(layer) => false_colour_image(&layer.values),
+        None => srgb8(&frame.radiance, exposure_stops),
     };
     (bytes, None)
 }

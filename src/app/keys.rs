@@ -109,7 +109,7 @@ pub fn handle(viewer: &ViewerState, ctx: &egui::Context, out: &mut Vec<Action>) 
         out.push(Action::SetExposure(settings.exposure_stops + 0.5));
     }
     if pressed(Key::D) {
-        let modes: Vec<DisplayMode> = DisplayMode::ALL
+        let modes: Vec<DisplayMode> = DisplayMode::all(&viewer.layer_labels())
             .into_iter()
             .filter(|m| viewer.reference().is_some() || !m.needs_reference())
             .collect();

@@ -26,10 +26,9 @@ pub enum Zoom {
 pub enum DisplayMode {
     /// Radiance, exposure-scaled and sRGB-encoded.
     Radiance,
-    /// The PPM search radius per pixel in false colour (log scale).
-    Radius,
-    /// The accumulated photon count per pixel in false colour (log scale).
-    PhotonCount,
+    /// The frame's `k`-th per-pixel layer (photon mapping: search radius, photon count) in
+    /// false colour (log scale).
+    Layer(u8),
     /// `render − reference`, diverging false colour (needs a reference).
     SignedDifference,
     /// `|render − reference| / (reference + 0.01)`, false colour (needs a reference).
@@ -37,14 +36,14 @@ pub enum DisplayMode {
 }
 
 impl DisplayMode {
-    /// Every mode, in menu order.
-    pub const ALL: [DisplayMode; 5] = [
-        DisplayMode::Radiance,
-        DisplayMode::Radius,
-        DisplayMode::PhotonCount,
-        DisplayMode::SignedDifference,
-        DisplayMode::RelativeDifference,
-    ];
+    /// The modes for a frame of `layers` (labels), in menu order: radiance, each layer, the
+    /// differences to a reference.
+    pub fn all(layers: &[&str]) -> Vec<DisplayMode> {
+        let mut modes = vec![DisplayMode::Radiance];
+        modes.extend((0..layers.len().min(u8::MAX as usize)).map(|k| DisplayMode::Layer(k as u8)));
+        modes.extend([DisplayMode::SignedDifference, DisplayMode::RelativeDifference]);
+        modes
+    }
 
     /// Whether the mode compares with a reference (and so shows radiance without one).
     pub fn needs_reference(self) -> bool {
@@ -54,14 +53,16 @@ impl DisplayMode {
         )
     }
 
-    /// Name shown in menus.
-    pub fn label(self) -> &'static str {
+    /// Name shown in menus, for a frame of `layers` (labels).
+    pub fn label(self, layers: &[&str]) -> String {
         match self {
-            DisplayMode::Radiance => "Radiance (sRGB)",
-            DisplayMode::Radius => "Search radius (false colour)",
-            DisplayMode::PhotonCount => "Photon count (false colour)",
-            DisplayMode::SignedDifference => "Difference to reference (signed)",
-            DisplayMode::RelativeDifference => "Difference to reference (relative)",
+            DisplayMode::Radiance => "Radiance (sRGB)".into(),
+            DisplayMode::Layer(k) => format!(
+                "{} (false colour)",
+                layers.get(k as usize).copied().unwrap_or("layer")
+            ),
+            DisplayMode::SignedDifference => "Difference to reference (signed)".into(),
+            DisplayMode::RelativeDifference => "Difference to reference (relative)".into(),
         }
     }
 }

@@ -80,6 +80,13 @@ impl ViewerState {
         self.watching.as_ref()
     }
 
+    /// The labels of the shown frame's per-pixel layers (none before the first frame).
+    pub fn layer_labels(&self) -> Vec<&'static str> {
+        self.frame
+            .as_ref()
+            .map_or_else(Vec::new, |f| f.layers.iter().map(|l| l.label).collect())
+    }
+
     /// The pixel under the pointer when the image was last drawn (it may lie outside a frame
     /// that has since shrunk).
     pub fn probe(&self) -> Option<(u32, u32)> {

@@ -31,16 +31,14 @@ impl TevSend {
         let address = address.to_owned();
         self.job = Some(Job::spawn("caustic-tev", ctx, move || {
             let mut stream = TevStream::connect(&address, &name).map_err(|e| e.to_string())?;
-            let layers = [
-                Layer {
-                    name: "radius",
-                    values: &frame.radius,
-                },
-                Layer {
-                    name: "photons",
-                    values: &frame.gathered,
-                },
-            ];
+            let layers: Vec<Layer> = frame
+                .layers
+                .iter()
+                .map(|l| Layer {
+                    name: l.name,
+                    values: &l.values,
+                })
+                .collect();
             stream
                 .send(frame.width, frame.height, &frame.radiance, &layers)
                 .map_err(|e| e.to_string())?;

@@ -12,9 +12,7 @@ use std::time::{Duration, Instant};
 
 use crossbeam_channel::{unbounded, Receiver, Sender};
 
-use crate::render::frame::StatRow;
-use crate::render::integrator::photon_mapping::frame_stats;
-use crate::render::ppm::PpmStats;
+use crate::render::frame::{FrameStats, StatRow};
 use crate::render::session::Frame;
 use crate::render::shard::{FolderMerge, RenderInFolder, RenderKey};
 
@@ -168,27 +166,36 @@ fn merged_frame(
     generation: u64,
     started: Instant,
 ) -> Frame {
-    let ppm = PpmStats {
-        passes: summary.passes as u32,
-        photons: summary.photons,
-        ..Default::default()
+    let stats = FrameStats {
+        kind: crate::settings::RendererKind::Ppm,
+        seconds: 0.0,
+        summary: Vec::new(),
+        skipped: Vec::new(),
+        json: serde_json::json!({ "watched_folder": { "passes": summary.passes, "total": summary.total, "photons": summary.photons } }),
+        metadata: vec![
+            (
+                crate::render::provenance::PASSES.into(),
+                summary.passes.to_string(),
+            ),
+            ("caustic:photons".into(), summary.photons.to_string()),
+        ],
+        progress: String::new(),
+        rows: vec![
+            StatRow::new(
+                "Passes merged",
+                format!("{} of {}", summary.passes, summary.total),
+                "Passes of the watched render merged from the folder's parts",
+            ),
+            StatRow::new("Parts", summary.parts.to_string(), "Part files merged"),
+            StatRow::new(
+                "Error estimate",
+                summary
+                    .relative_error
+                    .map_or("-".into(), |e| format!("{:.2} %", 100.0 * e)),
+                "Relative RMS error of the image, estimated from the spread of its independent passes",
+            ),
+        ],
     };
-    let mut stats = frame_stats(ppm, false);
-    stats.rows = vec![
-        StatRow::new(
-            "Passes merged",
-            format!("{} of {}", summary.passes, summary.total),
-            "Passes of the watched render merged from the folder's parts",
-        ),
-        StatRow::new("Parts", summary.parts.to_string(), "Part files merged"),
-        StatRow::new(
-            "Error estimate",
-            summary
-                .relative_error
-                .map_or("-".into(), |e| format!("{:.2} %", 100.0 * e)),
-            "Relative RMS error of the image, estimated from the spread of its independent passes",
-        ),
-    ];
     let mut frame = Frame::of_radiance(
         part.sums.size(),
         part.sums.mean(),

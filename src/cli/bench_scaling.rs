@@ -9,7 +9,7 @@ use anyhow::{bail, Result};
 use clap::Args;
 
 use super::bench_output::BenchOutput;
-use super::runs::{load_scene, photon_scene, ppm_stats, render_session};
+use super::runs::{load_scene, photon_scene, render_session};
 use caustic::bench::timings::{interleaved, Timings};
 use caustic::render::render_whitted;
 use caustic::render::session::SessionOptions;
@@ -166,10 +166,10 @@ pub fn bench_ppm(args: PpmArgs, out: &mut BenchOutput) -> Result<()> {
             ..Default::default()
         };
         let frame = render_session(scene.clone(), session, |_| {})?;
-        let stats = ppm_stats(&frame)?;
+        let (photons, photon_secs) = photon_work(&frame)?;
         // The same seed traces the same photons whatever the thread count.
-        paths = stats.photons;
-        Ok(stats.photon_secs)
+        paths = photons;
+        Ok(photon_secs)
     })?;
     let measured = Measured {
         threads,
@@ -224,5 +224,15 @@ fn runs_text(repeat: usize) -> String {
         "1 run per thread count".to_owned()
     } else {
         format!("{repeat} interleaved runs per thread count (best and median)")
+    }
+}
+
+/// The photons a photon-mapped frame's epoch traced and the seconds spent tracing them, from
+/// the statistics photon mapping describes (`photon_mapping` in its JSON).
+fn photon_work(frame: &caustic::render::session::Frame) -> Result<(u64, f64)> {
+    let stats = &frame.stats.json["photon_mapping"];
+    match (stats["photons"].as_u64(), stats["photon_secs"].as_f64()) {
+        (Some(photons), Some(secs)) => Ok((photons, secs)),
+        _ => anyhow::bail!("the renderer returned a frame that was not photon mapped"),
     }
 }

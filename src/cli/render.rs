@@ -325,9 +325,8 @@ fn render_passes(scene: &mut Scene, passes: Passes, args: &RunArgs, output: &mut
             Passes::Count(_) => (f.pass as u64, String::new()),
             Passes::UntilTimeLimit(_) => ((f.elapsed_secs * 10.0) as u64, format!("pass {}, ", f.pass)),
         };
-        if let Some(s) = f.stats.photon_mapping() {
-            let rate = s.photons as f64 / s.photon_secs.max(1e-9) / 1e6;
-            bar.set_message(format!("{what}, {pass}{rate:.2} M photons/s"));
+        if !f.stats.progress.is_empty() {
+            bar.set_message(format!("{what}, {pass}{}", f.stats.progress));
         }
         bar.set_position(progress);
         let image = frame_image(f);
@@ -336,11 +335,8 @@ fn render_passes(scene: &mut Scene, passes: Passes, args: &RunArgs, output: &mut
     })?;
     bar.finish_and_clear();
     output.report.set_bar(None);
-    let mut layers = Vec::new();
-    if frame.stats.photon_mapping().is_some() {
-        layers.push(("radius", frame.radius.to_vec()));
-        layers.push(("photons", frame.gathered.to_vec()));
-    }
+    let mut layers: Vec<(&'static str, Vec<f32>)> =
+        frame.layers.iter().map(|l| (l.name, l.values.to_vec())).collect();
     let error = previous
         .as_ref()
         .and_then(|p| pixel_error_estimate(p.photons, &p.radiance, frame.photons, &frame.radiance));
@@ -366,22 +362,16 @@ fn frame_image(f: &Frame) -> Image {
     }
 }
 
-/// The per-pixel layers a frame carries (what tev shows beside RGB): a photon-mapped frame's
-/// search radius and photon count.
+/// The per-pixel layers a frame carries (what tev shows beside RGB), as its renderer
+/// describes them.
 fn frame_layers(f: &Frame) -> Vec<Layer<'_>> {
-    if f.stats.photon_mapping().is_none() {
-        return Vec::new();
-    }
-    vec![
-        Layer {
-            name: "radius",
-            values: &f.radius,
-        },
-        Layer {
-            name: "photons",
-            values: &f.gathered,
-        },
-    ]
+    f.layers
+        .iter()
+        .map(|l| Layer {
+            name: l.name,
+            values: &l.values,
+        })
+        .collect()
 }
 
 /// A flag's value checked against [`limits`]: the message names the flag.

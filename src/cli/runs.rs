@@ -5,7 +5,6 @@ use std::path::Path;
 
 use anyhow::{bail, Context, Result};
 
-use caustic::render::ppm::PpmStats;
 use caustic::render::session::{Frame, RenderSession, SessionOptions};
 use caustic::scene::Scene;
 
@@ -64,12 +63,4 @@ pub fn render_session(
         bail!("the renderer failed: {failure}");
     }
     last.context("the renderer stopped before completing a pass")
-}
-
-/// A photon-mapped frame's statistics (an error for a frame of another renderer).
-pub fn ppm_stats(frame: &Frame) -> Result<&PpmStats> {
-    frame
-        .stats
-        .photon_mapping()
-        .context("the renderer returned a frame that was not photon mapped")
 }

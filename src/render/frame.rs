@@ -1,12 +1,28 @@
-//! What a render hands on after each pass: a [`Frame`] (radiance and per-pixel statistics) and
-//! what its integrator measured ([`FrameStats`]: the rows the viewer shows, the lines and JSON
-//! the command line prints, the metadata an image records). The integrator fills them in; the
-//! session, the viewer and the command line only pass them on.
+//! What a render hands on after each pass: a [`Frame`] (radiance and the per-pixel layers its
+//! renderer describes) and what its integrator measured ([`FrameStats`]: the rows the viewer
+//! shows, the lines and JSON the command line prints, the metadata an image records). The
+//! integrator fills them in; the session, the viewer and the command line only pass them on.
 
 use std::sync::Arc;
 
-use crate::render::ppm::PpmStats;
 use crate::settings::RendererKind;
+
+/// A per-pixel quantity a renderer describes besides radiance (photon mapping: its search
+/// radius and photon count): shown in false colour by the viewer and in its probe, written as
+/// the EXR layer `NAME.Y`, sent to tev.
+#[derive(Clone, Debug)]
+pub struct PixelLayer {
+    /// Its name in files and tev (`radius`).
+    pub name: &'static str,
+    /// Its name in the viewer (`Search radius`).
+    pub label: &'static str,
+    /// What it means.
+    pub help: &'static str,
+    /// Decimals its values are shown with.
+    pub decimals: usize,
+    /// One value a pixel, rows from the top.
+    pub values: Arc<[f32]>,
+}
 
 /// One statistic as the viewer shows it.
 #[derive(Clone, Debug, PartialEq)]
@@ -48,19 +64,14 @@ pub struct FrameStats {
     pub json: serde_json::Value,
     /// `caustic:*` metadata the saved image records.
     pub metadata: Vec<(String, String)>,
-    /// Photon mapping's own statistics, where the frame was photon mapped.
-    pub ppm: Option<PpmStats>,
+    /// A short line of how fast it goes (`1.23 M photons/s`), for progress bars; may be empty.
+    pub progress: String,
 }
 
 impl FrameStats {
     /// Seconds the renderer spent on the frame (all passes of the epoch for photon mapping).
     pub fn elapsed_secs(&self) -> f64 {
         self.seconds
-    }
-
-    /// Photon mapping's statistics, if the frame was photon mapped.
-    pub fn photon_mapping(&self) -> Option<&PpmStats> {
-        self.ppm.as_ref()
     }
 
     /// Which renderer made the frame.
@@ -89,12 +100,8 @@ pub struct Frame {
     pub height: u32,
     /// Linear RGB radiance, `width × height` pixels, rows from the top.
     pub radiance: Arc<[[f32; 3]]>,
-    /// Search radius per pixel (largest of the pixel's slots), for the viewer's probe; zeros
-    /// for renderers without one.
-    pub radius: Arc<[f32]>,
-    /// Accumulated photon count `N` per pixel (summed over the pixel's slots; with the global
-    /// radius schedule, the photons its last pass gathered), or samples.
-    pub gathered: Arc<[f32]>,
+    /// The per-pixel layers the renderer describes (none for some renderers).
+    pub layers: Vec<PixelLayer>,
     /// A quick low-resolution preview of a new epoch (pass 0), enlarged to full size.
     pub preview: bool,
 }
@@ -108,7 +115,6 @@ impl Frame {
         (epoch, elapsed_secs): (u64, f64),
         stats: FrameStats,
     ) -> Frame {
-        let pixels = radiance.len();
         Frame {
             epoch,
             pass,
@@ -118,24 +124,29 @@ impl Frame {
             width,
             height,
             radiance: radiance.into(),
-            radius: vec![0.0; pixels].into(),
-            gathered: vec![0.0; pixels].into(),
+            layers: Vec::new(),
             preview: false,
         }
     }
 
-    /// Pixel `(x, y)`'s radiance, search radius and photon count, or `None` outside the
+    /// Pixel `(x, y)`'s radiance and each layer's label and value, or `None` outside the
     /// frame (a probe taken on an earlier frame of another size).
-    pub fn pixel(&self, x: u32, y: u32) -> Option<([f32; 3], f32, f32)> {
+    pub fn pixel(&self, x: u32, y: u32) -> Option<([f32; 3], Vec<(&PixelLayer, f32)>)> {
         if x >= self.width || y >= self.height {
             return None;
         }
         let i = y as usize * self.width as usize + x as usize;
-        Some((
-            *self.radiance.get(i)?,
-            *self.radius.get(i)?,
-            *self.gathered.get(i)?,
-        ))
+        let layers = self
+            .layers
+            .iter()
+            .map(|l| Some((l, *l.values.get(i)?)))
+            .collect::<Option<_>>()?;
+        Some((*self.radiance.get(i)?, layers))
+    }
+
+    /// The layer named `name`.
+    pub fn layer(&self, name: &str) -> Option<&PixelLayer> {
+        self.layers.iter().find(|l| l.name == name)
     }
 
     /// This frame at a larger size `(w, h)` (nearest neighbour), marked as a preview.
@@ -147,8 +158,14 @@ impl Frame {
             width: w,
             height: h,
             radiance: enlarge(&self.radiance, small, (w, h)),
-            radius: enlarge(&self.radius, small, (w, h)),
-            gathered: enlarge(&self.gathered, small, (w, h)),
+            layers: self
+                .layers
+                .iter()
+                .map(|l| PixelLayer {
+                    values: enlarge(&l.values, small, (w, h)),
+                    ..l.clone()
+                })
+                .collect(),
             preview: true,
             ..self
         }

@@ -318,7 +318,6 @@ impl Integrator for PathTracer {
         let n = self.stats.passes.max(1) as f64;
         let radiance = self.sums.iter().map(|s| (*s / n).as_vec3().to_array()).collect();
         let mut frame = Frame::of_radiance(self.size, radiance, self.stats.passes, (epoch, elapsed_secs), frame_stats(&self.stats));
-        frame.gathered = vec![self.stats.passes as f32; self.sums.len()].into();
         // Paths traced: what error estimates scale by, as photons are for photon mapping.
         frame.photons = self.stats.passes as u64 * self.sums.len() as u64;
         frame
@@ -349,6 +348,6 @@ fn frame_stats(s: &PathStats) -> FrameStats {
             (provenance::PASSES.into(), s.passes.to_string()),
             ("caustic:elapsed_secs".into(), format!("{:.3}", s.elapsed_secs)),
         ],
-        ppm: None,
+        progress: String::new(),
     }
 }

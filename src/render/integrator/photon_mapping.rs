@@ -2,7 +2,7 @@
 //! and the photon counts taken from each pass's plan.
 
 use super::{Control, Integrator, PassPlan, Setup};
-use crate::render::frame::{Frame, FrameStats, StatRow};
+use crate::render::frame::{Frame, FrameStats, PixelLayer, StatRow};
 use crate::render::ppm::{PassOutcome, Ppm, PpmOptions, PpmStats};
 use crate::render::provenance;
 use crate::scene::Scene;
@@ -98,8 +98,22 @@ impl Frame {
             width,
             height,
             radiance: layers.radiance,
-            radius: layers.radius,
-            gathered: layers.gathered,
+            layers: vec![
+                PixelLayer {
+                    name: "radius",
+                    label: "radius",
+                    help: "The search radius of the pixel's visible points (the largest of its estimates), in scene units",
+                    decimals: 4,
+                    values: layers.radius,
+                },
+                PixelLayer {
+                    name: "photons",
+                    label: "photons",
+                    help: "The photons the pixel's estimates hold (N, after the shrinking; with the global radius schedule, those its last pass gathered)",
+                    decimals: 0,
+                    values: layers.gathered,
+                },
+            ],
             preview: false,
         }
     }
@@ -227,7 +241,7 @@ pub fn frame_stats(s: PpmStats, guided: bool) -> FrameStats {
             ("caustic:mean_radius".into(), format!("{:.6}", s.mean_radius)),
             ("caustic:elapsed_secs".into(), format!("{:.3}", s.elapsed_secs)),
         ],
-        ppm: Some(s),
+        progress: format!("{:.2} M photons/s", s.photons as f64 / s.photon_secs.max(1e-9) / 1e6),
     }
 }
 

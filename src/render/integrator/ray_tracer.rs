@@ -47,7 +47,7 @@ pub fn frame_stats(stats: &WhittedStats) -> FrameStats {
             ("caustic:camera_rays".into(), stats.camera_rays.to_string()),
             ("caustic:elapsed_secs".into(), format!("{:.3}", stats.elapsed_secs)),
         ],
-        ppm: None,
+        progress: String::new(),
     }
 }
 
