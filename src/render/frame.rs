@@ -24,6 +24,9 @@ pub struct PixelLayer {
     pub values: Arc<[f32]>,
 }
 
+/// A pixel's radiance and each layer with its value there ([`Frame::pixel`]).
+pub type Probed<'a> = ([f32; 3], Vec<(&'a PixelLayer, f32)>);
+
 /// One statistic as the viewer shows it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct StatRow {
@@ -131,7 +134,7 @@ impl Frame {
 
     /// Pixel `(x, y)`'s radiance and each layer's label and value, or `None` outside the
     /// frame (a probe taken on an earlier frame of another size).
-    pub fn pixel(&self, x: u32, y: u32) -> Option<([f32; 3], Vec<(&PixelLayer, f32)>)> {
+    pub fn pixel(&self, x: u32, y: u32) -> Option<Probed<'_>> {
         if x >= self.width || y >= self.height {
             return None;
         }
