@@ -149,6 +149,7 @@ fn export_obj_writes_the_tessellated_patches() {
     let obj = dir.path().join("teapot.obj");
     let out = caustic(&[
         "export-obj",
+        "scenes/teapot.toml",
         "--out",
         obj.to_str().expect("utf-8"),
         "--resolution",
@@ -606,6 +607,7 @@ fn tessellation_bench_compares_exact_and_tessellated_renders() {
     let out = caustic(&[
         "bench",
         "tessellation",
+        "scenes/teapot.toml",
         "--width",
         "64",
         "--segments",

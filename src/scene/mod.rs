@@ -65,9 +65,10 @@ pub struct Scene {
     pub base_dir: Option<PathBuf>,
 }
 
-/// The scene the program shows when started without a file: the Utah teapot on a checkered
-/// floor in a box (the same text as `scenes/teapot.toml`).
-pub const BUILTIN_SCENE: &str = include_str!("../../scenes/teapot.toml");
+/// The scene the program shows when started without a file: a glass Utah teapot and a mirror
+/// ring casting the coffee-cup caustic, on a table under a small lamp (the same text as
+/// `scenes/builtin.toml`).
+pub const BUILTIN_SCENE: &str = include_str!("../../scenes/builtin.toml");
 
 impl Scene {
     /// The built-in default scene.
