@@ -705,12 +705,13 @@ fn control_point_moves_render_like_the_edited_scene_built_from_scratch() {
     );
 }
 
-/// Moving a light (here the teapot's sphere light) moves its visible surface by a refit, with
+/// Moving a light (here the porcelain teapot scene's sphere light) moves its visible surface by a refit, with
 /// no patch prepared again, refuses another kind of light or a non-finite number, and renders
 /// like the scene saved with the light there and loaded from scratch.
 #[test]
 fn a_moved_light_renders_like_the_scene_written_with_it_there() {
-    let mut scene = Scene::builtin();
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/teapot.toml");
+    let mut scene = Scene::load(&path).expect("the porcelain teapot loads");
     (scene.camera.width, scene.camera.height) = (64, 48);
     scene.params.photons_per_pass = 20_000;
     scene.params.renderer = caustic::scene::RendererKind::Ppm;
