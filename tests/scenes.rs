@@ -28,6 +28,7 @@ fn every_shipped_scene_loads_and_renders() {
         .collect();
     names.sort();
     let expected = [
+        "builtin",
         "cornell",
         "glass_teapot",
         "hairpin",
