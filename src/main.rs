@@ -17,11 +17,9 @@ fn main() -> std::process::ExitCode {
 /// Serves every allocation of 16 MiB or more from its own mapping, given back to the system
 /// when freed (glibc). By default glibc raises this threshold to the size of each large block
 /// freed (up to 32 MiB), so a 1920×1080 render's per-pass buffers of 16–32 MiB (photon counts,
-/// the grid's bucket starts) come from malloc's heaps after the first pass and fragment them:
-/// `caustic bench memory` (1920×1080) peaked at 517 MiB by pass 40 with glibc's default and at
-/// 456 MiB through 50 passes with this. A threshold of 1 MiB held the same peak but made small
-/// renders' passes fault in fresh pages: `caustic bench edit` took 0.72–0.73 s warm against
-/// 0.54–0.63 s with 16 MiB.
+/// the grid's bucket starts) come from malloc's heaps after the first pass and fragment them,
+/// and the peak grows pass by pass (`caustic bench memory`). A lower threshold would make
+/// small renders' passes fault in fresh pages.
 #[cfg(all(target_os = "linux", target_env = "gnu"))]
 #[allow(unsafe_code)]
 fn return_large_allocations() {

@@ -5,10 +5,10 @@ use egui::{Color32, RichText};
 use egui_plot::{Line, Plot, PlotPoints};
 
 use super::action::Action;
-use super::keys::HELP;
+use super::commands::{self, Menu};
 use super::params::{PanelParams, Ranges};
 use super::setting_ui;
-use super::settings::{DisplayMode, Zoom};
+use super::settings::DisplayMode;
 use super::state::{Status, ViewerState};
 use crate::scene::RendererKind;
 
@@ -34,132 +34,26 @@ fn percent(fraction: f64) -> String {
     format!("{p:.decimals$} %")
 }
 
-/// File, View and Help menus.
+/// The File, Edit, View and Help menus, drawn from the table of commands
+/// ([`super::commands`]); View adds the display modes, which follow the frame's layers.
 pub fn menu_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Action>) {
     egui::MenuBar::new().ui(ui, |ui| {
-        ui.menu_button("File", |ui| file_menu_ui(viewer, ui, out));
-        super::edit_panel::edit_menu_ui(viewer, ui, out);
-        ui.menu_button("View", |ui| view_menu_ui(viewer, ui, out));
-        ui.menu_button("Help", |ui| {
-            if ui
-                .button("Keys and mouse  (F1)")
-                .on_hover_text("List the shortcuts")
-                .clicked()
-            {
-                out.push(Action::ShowHelp(true));
-            }
+        ui.menu_button("File", |ui| commands::menu_ui(viewer, Menu::File, ui, out));
+        ui.menu_button("Edit", |ui| commands::menu_ui(viewer, Menu::Edit, ui, out));
+        ui.menu_button("View", |ui| {
+            commands::menu_ui(viewer, Menu::View, ui, out);
+            ui.separator();
+            display_modes_ui(viewer, ui, out);
         });
+        ui.menu_button("Help", |ui| commands::menu_ui(viewer, Menu::Help, ui, out));
         ui.separator();
         ui.label(RichText::new(viewer.scene.source.display().to_string()).weak())
             .on_hover_text("The scene file being rendered");
     });
 }
 
-/// Open, save, the reference, tev, quit.
-fn file_menu_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Action>) {
-    if ui
-        .button("Open scene...  (Ctrl+O)")
-        .on_hover_text("Open a scene file (.toml); you can also drop one on the window")
-        .clicked()
-    {
-        out.push(Action::PickScene);
-    }
-    if ui
-        .button("Save frame...  (Ctrl+S)")
-        .on_hover_text("Save the current frame: PNG as displayed, or EXR with linear radiance")
-        .clicked()
-    {
-        out.push(Action::SaveFrame);
-    }
-    if ui
-        .button("Send frame to tev")
-        .on_hover_text(format!(
-            "Show the current frame (radiance, radius, photon count) in a running tev at {}",
-            crate::tev::DEFAULT_ADDRESS
-        ))
-        .clicked()
-    {
-        out.push(Action::SendToTev(crate::tev::DEFAULT_ADDRESS.into()));
-    }
-    ui.separator();
-    if viewer.watching().is_some() {
-        if ui
-            .button("Stop watching")
-            .on_hover_text("Stop merging the render folder's parts and render the scene again")
-            .clicked()
-        {
-            out.push(Action::StopWatching);
-        }
-    } else if ui
-        .button("Watch a render folder...")
-        .on_hover_text("Show the parts a farm writes into a folder (caustic render --shard), merged as they land, with the passes done and the error estimate")
-        .clicked()
-    {
-        out.push(Action::PickWatchFolder);
-    }
-    ui.separator();
-    if ui
-        .button("Open reference...")
-        .on_hover_text("Compare with a reference image (.exr or .pfm of the render's size): the true error in the plot, difference views and A/B; you can also drop one on the window")
-        .clicked()
-    {
-        out.push(Action::PickReference);
-    }
-    if ui
-        .add_enabled(viewer.reference().is_some(), egui::Button::new("Close reference"))
-        .on_hover_text("Stop comparing with the reference")
-        .clicked()
-    {
-        out.push(Action::CloseReference);
-    }
-    ui.separator();
-    if ui
-        .button("Save scene  (Ctrl+Shift+S)")
-        .on_hover_text("Write the scene as edited (camera, parameters, control points, lights) to its file, after you confirm; the built-in scene asks where")
-        .clicked()
-    {
-        out.push(Action::SaveScene);
-    }
-    if ui
-        .button("Save scene as...")
-        .on_hover_text("Write the scene as edited to a new .toml file that loads back to the same patches")
-        .clicked()
-    {
-        out.push(Action::SaveSceneAs);
-    }
-    ui.separator();
-    if ui
-        .button("Quit")
-        .on_hover_text("Close the viewer (settings are kept; unsaved edits are asked about)")
-        .clicked()
-    {
-        out.push(Action::Close);
-    }
-}
-
-/// Zoom, what the image shows, the overlay and the panel.
-fn view_menu_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Action>) {
-    if ui
-        .button("Fit  (F)")
-        .on_hover_text("Scale the image to fit the view")
-        .clicked()
-    {
-        out.push(Action::SetZoom {
-            zoom: Zoom::Fit,
-            recentre: true,
-        });
-    }
-    if ui
-        .button("1:1  (1)")
-        .on_hover_text("One image pixel per screen pixel")
-        .clicked()
-    {
-        out.push(Action::SetZoom {
-            zoom: Zoom::Scale(1.0),
-            recentre: true,
-        });
-    }
-    ui.separator();
+/// What the image shows: radiance, each of the frame's layers, the differences to a reference.
+fn display_modes_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Action>) {
     let mut display = viewer.settings.display;
     let layers = viewer.layer_labels();
     for mode in DisplayMode::all(&layers) {
@@ -175,36 +69,8 @@ fn view_menu_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Action>) 
                 .on_disabled_hover_text(hover);
         });
     }
-    let mut ab = viewer.showing_reference();
-    if ui
-        .add_enabled(
-            viewer.reference().is_some(),
-            egui::Checkbox::new(&mut ab, "Show the reference (A/B)  (B)"),
-        )
-        .on_hover_text("Show the reference image instead of the render, with the same exposure")
-        .changed()
-    {
-        out.push(Action::ShowReference(ab));
-    }
     if display != viewer.settings.display {
         out.push(Action::SetDisplay(display));
-    }
-    ui.separator();
-    let mut nets = viewer.settings.show_wireframe;
-    if ui
-        .checkbox(&mut nets, "Control nets and lights  (W)")
-        .on_hover_text("Draw the patches' control nets and boundary curves and the lights' gizmos over the image, to pick and drag")
-        .changed()
-    {
-        out.push(Action::ShowWireframe(nets));
-    }
-    let mut side = viewer.settings.show_side_panel;
-    if ui
-        .checkbox(&mut side, "Side panel  (P)")
-        .on_hover_text("Show or hide the parameters and statistics")
-        .changed()
-    {
-        out.push(Action::ShowSidePanel(side));
     }
 }
 
@@ -554,9 +420,9 @@ fn help_window_ui(ctx: &egui::Context, out: &mut Vec<Action>) {
         .resizable(false)
         .show(ctx, |ui| {
             egui::Grid::new("caustic-help").num_columns(2).show(ui, |ui| {
-                for (keys, what) in HELP {
-                    ui.monospace(*keys);
-                    ui.label(*what);
+                for (keys, what) in commands::help_rows() {
+                    ui.monospace(keys);
+                    ui.label(what);
                     ui.end_row();
                 }
             });

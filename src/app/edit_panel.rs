@@ -1,74 +1,13 @@
-//! The Edit menu and the side panel's editing section: undo/redo, selection, exact
-//! coordinates of a selected control point, framing, saving the scene.
+//! The side panel's editing section: the Edit menu's commands as buttons, the selection, exact
+//! coordinates of a selected control point, saving the scene.
 
 use egui::RichText;
 
 use super::action::Action;
+use super::commands::{Menu, COMMANDS};
 use super::editor::Editor;
 use super::handle::{Handle, LightPart};
 use super::state::ViewerState;
-
-/// An editing command offered by both the Edit menu and the side panel.
-struct EditCommand {
-    label: &'static str,
-    keys: &'static str,
-    tip: &'static str,
-    action: Option<Action>,
-}
-
-/// Undo, redo, whole patch, select none, frame: `action` is `None` where it does not apply.
-fn edit_commands(viewer: &ViewerState) -> [EditCommand; 5] {
-    let (can_undo, can_redo) = viewer.editor.history.can_undo_redo();
-    let selected = viewer.editor.selection.first().copied();
-    [
-        EditCommand {
-            label: "Undo",
-            keys: "Ctrl+Z",
-            tip: "Undo the last control-point or camera edit",
-            action: can_undo.then_some(Action::Undo),
-        },
-        EditCommand {
-            label: "Redo",
-            keys: "Ctrl+Shift+Z",
-            tip: "Redo the last undone edit",
-            action: can_redo.then_some(Action::Redo),
-        },
-        EditCommand {
-            label: "Whole patch",
-            keys: "A",
-            tip: "Select all 16 control points of the selected point's patch, to move it as one",
-            action: selected.and_then(Handle::patch).map(Action::SelectPatch),
-        },
-        EditCommand {
-            label: "Select none",
-            keys: "Esc",
-            tip: "Clear the selection",
-            action: selected.map(|_| Action::ClearSelection),
-        },
-        EditCommand {
-            label: "Frame",
-            keys: "C",
-            tip: "Turn and move the camera onto the selection (or all patches)",
-            action: Some(Action::FrameSelection),
-        },
-    ]
-}
-
-/// The Edit menu.
-pub fn edit_menu_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Action>) {
-    ui.menu_button("Edit", |ui| {
-        for c in edit_commands(viewer) {
-            let button = egui::Button::new(format!("{}  ({})", c.label, c.keys));
-            if ui
-                .add_enabled(c.action.is_some(), button)
-                .on_hover_text(c.tip)
-                .clicked()
-            {
-                out.extend(c.action);
-            }
-        }
-    });
-}
 
 /// Three fields for a point's x, y, z; `Some` with the new position when one was changed.
 fn coordinates_ui(ui: &mut egui::Ui, position: glam::DVec3, speed: f64) -> Option<glam::DVec3> {
@@ -100,15 +39,17 @@ pub fn edit_panel_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Acti
         out.push(Action::ShowWireframe(nets));
     }
     selection_ui(editor, ui, out);
+    // The Edit menu's commands, as buttons.
     ui.horizontal_wrapped(|ui| {
-        for c in edit_commands(viewer) {
-            let tip = format!("{} ({})", c.tip, c.keys);
+        for c in COMMANDS.iter().filter(|c| c.menu == Menu::Edit) {
+            let action = (c.action)(viewer);
+            let tip = format!("{} ({})", c.tooltip, c.keys);
             if ui
-                .add_enabled(c.action.is_some(), egui::Button::new(c.label))
+                .add_enabled(action.is_some(), egui::Button::new(c.label))
                 .on_hover_text(tip)
                 .clicked()
             {
-                out.extend(c.action);
+                out.extend(action);
             }
         }
     });

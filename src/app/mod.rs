@@ -19,12 +19,14 @@
 //! - [`save`], [`job`], [`file_dialog`]: dialogs (native, or inside the window where no native
 //!   one can be shown) and file writes off the UI thread; [`tev_send`]: the frame
 //!   to a running tev.
-//! - [`keys`], [`settings`], [`automation`]: shortcuts, stored preferences, scripted runs.
+//! - [`commands`]: the one table of the viewer's commands (menus, shortcuts, F1's help);
+//!   [`keys`], [`settings`], [`automation`]: the keyboard, stored preferences, scripted runs.
 //! - [`watch`]: a render folder's parts merged as a farm writes them (`view --watch`).
 
 pub mod action;
 mod apply;
 pub mod automation;
+pub mod commands;
 pub mod controls;
 pub mod difference;
 pub mod edit_panel;

@@ -64,6 +64,9 @@ pub enum BenchCommand {
     Tessellation(super::tessellation::TessellationArgs),
     /// Whitted ray tracer: rays per second on a scene, at the given thread counts.
     Whitted(super::bench_scaling::WhittedArgs),
+    /// The README's benchmark table: runs each of its benchmarks, keeps the figures with their
+    /// command, date and machine in assets/readme/benchmarks.json, and writes the table.
+    All(super::bench_all::AllArgs),
 }
 
 /// The order `bench intersect` traces its rays in.
@@ -121,6 +124,7 @@ pub fn bench(what: BenchCommand, json: bool) -> Result<()> {
         BenchCommand::Shards(_) => "shards",
         BenchCommand::Whitted(_) => "whitted",
         BenchCommand::Tessellation(_) => "tessellation",
+        BenchCommand::All(_) => "all",
     };
     let mut out = BenchOutput::new(json, name);
     match what {
@@ -147,6 +151,7 @@ pub fn bench(what: BenchCommand, json: bool) -> Result<()> {
         BenchCommand::Memory(args) => super::memory::bench_memory(args, &mut out),
         BenchCommand::Shards(args) => super::bench_shards::bench_shards(args, &mut out),
         BenchCommand::Tessellation(args) => super::tessellation::bench_tessellation(args, &mut out),
+        BenchCommand::All(args) => super::bench_all::bench_all(args, &mut out),
         BenchCommand::Ppm(args) => super::bench_scaling::bench_ppm(args, &mut out),
         BenchCommand::Convergence(args) => super::bench_convergence::bench_convergence(args, &mut out),
         BenchCommand::Edit(args) => super::bench_edit::bench_edit(args, &mut out),

@@ -129,6 +129,7 @@ pub fn bench_memory(args: MemoryArgs, out: &mut BenchOutput) -> Result<()> {
         ..Default::default()
     };
     let mut samples = Vec::new();
+    let mut peak_mib: f64 = 0.0;
     render_session(scene, options, |f| {
         if f.pass % args.every == 0 || f.pass == 1 {
             if let Some((rss, peak)) = resident_mib() {
@@ -146,6 +147,7 @@ pub fn bench_memory(args: MemoryArgs, out: &mut BenchOutput) -> Result<()> {
                     }),
                 );
                 samples.push(rss);
+                peak_mib = peak_mib.max(peak);
             }
         }
     })?;
@@ -156,5 +158,6 @@ pub fn bench_memory(args: MemoryArgs, out: &mut BenchOutput) -> Result<()> {
         ));
         out.set("growth_percent", (last / first - 1.0) * 100.0);
     }
+    out.set("peak_mib", peak_mib);
     Ok(())
 }

@@ -2,6 +2,7 @@
 //! its own ([`view`], [`render`], [`export`], [`bench`], [`bench_convergence`], [`memory`]).
 
 mod bench;
+mod bench_all;
 mod bench_convergence;
 mod bench_edit;
 mod bench_output;

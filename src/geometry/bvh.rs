@@ -6,25 +6,11 @@
 //! The walk reads the interior nodes in a second layout ([`NodePair`]): each holds its two
 //! children's boxes side by side, as wider BVHs do (Wald et al. 2008, "Getting rid of packets";
 //! Embree's BVH4 has four), so one step loads one record and tests both boxes with two-wide
-//! arithmetic. The gain is small: on `bench intersect` the teapot's hitting rays took 642 ns
-//! against 678 at best (six interleaved runs each; 813 against 856 in a second set, on a
-//! slower host), and in two calmer sets later, with a tighter patch test as well, 642-669
-//! against 658-686. Glass-teapot renders did not change measurably. Four boxes a step, tried
-//! too, was slower: its records span four cache lines and its lane ordering branches (hitting
-//! rays 784-867 ns against 696-905, missing rays 87-90 ns against 61-62, interleaved). Four
-//! boxes a step in `f32` (two cache lines, rounded outward, the ray's origin rounded towards
-//! each box's far side, lanes ordered by the three split axes without sorting) was tried
-//! again: primary rays at the teapot 626-628 ns against 634-637, the glass teapot's photons
-//! 7 % faster, but the Cornell box's ray tracer 20-40 % slower. A ray leaves a surface only
-//! 1e-9 of its coordinates off it ([`super::ray::OFFSET_RELATIVE`]), far below `f32`'s
-//! resolution, so in `f32` it still meets the box of the surface it leaves, and of every
-//! surface sharing that plane: 2.6 times the primitive tests there (9.3 million against 3.6).
-//! Keeping the tie rule below (equal entries, first child first) costs a comparison per lane
-//! pair besides. Two boxes a step stored in `f32` (rounded outward, tested in `f64`: 64-byte
-//! records, the teapot's tree 357 KB against 670 KB, inside this machine's 512-KB L2) gained
-//! nothing clear: `bench intersect --order shuffled` 771-781 ns per hitting ray against
-//! 770-776, image order 628-652 against 622-626, the glass teapot's passes 1.5-2 % faster;
-//! it would bring the flat-surface problem back, so the records stay `f64`.
+//! arithmetic. The records stay two-wide and in `f64`: a ray leaves a surface only 1e-9 of its
+//! coordinates off it ([`super::ray::OFFSET_RELATIVE`]), far below `f32`'s resolution, so boxes
+//! rounded to `f32` would hand it back the surface it leaves, and every surface sharing that
+//! plane; and four boxes a step span more cache lines and order their lanes with more branches
+//! than the step saves.
 
 use glam::DVec3;
 
@@ -145,9 +131,8 @@ impl NodePair {
     /// (two walls along their shared edge) resolve as they always have.
     ///
     /// Which children an incoherent ray (a photon, a secondary ray) enters is hard to
-    /// predict: one branch asks whether it enters either, and the rest is chosen by selects.
-    /// Four-way branching on the pair of outcomes made the glass teapot's passes 3 % slower
-    /// and `bench intersect --order shuffled` 3-5 %.
+    /// predict: one branch asks whether it enters either, and the rest is chosen by selects,
+    /// rather than branching four ways on the pair of outcomes.
     #[inline(always)]
     fn enter(&self, origin: DVec3, inv_dir: DVec3, t_max: f64, negative: &[bool; 3]) -> Option<Step> {
         let (t0, t1) = self.hit_intervals(origin, inv_dir, t_max);
@@ -181,9 +166,8 @@ const SHORT_STACK: usize = 32;
 const LONG_STACK: usize = 64;
 
 /// A traversal's stack: the nodes still to visit, where the ray enters their boxes and where
-/// it leaves them. A node is kept as its [`Child`]'s two fields in two arrays: one array of
-/// `Child` (8 bytes an entry, padding included, against 6) made `bench intersect`'s missing
-/// rays 4-5 ns slower (64.2-72.1 ns against 59.2-74.9, six interleaved runs).
+/// it leaves them. A node is kept as its [`Child`]'s two fields in two arrays, 6 bytes an
+/// entry, where one array of `Child` would take 8 with its padding.
 struct Stack<'a> {
     node: &'a mut [u32],
     count: &'a mut [u16],

@@ -63,10 +63,7 @@ impl PassPlan {
     /// its first pass: that pass stays small so that the edit's first image comes as soon as
     /// it did with the doubling ramp, but from then on its image is the kept estimates plus new
     /// photons, and what improves it is photons per second, which small passes waste on each
-    /// pass's fixed cost (the stochastic eye pass: about 40 ms of a 16,384-photon pass's
-    /// 50 ms on `scenes/inline_patch.toml`). `caustic bench edit` (inline_patch, three
-    /// interleaved sets of 5 runs): warm to relative MSE 1e-2 in 0.41–0.44 s against
-    /// 0.50–0.63 s with the doubling ramp; on the built-in teapot 3.63 against 3.58 s.
+    /// pass's fixed cost (the stochastic eye pass is most of a 16,384-photon pass).
     pub fn pass_photons(&self, completed: u32, full: u64, warm: bool) -> u64 {
         if warm && completed > 0 {
             return full;

@@ -47,23 +47,14 @@ fn compact(deposits: &mut Vec<Deposit>) {
 }
 
 /// Hits a window holds before they are handed (64 bytes each: 32 MiB): the more, the more
-/// often consecutive hits share cells. `bench ppm --indirect-radius-scale 1 --threads 1`
-/// (smallppm's scene, 2.25 hits a photon, about 110,000 cells hit in a window), two runs
-/// each, in paths per core-second: 2^18 hits 378k/368k, 2^19 435k/409k, 2^20 446k/414k,
-/// 2^21 452k/405k — beyond 2^19, twice the memory buys 1–2 % (measured before neighbouring
-/// cells' buckets were put side by side, [`HashGrid`](super::HashGrid)).
+/// often consecutive hits share cells; beyond 2^19, twice the memory buys little.
 pub(super) const WINDOW_HITS: usize = 1 << 19;
 
 /// Sorted hits handed to the points as one unit of parallel work. Each wave ends when its
-/// last group does, so a thread waits for up to one group at every wave's end: with 4096
-/// hits a group (about 2 ms on smallppm's scene) the two threads of `bench ppm
-/// --indirect-radius-scale 1` lost about 1 ms of each 10-ms wave. 1024 hits and four times
-/// the groups per wave (the same hits a wave, so the same deposits held at once), three
-/// interleaved runs each: 2 threads 365k–367k paths per core-second against 345k–356k
-/// (speed-up 1.86–1.93× against 1.74–1.79×), 1 thread unchanged (380k–394k against
-/// 385k–399k). Unless a group's deposits outgrow [`MAX_GROUP_DEPOSITS`] and are merged, they
-/// are folded in the sorted hits' order whatever the group, so the image is the same
-/// (bit-identical on every scene in `scenes/`).
+/// last group does, so a thread waits for up to one group at every wave's end: groups small
+/// beside a wave keep that wait short. Unless a group's deposits outgrow
+/// [`MAX_GROUP_DEPOSITS`] and are merged, they are folded in the sorted hits' order whatever
+/// the group, so the image does not depend on the group size.
 const GROUP: usize = 1024;
 
 /// Groups ([`GROUP`] hits each) handed between two looks at the caller's control, and

@@ -29,10 +29,9 @@ pub fn has_area_lights(scene: &Scene) -> bool {
     scene.lights.iter().any(|l| l.is_area())
 }
 
-/// Points [`area_light_pass`] samples at a time: their light takes 24 bytes a point, and
-/// for a whole pass's points at 1920×1080 that was 50 MiB of the render's peak (`caustic
-/// bench memory`), where a block's is 1.5 MiB. Large enough that each block keeps every
-/// thread busy.
+/// Points [`area_light_pass`] samples at a time: their light takes 24 bytes a point, which
+/// for a whole pass's points at 1920×1080 would be 50 MiB of the render's peak, and for a
+/// block is 1.5 MiB. Large enough that each block keeps every thread busy.
 const BLOCK: usize = 1 << 16;
 
 /// Reflected radiance from every area light at each point (one sample each), handed to

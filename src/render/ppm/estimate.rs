@@ -158,9 +158,7 @@ impl Ppm {
             guide.learn(tally);
         }
         // Compute new photon counts, radii and flux (Hachisuka et al. 2008, eqs. 6–11), slot by
-        // slot, [`SWEEP_BLOCK`] a task. It is memory-bound (52-byte slots): in smallppm's scene
-        // at 1024×768 (`bench ppm`) an update took 15-17 ms with two threads serially and
-        // 11.6-16.7 ms in parallel; with one thread 14-16 ms either way.
+        // slot, [`SWEEP_BLOCK`] a task (memory-bound: 52-byte slots).
         let alpha = self.alpha;
         self.slots
             .par_chunks_mut(SWEEP_BLOCK)

@@ -21,14 +21,9 @@
 //! emission's would — so they land about as many useful photons as unguided passes, without
 //! tracing the ones that would have been lost. Later passes, whose error is mostly the photon
 //! estimate's noise, divide by the gain's square root: √gain times as many useful photons as
-//! an unguided pass, fewer passes, less of the time in eye passes. Measured on
-//! `scenes/glass_teapot.toml` (320×240, 20 s each, gain about 4–6): RMSE 3.81e-3–3.95e-3 (4
-//! runs) dividing by the gain throughout (about 200 passes, half their time in eye passes),
-//! 3.42e-3–3.61e-3 (4 runs) with this rule, 3.36e-3–3.52e-3 (6 runs) dividing by the square
-//! root throughout, 3.53e-3–3.91e-3 (4 runs) not dividing; but after an edit
-//! (`caustic bench edit`, `scenes/inline_patch.toml`, a few passes) the square root throughout
-//! took the warm restart to relative MSE 1e-2 in 0.65–0.84 s against 0.43–0.65 s dividing by
-//! the gain (4 sets, interleaved), and this rule in 0.57–0.71 s (3 sets).
+//! an unguided pass, fewer passes, less of the time in eye passes. Dividing by the whole gain
+//! throughout would leave long renders' passes mostly eye pass; by its square root throughout,
+//! the first passes after an edit would be slow to come.
 //!
 //! Determinism: the map changes only between passes, from integer counts summed over the
 //! pass's chunks, so it is the same for any number of threads.
@@ -57,8 +52,7 @@ pub const MAX_GAIN: f64 = 64.0;
 pub const GAIN_DIVIDED_PASSES: u64 = 32;
 /// A light's learned density is used only when it gains at least this much: below, as in a
 /// closed room where nearly every photon lands in view, reshaping the emission buys little and
-/// costs time (guided photons reach more points, each a deposit). Measured in the Cornell box
-/// (gain ≈ 1.2): 85 guided passes against 94 unguided in 20 s, RMSE 5.5e-2 against 5.3e-2.
+/// costs time (guided photons reach more points, each a deposit).
 pub const MIN_GAIN: f64 = 1.5;
 
 /// Emitted and useful photons per light and bin, for one chunk or one pass.

@@ -31,12 +31,8 @@ pub struct HashGrid {
 /// Cell width over the largest search radius. A photon's bucket lookups are cache misses and
 /// its candidates (read in a row) are cheap: cells of 3 radii mean about 1.7 cells per axis
 /// to look in instead of 2 for cells of one diameter (4.6 lookups instead of 8) for about 1.5
-/// times the candidates. `bench ppm --indirect-radius-scale 1 --photons 300000 --threads 1`,
-/// 6 interleaved runs each: median 191k paths per core-second against 163k with cells of
-/// 2 radii; with smallppm's automatic (wider) indirect radius 70k against 72k.
-/// Measured again once photons were handed in cell order (`ppm/deposit.rs`), two
-/// runs each: cells of 2, 3 and 4 radii 386k/349k, 433k/412k and 408k/400k paths per
-/// core-second; with the automatic indirect radius 278k, 266k and 235k (one run).
+/// times the candidates: with photons handed in cell order (`ppm/deposit.rs`), cells of 3
+/// radii trace more photon paths per second than cells of 2 or 4 (`bench ppm`).
 pub const CELL_PER_RADIUS: f64 = 3.0;
 
 /// How far the largest radius may shrink below the one a grid was built for while the grid
@@ -153,10 +149,8 @@ impl HashGrid {
     /// Cell `c`'s bucket: blocks of 4×4×4 cells are hashed (Teschner et al. 2003) to runs of
     /// 64 consecutive buckets, the cells of a block in Morton order within the run. The points
     /// of neighbouring cells then lie near each other, and photons handed in Morton order of
-    /// their cells ([`HashGrid::cell_key`]) read them nearly in a row: `bench ppm
-    /// --indirect-radius-scale 1 --threads 1`, 3 interleaved runs, 544–557k paths per
-    /// core-second against 471–504k with every cell hashed on its own (automatic indirect
-    /// radius: 262–280k against 257–274k; the Cornell box's photon time unchanged).
+    /// their cells ([`HashGrid::cell_key`]) read them nearly in a row, where hashing every
+    /// cell on its own would scatter them.
     #[inline]
     fn bucket(&self, c: IVec3) -> u32 {
         let block = hash(c >> 2) << 6;

@@ -470,10 +470,8 @@ impl Ppm {
     /// What a frame shows per pixel — [`Ppm::radiance`], the largest search radius of the
     /// pixel's slots and the photons they gathered — each in one allocation, made in one
     /// parallel sweep over the slots, [`SWEEP_BLOCK`] pixels a task (each block finds its
-    /// first slot by a binary search: they lie in pixel order). Three serial sweeps took
-    /// 31–42 ms of every 600-ms pass of `caustic bench ppm` on 2 threads, one parallel sweep
-    /// takes 15–19 ms; each pixel's values depend on it alone, so they are the same for any
-    /// number of threads.
+    /// first slot by a binary search: they lie in pixel order), rather than three serial ones;
+    /// each pixel's values depend on it alone, so they are the same for any number of threads.
     pub fn pixel_layers(&self) -> PixelLayers {
         use rayon::prelude::*;
         debug_assert!(

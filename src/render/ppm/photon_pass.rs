@@ -18,13 +18,9 @@ use crate::scene::Scene;
 
 /// Photons per chunk: the unit of parallel tracing (their hits are reduced in groups of the
 /// sorted window, [`deposit`](super::deposit)). A batch ends when its last chunk does, and
-/// photons through glass cost several times those that miss it: the glass teapot's passes
-/// (about 70,000 photons at 320×240, a batch of 16 chunks of 4096 and one of 1 or 2) left a
-/// thread waiting for up to a chunk twice a pass. With chunks of 1024 (and
-/// [`Gathered::new`](super::gathered::Gathered::new) filled in parallel), `render
-/// scenes/glass_teapot.toml --width 320 --passes 50`, 3 interleaved runs: photons 2.49–2.57 s
-/// against 2.59–2.68 s (−4 %); images bit-identical (a photon's random numbers depend on its
-/// number alone).
+/// photons through glass cost several times those that miss it: small chunks keep the threads
+/// from waiting on one long chunk at the end of each batch. The image does not depend on the
+/// chunk size: a photon's random numbers depend on its number alone.
 pub(super) const CHUNK: u64 = 1024;
 
 /// Photons per batch unless [`PpmOptions::batch_photons`](super::PpmOptions::batch_photons)

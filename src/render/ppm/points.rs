@@ -150,10 +150,9 @@ impl VisiblePoints {
 
     /// Copies each point's slot's radii² into its reach; returns the largest radius² of each
     /// estimate (0 without points). In parallel, [`SWEEP_BLOCK`] points a task: every pass
-    /// does it before its photons, and each point reads its slot from wherever it lies. In
-    /// smallppm's scene at 1024×768 (`bench ppm`, passes 2-5) it took 20-25 ms a pass with one
-    /// thread or two; now 13.5-19.5 ms with two (one thread unchanged). The largest of a set
-    /// of radii does not depend on the order it is taken in, so neither does the result.
+    /// does it before its photons, and each point reads its slot from wherever it lies. The
+    /// largest of a set of radii does not depend on the order it is taken in, so neither does
+    /// the result.
     pub fn set_radii(&mut self, slots: &[Slot]) -> [f32; 2] {
         let largest = |reach: &mut [Reach], shade: &[Shade]| {
             let mut largest = [0.0f32; 2];

@@ -163,23 +163,16 @@ impl Ppm {
     /// The first pass's flux, gathered over the wide radius, is dropped at the second pass
     /// (kept until then, scaled by the area, so the image does not go dark), so that no blur of
     /// it stays in the estimate; the radius is chosen from photons the estimate then never
-    /// uses. Counts are deterministic, so are the radii.
-    ///
-    /// Measured on `scenes/glass_teapot.toml` at 320×240 (46 passes, against `bench
-    /// convergence`'s reference): RMSE 4.78e-3 against 5.49e-3 narrowing only (4.68e-3
-    /// without the one more photon, which the viewer's small first pass needs); first passes
-    /// at 1.5, 3 and 4 times the radius and thresholds of 1, 3, 4 and 8 photons did no
-    /// better, and without the neighbours' counts the lens of `scenes/lens.toml`, which shows
-    /// its focus, had 5 times the relative MSE.
+    /// uses. Counts are deterministic, so are the radii. The neighbours' counts matter where
+    /// dim light lies beside bright (the focus of `scenes/lens.toml`, seen through the lens):
+    /// widened there, a point would blur the bright light into its estimate.
     pub(super) fn adapt_radii(&mut self, gathered: &Gathered) {
         let merged = self.indirect_scale == IndirectScale::Off;
         let r0_2 = self.initial_radius2;
         let area = MAX_WIDENING * MAX_WIDENING;
         // The widest a sparse point may grow: no wider than the indirect estimate's radius,
         // which sets the spatial index's reach already — beyond it, every photon would look
-        // at more points (in the Cornell box, indirect radius 1.5×, photons took 5 % longer
-        // at twice the radius, two interleaved runs of 30 passes at 320×240). With one
-        // estimate for all photons, not at all.
+        // at more points. With one estimate for all photons, not at all.
         let widest2 = match self.indirect_scale {
             IndirectScale::Fixed(k) => k.min(MAX_WIDENING).powi(2),
             _ => 1.0,
@@ -196,8 +189,8 @@ impl Ppm {
             .collect();
         // The sparse test counts photons as a full pass would hand them, and one more than
         // the first pass found: the viewer's first pass is smaller (16,384 photons), and its
-        // few photons cannot tell a sparse point from one they missed (`bench edit`, counting
-        // only what it found: a cold restart took 3.9 s to relative MSE 1e-2 against 0.7 s).
+        // few photons cannot tell a sparse point from one they missed (counting only what it
+        // found would widen nearly every point after a cold restart).
         let full = (self.full_pass_photons as f64 / self.pass_photons.max(1) as f64).max(1.0);
         let pixels = self.slots.iter().map(|s| s.pixel);
         let nearby = densest_nearby(pixels, &within, self.width, self.height);

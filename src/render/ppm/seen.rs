@@ -66,26 +66,15 @@ pub const SUBSAMPLES: u32 = 16;
 pub const BUDGET: f64 = 0.25;
 
 /// How many times the pass's mean light seen a pixel's difference from a neighbour must exceed
-/// for the pixel to be supersampled. Measured at 320×240 (27 passes of `scenes/cornell.toml`,
-/// whose mean light seen is 0.24; 70 of `scenes/glass_teapot.toml`, whose light seen is the
-/// checker floor under a point light):
-///
-/// | factor | Cornell: pixels chosen, RMSE | glass teapot: pixels chosen, eye passes, RMSE |
-/// |---|---|---|
-/// | 2 or 4 | 0.69 %, 1.191e-2 | 1.56 % (the budget), 3.23–3.30 s, 5.71e-3 |
-/// | 8 | 0.67 %, 1.191e-2 | 0.06 %, 2.22 s, 5.78e-3 |
-/// | 16 | 0.57 %, 1.240e-2 | none, 2.16 s, 5.79e-3 |
-///
-/// Below 8 the glass teapot's extra rays, through the glass, cost half as much again as its
-/// eye pass for 1 % less error.
+/// for the pixel to be supersampled. Lamps' outlines and their images exceed it by far; below
+/// it, the edges of an ordinary lit surface (a checker floor seen through glass) would be
+/// chosen too, whose extra rays cost much and buy little.
 pub const CONTRAST: f32 = 8.0;
 
 /// Extra eye rays a pass in a pixel chosen for its variance between passes. A power of two,
 /// as [`SUBSAMPLES`]. Fewer than an outline's: these pixels are many more (a checker floor's
-/// edges, a glass object), and their light changes by less. Measured on
-/// `scenes/glass_teapot.toml` (320×240, 46 passes, seeds 1–3, RMSE and seconds; no pixel
-/// chosen: 4.70e-3–4.78e-3 in 4.2–4.8 s): 2 rays 4.46e-3–4.55e-3 in 4.3–4.6 s, 4 rays
-/// 4.34e-3–4.43e-3 in 4.7–5.2 s, 8 rays 4.30e-3–4.39e-3 in 5.3–5.4 s (with a factor of 4).
+/// edges, a glass object), and their light changes by less: beyond 4, the extra rays' cost
+/// grows faster than the error falls.
 pub const VARIED_SUBSAMPLES: u32 = 4;
 
 /// Completed passes whose light seen per pixel gives the variances the second choice is made
@@ -93,9 +82,8 @@ pub const VARIED_SUBSAMPLES: u32 = 4;
 pub const VARIANCE_PASSES: u32 = 8;
 
 /// How many times the image's mean variance a pixel's variance must exceed to be chosen for
-/// it. On `scenes/glass_teapot.toml` (as for [`VARIED_SUBSAMPLES`]): a factor of 8 chooses
-/// 3.9 % of the pixels, RMSE 4.40e-3–4.49e-3 in 4.5–4.7 s; 4 chooses 6.1 %, 4.34e-3–4.43e-3
-/// in 4.7–5.2 s.
+/// it: a few per cent of the pixels hold most of the light seen's variance, and those are
+/// what it chooses.
 pub const VARIANCE_FACTOR: f64 = 8.0;
 
 /// The value a pixel's light seen is compared by: the mean of its channels.

@@ -18,9 +18,8 @@
 //!   The count `N` is capped with the flux, so the estimate goes on as one that had gathered
 //!   the prior's photons; and a radius so narrow that the first passes would hand it fewer
 //!   photons than a cold slot's adaptive radius aims at is widened towards it (never beyond a
-//!   cold slot's), its value unchanged ([`Reopen`]). Kept at their converged radii, those few
-//!   new photons were noisier than a cold start's: on `scenes/teapot.toml` a warm restart
-//!   reached relative MSE 1e-2 after 8.5 s, a cold one after 6.5 s; widened, after 3.6 s.
+//!   cold slot's), its value unchanged ([`Reopen`]): kept at their converged radii, those few
+//!   new photons would be noisier than a cold start's.
 //! - **Estimates near a moved point.** A point that moved further (the edited surface, what is
 //!   seen through or in it) takes the previous estimate of the nearest point of any pixel
 //!   whose radius holds it and that faces the same way, the flux scaled by the ratio of the
@@ -50,15 +49,9 @@ use crate::scene::Scene;
 /// The most a kept pixel's previous estimate counts for, in passes of the epoch's first pass's
 /// photons (the photon ramp's first pass in the viewer, 16,384 photons: on
 /// `scenes/inline_patch.toml` at 480×360 the prior is then 131,072 photons, 0.19 of a full
-/// pass). Measured again on 2026-12-01 (release, medians of 5, a machine about 25 % slower
-/// than before): a prior of 32,768 photons 0.87 s, 65,536 0.86 s, 131,072 (this) 0.67–0.77 s,
-/// 700,000 0.87 s, 2,000,000 1.21 s, cold 0.80–0.93 s; a smaller cap only for the caustic
-/// (primary) estimate did not help (0.65–0.69 s). Chosen with `caustic bench edit` on `scenes/inline_patch.toml` (time to relative MSE 1e-2
-/// after the edit; development build, medians of 3 runs: 2 passes 0.71 s, 4 passes 0.63 s,
-/// 8 passes 0.55 s, cold 0.62–0.69 s; release, medians of 5: 8 passes 0.51–0.56 s, 12 passes
-/// 0.54 s, 16 passes 0.53 s, cold 0.62–0.67 s): a smaller prior lets the new photons' noise at
-/// the kept, narrow radii through; from 8 on, the old light where the edit changed it (the
-/// caustic's moved edge) is what is left.
+/// pass). Chosen with `caustic bench edit` (time from an edit to relative MSE 1e-2): a smaller
+/// prior lets the new photons' noise at the kept, narrow radii through; a larger one keeps the
+/// old light where the edit changed it (the caustic's moved edge) too long.
 pub const PRIOR_PASSES: f64 = 8.0;
 
 /// Where an epoch's random streams start: a warm epoch continues the previous one's, so its
