@@ -11,7 +11,7 @@
 //! * [`scene`]: the TOML scene format, validation, camera, materials, textures, lights.
 //! * [`render`]: the Whitted ray tracer, the film and its PNG/EXR output, random streams.
 //! * [`assets`]: the data the binary carries built in (Newell's teapot).
-//! * [`bench`]: measurement harnesses used by `caustic bench`.
+//! * [`mod@bench`]: measurement harnesses used by `caustic bench`.
 //! * [`farm`]: the Slurm script and Kubernetes manifest of a sharded render, every value
 //!   quoted by one function.
 //! * [`tev`]: streaming frames to a running tev viewer.

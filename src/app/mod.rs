@@ -14,7 +14,7 @@
 //! - [`params`]: parameters and the session commands their changes send; [`setting_ui`]:
 //!   each render setting's control, from the table of settings.
 //! - [`error_plot`]: the error estimate (and the true error against a reference) plotted
-//!   against time; [`reference`], [`difference`]: the reference image, the difference views
+//!   against time; [`mod@reference`], [`difference`]: the reference image, the difference views
 //!   and the A/B toggle.
 //! - [`save`], [`job`], [`file_dialog`]: dialogs (native, or inside the window where no native
 //!   one can be shown) and file writes off the UI thread; [`tev_send`]: the frame

@@ -149,7 +149,7 @@ const CIRCLE_SEGMENTS: usize = 32;
 
 /// The overlay for `patches` and `lights` (each with its aim point): each control net (rows
 /// and columns), each patch's four boundary curves, a marker per control point, and the lights'
-/// gizmos ([`light_gizmos`]); hovered and selected handles, and the nets of patches with a
+/// gizmos (`light_gizmos`); hovered and selected handles, and the nets of patches with a
 /// selected point, stand out.
 pub fn overlay_geometry(
     patches: &[BezierPatch],

@@ -1,6 +1,6 @@
 //! Measurement harnesses behind `caustic bench`: deterministic inputs, figures printed, never
 //! asserted (tests assert correctness; benches report speed). Error against time lives in
-//! [`error_curves`] (curves, CSV), [`plot`] (log-log PNG) and [`reference`] (the cached
+//! [`error_curves`] (curves, CSV), [`plot`] (log-log PNG) and [`mod@reference`] (the cached
 //! reference render).
 
 pub mod edit;

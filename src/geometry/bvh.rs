@@ -3,7 +3,7 @@
 //! flattened into a depth-first array, traversed with an explicit stack, at each node the child
 //! nearer along its split axis first (pbrt-v4's `BVHAggregate::Intersect`).
 //!
-//! The walk reads the interior nodes in a second layout ([`NodePair`]): each holds its two
+//! The walk reads the interior nodes in a second layout (`NodePair`): each holds its two
 //! children's boxes side by side, as wider BVHs do (Wald et al. 2008, "Getting rid of packets";
 //! Embree's BVH4 has four), so one step loads one record and tests both boxes with two-wide
 //! arithmetic. The records stay two-wide and in `f64`: a ray leaves a surface only 1e-9 of its

@@ -1,4 +1,4 @@
-//! What the table of render settings ([`super::params`]) says of each setting ([`Setting`]),
+//! What the table of render settings (`settings/params.rs`, [`super::SETTINGS`]) says of each setting ([`Setting`]),
 //! and the typed values behind it ([`Field`], [`Value`]): enough for the scene loader, the
 //! command line's flags ([`super::flags`]), the viewer's widgets and the benches to handle
 //! every setting the same way, by its key, without naming it.

@@ -36,7 +36,7 @@
 //! leaf whose window holds the departure point, or lies beside it, is ruled out at once when
 //! the Jacobian's sign is fixed over the leaf and agrees with its sign at the departure: the
 //! ray then crosses the leaf at most once and that crossing is the departure (see
-//! [`departure`]). Shadow rays from a patch's own points are most of a ray-traced patch
+//! `departure`). Shadow rays from a patch's own points are most of a ray-traced patch
 //! scene's rays.
 //!
 //! Sub-patch `(s,t)` map back to the original patch as `u = u0 + s(u1-u0)`, `v = v0 + t(v1-v0)`
@@ -134,10 +134,10 @@ pub struct PatchLeaf {
     pub scale: f64,
     /// The largest distance of the sub-patch's control points from the bilinear patch through
     /// its corners ([`BezierPatch::bilinear_deviation`]): in ray space the projected deviation
-    /// is no larger, so [`root::beside`] can often rule a ray out without measuring it.
+    /// is no larger, so the solver's `beside` test can often rule a ray out without measuring it.
     pub deviation: f64,
     /// A cone holding every normal of the sub-patch: tells a ray that leaves the leaf whether
-    /// the normal keeps one side towards it, before the leaf is projected ([`departure`]).
+    /// the normal keeps one side towards it, before the leaf is projected (`departure`).
     pub normals: NormalCone,
     /// A slab that holds the sub-patch: with `bounds`, rules out rays that pass through the
     /// box above or below a leaf lying oblique to the axes, before it is projected.

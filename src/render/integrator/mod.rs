@@ -1,6 +1,6 @@
 //! The seam between a render and its renderer: every renderer is an [`Integrator`] that
 //! renders a pass at a time and describes its own image and statistics ([`Frame`],
-//! [`FrameStats`]). The session, the command line and the viewer talk to it through this
+//! [`crate::render::frame::FrameStats`]). The session, the command line and the viewer talk to it through this
 //! interface only; which renderers exist, and whether each renders pass after pass or one
 //! frame per epoch, comes from the one list of renderers in `src/settings/renderer.rs`
 //! ([`RendererKind`]).

@@ -37,7 +37,7 @@ const BLOCK: usize = 1 << 16;
 /// Reflected radiance from every area light at each point (one sample each), handed to
 /// `add(k, light)` in point order: `point.weight × L × cos θ / pdf` where the shadow ray is
 /// clear. `key(k)` names point `k` stably across passes (its statistics slot), for the
-/// stratification. Sampled [`BLOCK`] points at a time, in parallel.
+/// stratification. Sampled `BLOCK` points at a time, in parallel.
 pub fn area_light_pass(
     scene: &Scene,
     points: &VisiblePoints,

@@ -120,7 +120,7 @@ pub struct Slot {
     pub prior: f32,
 }
 
-/// A primary estimate's restart with its adapted radius ([`Ppm::adapt_radii`]).
+/// A primary estimate's restart with its adapted radius (`Ppm::adapt_radii`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Restart {
     /// Not restarted: it counts every pass.

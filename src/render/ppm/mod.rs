@@ -11,11 +11,11 @@
 //! `N' = N + αM`, `R'² = R²·(N + αM)/(N + M)`, `τ' = (τ + φ)·(N + αM)/(N + M)`;
 //!
 //! and the radiance is `L = τ / (π R² N_emitted)` plus light seen directly (in stochastic
-//! passes supersampled where it changes within a pixel, [`seen`]). No brightness
+//! passes supersampled where it changes within a pixel, `seen`). No brightness
 //! factor: exposure belongs to the viewer. After the first pass, two per-point choices are
-//! made from its photon counts: the indirect estimate's radius ([`Ppm::widen_indirect`]) and
+//! made from its photon counts: the indirect estimate's radius (`Ppm::widen_indirect`) and
 //! a restart of the primary one, narrower where photons are dense and wider where they are
-//! sparse ([`Ppm::adapt_radii`], the adaptive radius: in the spirit of classic photon
+//! sparse (`Ppm::adapt_radii`, the adaptive radius: in the spirit of classic photon
 //! mapping's k-nearest-neighbour radius, Jensen 2001, chosen once and then shrunk by the
 //! paper's rule).
 //!
@@ -149,7 +149,7 @@ pub struct Ppm {
     pub photons_per_pass: u64,
     /// Photons of a full pass, what `photons_per_pass` ramps up to (the viewer's first passes
     /// are smaller): the adaptive radius tells sparse points by the photons such a pass
-    /// would hand them ([`Ppm::adapt_radii`]). The scene's photons per pass unless set.
+    /// would hand them (`Ppm::adapt_radii`). The scene's photons per pass unless set.
     pub full_pass_photons: u64,
     initial_radius: Option<f64>,
     slots: Vec<Slot>,
@@ -469,7 +469,7 @@ impl Ppm {
 
     /// What a frame shows per pixel — [`Ppm::radiance`], the largest search radius of the
     /// pixel's slots and the photons they gathered — each in one allocation, made in one
-    /// parallel sweep over the slots, [`SWEEP_BLOCK`] pixels a task (each block finds its
+    /// parallel sweep over the slots, `SWEEP_BLOCK` pixels a task (each block finds its
     /// first slot by a binary search: they lie in pixel order), rather than three serial ones;
     /// each pixel's values depend on it alone, so they are the same for any number of threads.
     pub fn pixel_layers(&self) -> PixelLayers {

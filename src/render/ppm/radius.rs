@@ -61,7 +61,7 @@ const SPARSE_NEIGHBOURHOOD: usize = 2;
 
 impl Ppm {
     /// The initial radius photon mapping would choose for `scene` by itself (its own
-    /// `initial_radius` ignored): see [`Ppm::automatic_radius`]. Traces one eye pass.
+    /// `initial_radius` ignored): see `Ppm::automatic_radius`. Traces one eye pass.
     pub fn automatic_initial_radius(scene: &Scene) -> f64 {
         let mut scene = scene.clone();
         scene.params.initial_radius = None;

@@ -29,7 +29,7 @@ pub struct PpmStats {
     /// first pass, where photons were sparse (adaptive radius; 0 before it or when off).
     pub widened_share: f64,
     /// Share of the pixels whose light seen directly takes extra eye rays every pass, where it
-    /// changes within the pixel (a lamp's outline and its images; [`super::seen`]).
+    /// changes within the pixel (a lamp's outline and its images; the `seen` module).
     pub supersampled_share: f64,
     /// Share of the pixels whose statistics a warm restart kept from the previous epoch (0
     /// for a cold start).

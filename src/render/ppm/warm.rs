@@ -18,7 +18,7 @@
 //!   The count `N` is capped with the flux, so the estimate goes on as one that had gathered
 //!   the prior's photons; and a radius so narrow that the first passes would hand it fewer
 //!   photons than a cold slot's adaptive radius aims at is widened towards it (never beyond a
-//!   cold slot's), its value unchanged ([`Reopen`]): kept at their converged radii, those few
+//!   cold slot's), its value unchanged (`Reopen`): kept at their converged radii, those few
 //!   new photons would be noisier than a cold start's.
 //! - **Estimates near a moved point.** A point that moved further (the edited surface, what is
 //!   seen through or in it) takes the previous estimate of the nearest point of any pixel
@@ -327,7 +327,7 @@ impl Ppm {
 
     /// Starts this (new, edited) epoch from `warm`: the radius choices, the guide and the
     /// random streams now; the statistics of unmoved pixels at the first eye pass
-    /// ([`Ppm::keep_unmoved`]). Ignored when the image size or the kind of eye pass differ,
+    /// (`Ppm::keep_unmoved`). Ignored when the image size or the kind of eye pass differ,
     /// or the points are missing (a stochastic render without [`PpmOptions::warm_restarts`]).
     ///
     /// [`PpmOptions::warm_restarts`]: super::PpmOptions::warm_restarts
