@@ -13,9 +13,10 @@ use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
 use super::gathered::Gathered;
+use super::index::SpatialIndex;
 use super::photon::Emitted;
 use super::points::VisiblePoints;
-use super::{Control, SpatialIndex};
+use crate::render::control::Control;
 
 /// Deposits one group of hits may hold before they are merged per slot: bounds memory when
 /// radii are large (every photon then reaches thousands of points).

@@ -1,14 +1,10 @@
 //! One progressive density estimate and its update rule (Hachisuka et al. 2008 §4:
 //! `N' = N + αM`, `R'² = R²·(N + αM)/(N + M)`, `τ' = (τ + Φ)·(N + αM)/(N + M)`), the statistics
-//! slot that holds a point's two estimates, and the update of every slot after a pass.
+//! slot that holds a point's two estimates.
 
 use std::f64::consts::PI;
 
-use super::gathered::Gathered;
-use super::radius::IndirectScale;
-use super::{Ppm, SWEEP_BLOCK};
 use glam::{DVec3, Vec3};
-use rayon::prelude::*;
 
 /// One progressive density estimate (Hachisuka et al. 2008 §4): search radius², photon
 /// count `N` and flux `τ`, updated after every pass. Stored in f32 (20 bytes instead of 40:
@@ -148,72 +144,6 @@ impl Slot {
             restart: Restart::None,
             prior: 0.0,
         }
-    }
-}
-
-impl Ppm {
-    /// Folds a completed pass into the slots and the statistics.
-    pub(super) fn update(&mut self, gathered: Gathered) {
-        if let (Some(guide), Some(tally)) = (&mut self.guide, &gathered.tally) {
-            guide.learn(tally);
-        }
-        // Compute new photon counts, radii and flux (Hachisuka et al. 2008, eqs. 6–11), slot by
-        // slot, [`SWEEP_BLOCK`] a task (memory-bound: 52-byte slots).
-        let alpha = self.alpha;
-        self.slots
-            .par_chunks_mut(SWEEP_BLOCK)
-            .enumerate()
-            .for_each(|(chunk, slots)| {
-                for (k, s) in (chunk * SWEEP_BLOCK..).zip(slots) {
-                    if s.restart == Restart::Pending {
-                        // The first pass's flux only stood in until this pass: it was
-                        // gathered over the wide radius.
-                        s.primary = Estimate::empty(s.primary.radius2());
-                        s.restart = Restart::Restarted;
-                    }
-                    s.primary.update(gathered.flux(k, 0), gathered.count(k, 0), alpha);
-                    s.indirect
-                        .update(gathered.flux(k, 1), gathered.count(k, 1), alpha);
-                }
-            });
-        if self.indirect_scale == IndirectScale::Automatic && self.stats.passes == 0 {
-            self.widen_indirect(&gathered);
-        }
-        if self.adaptive_radius && self.stats.passes == 0 {
-            self.first_pass_photons = self.pass_photons;
-            self.adapt_radii(&gathered);
-        }
-        if self.stochastic && self.options.warm_restarts {
-            self.last_points = self.point_records();
-        }
-        if self.stochastic {
-            self.forget_before_supersampling();
-            self.seen.tally(&self.pass_direct);
-            for (d, p) in self.direct.iter_mut().zip(self.pass_direct.drain(..)) {
-                *d += p.as_dvec3();
-            }
-            self.stats.eye_passes += 1;
-            self.seen.choose(self.stats.eye_passes);
-            self.seen.choose_by_variance(&self.direct, self.stats.eye_passes);
-            self.stats.supersampled_share = self.seen.count() as f64 / self.direct.len().max(1) as f64;
-        }
-        self.stats.passes += 1;
-        self.inherited = None;
-        self.stats.indirect_radius_scale = match self.indirect_scale {
-            IndirectScale::Fixed(k) => k,
-            _ => 1.0,
-        };
-        self.stats.photons += self.pass_photons;
-        self.stats.bounces += gathered.counts.bounces;
-        self.stats.deposits += gathered.counts.deposits;
-        self.stats.useful_paths += gathered.counts.useful;
-        self.stats.visible_points = self.points.len();
-        // Over the slots that have gathered photons; while none has (this estimate holds
-        // caustics only when direct light is sampled, and a scene may have none), over every
-        // slot with a radius: the radius in use, not 0.
-        self.stats.mean_radius = mean_primary_radius(&self.slots, |s| s.primary.n > 0.0)
-            .or_else(|| mean_primary_radius(&self.slots, Slot::has_radius))
-            .unwrap_or(0.0);
     }
 }
 

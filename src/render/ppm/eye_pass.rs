@@ -1,44 +1,78 @@
 //! The eye pass: visible points traced through the pixels — once for classic PPM (pinhole,
 //! no anti-aliasing; glass paths split), every pass for stochastic PPM (Hachisuka & Jensen
-//! 2009: one jittered point per pixel) — and light sampled at them for direct light.
+//! 2009: one jittered point per pixel) — and the spatial index over them.
 
-use std::time::Instant;
-
-use glam::{DVec2, DVec3, Vec3};
+use glam::{DVec2, DVec3};
 use rand::Rng;
 use rand_pcg::Pcg64Mcg;
 use rayon::prelude::*;
 
+use super::config::Config;
+use super::estimate::Slot;
+use super::hash_grid::HashGrid;
+use super::index::SpatialIndex;
+use super::kd_tree::KdTree;
+use super::light::LightSeen;
 use super::points::{self, Shade, VisiblePoints};
+use super::seen;
+use super::streams;
 use super::visible::{trace_eye, Branching, VisiblePoint};
-
-use super::{direct, global, seen, streams, Estimate, Ppm, Slot};
 use crate::render::rng::stream_rng;
 use crate::render::sequence;
 use crate::scene::Scene;
+use crate::settings::IndexKind;
 
-impl Ppm {
+/// A pass's visible points and the spatial index over them, kept while the points stay.
+#[derive(Default)]
+pub struct EyePass {
+    /// This pass's visible points (classic PPM: the one eye pass's).
+    pub points: VisiblePoints,
+    /// The hash grid over the points as they lie now, kept while no eye pass replaces them
+    /// (classic PPM traces one) for as long as it serves the shrinking radii
+    /// ([`HashGrid::serves`]).
+    kept_grid: Option<HashGrid>,
+}
+
+/// What an eye pass needs besides the scene: the render's choices, the pass whose random
+/// streams it uses, and what may interrupt it.
+pub struct EyeJob<'a> {
+    /// The render's choices.
+    pub config: &'a Config,
+    /// The pass of the random streams.
+    pub pass: u64,
+    /// Polled during the pass; true abandons it.
+    pub interrupt: Option<&'a (dyn Fn() -> bool + Send + Sync)>,
+}
+
+impl EyePass {
     /// Stochastic PPM's eye pass: one eye ray per pixel (jittered, through the lens), in
     /// parallel, written in place: each pixel's visible point (at most one: glass is chosen,
-    /// not split) into `points` at the pixel's index, its directly seen light into
-    /// `pass_direct`; pixels without a point are then squeezed out. Nothing is allocated per
-    /// pixel, and the buffers keep their capacity from pass to pass. `false` when interrupted
-    /// (the pass is then traced again, so the half-written buffers do not matter).
-    pub(super) fn trace_stochastic_eye_pass(&mut self, scene: &Scene) -> bool {
-        let (w, h) = (self.width as u64, self.height as u64);
-        let pass = self.stream_pass();
-        let (direct_light, seed) = (self.direct_light, self.seed);
-        let sequences = self
+    /// not split) into `points` at the pixel's index, its directly seen light into the pass's
+    /// light seen; pixels without a point are then squeezed out. Nothing is allocated per
+    /// pixel, and the buffers keep their capacity from pass to pass. With `observe`, the
+    /// pass's light seen chooses pixels to supersample ([`LightSeen::observe`]). `false` when
+    /// interrupted (the pass is then traced again, so the half-written buffers do not matter).
+    pub fn trace_stochastic(
+        &mut self,
+        job: &EyeJob,
+        scene: &Scene,
+        light: &mut LightSeen,
+        observe: bool,
+    ) -> bool {
+        let config = job.config;
+        let (w, h) = (config.width as u64, config.height as u64);
+        let pass = job.pass;
+        let (direct_light, seed) = (config.direct_light, config.seed);
+        let sequences = config
             .stratified_eye_rays
             .then(|| (sequence::r4(pass)[0], sequence::golden(pass)));
-        let interrupt = self.interrupt.as_deref();
+        let interrupt = job.interrupt;
         let skipped = std::sync::atomic::AtomicBool::new(false);
         let pixels = (w * h) as usize;
         // New points: the grid over the old ones no longer holds them.
         self.kept_grid = None;
         self.points.reset(pixels);
-        self.pass_direct.clear();
-        self.pass_direct.resize(pixels, Vec3::ZERO);
+        let (seen, pass_direct) = light.start_stochastic_pass();
         let rays = scene.camera.eye_rays();
         let subsampler = seen::Subsampler {
             scene,
@@ -46,15 +80,14 @@ impl Ppm {
             seed,
             pass,
             pixels: w * h,
-            stratified: self.stratified_eye_rays,
+            stratified: config.stratified_eye_rays,
             direct_light,
         };
-        let seen = &self.seen;
         let VisiblePoints { reach, shade } = &mut self.points;
         reach
             .par_iter_mut()
             .zip(shade.par_iter_mut())
-            .zip(self.pass_direct.par_iter_mut())
+            .zip(pass_direct.par_iter_mut())
             .enumerate()
             .for_each(|(i, ((reach, shade), direct))| {
                 if interrupt.is_some_and(|f| f()) {
@@ -93,127 +126,100 @@ impl Ppm {
         if skipped.into_inner() {
             return false;
         }
-        if self.global.as_ref().is_none_or(global::Global::learning) {
-            self.seen.observe(&self.pass_direct, w as usize);
+        if observe {
+            light.observe(w as usize);
         }
         self.points.drop_empty();
         true
     }
 
-    /// Classic PPM's one eye pass: an eye ray through each pixel centre, split at glass, rows
-    /// in parallel. Per pixel: the directly seen light; per visible point: the point, its
-    /// `slot` holding its pixel. `None` when interrupted.
-    pub(super) fn trace_classic_eye_pass(&self, scene: &Scene) -> Option<(Vec<DVec3>, Vec<VisiblePoint>)> {
-        let (w, h) = (self.width as u64, self.height as u64);
-        let pass = self.stream_pass();
-        let (direct_light, seed) = (self.direct_light, self.seed);
-        let interrupt = self.interrupt.as_deref();
-        let skipped = std::sync::atomic::AtomicBool::new(false);
-        let rays = scene.camera.eye_rays();
-        let rows: Vec<(Vec<DVec3>, Vec<VisiblePoint>)> = (0..h)
-            .into_par_iter()
-            .map(|y| {
-                let (mut direct, mut points) = (Vec::with_capacity(w as usize), Vec::new());
-                if interrupt.is_some_and(|f| f()) {
-                    skipped.store(true, std::sync::atomic::Ordering::Relaxed);
-                    return (direct, points);
-                }
-                for x in 0..w {
-                    let i = y * w + x;
-                    let mut rng = stream_rng(seed, streams::EYE, pass * w * h + i);
-                    let px = Scene::pixel_center(x as u32, y as u32);
-                    direct.push(trace_eye(
-                        scene,
-                        &rays.ray(px, DVec2::ZERO),
-                        i as u32,
-                        Branching::Split,
-                        direct_light,
-                        &mut rng,
-                        &mut |vp| points.push(vp),
-                    ));
-                }
-                (direct, points)
-            })
-            .collect();
-        if skipped.into_inner() {
-            return None;
+    /// Classic PPM's points: those of its one eye pass ([`trace_classic`]), each given a new
+    /// slot of its pixel (its `slot` holds the pixel until then) at the end of `slots`.
+    pub fn set_classic(&mut self, points: Vec<VisiblePoint>, slots: &mut Vec<Slot>) {
+        self.kept_grid = None;
+        self.points = points.into_iter().collect();
+        for shade in &mut self.points.shade {
+            let pixel = shade.slot;
+            shade.slot = slots.len() as u32;
+            slots.push(Slot::new(pixel));
         }
-        let mut direct = Vec::with_capacity((w * h) as usize);
-        let mut points = Vec::new();
-        for (d, p) in rows {
-            direct.extend(d);
-            points.extend(p);
-        }
-        Some((direct, points))
     }
 
-    /// Traces the eye pass; `false` when interrupted (nothing the next pass needs changed then).
-    pub(super) fn eye_pass(&mut self, scene: &Scene) -> bool {
-        if self.stochastic {
-            // A stochastic pass's directly seen light counts only when the pass completes.
-            if !self.trace_stochastic_eye_pass(scene) {
-                return false;
-            }
-            if self.slots.is_empty() {
-                self.slots = (0..self.width * self.height).map(Slot::new).collect();
-            }
-        } else {
-            // Classic PPM keeps its one eye pass at once: a slot per visible point.
-            let Some((direct, points)) = self.trace_classic_eye_pass(scene) else {
-                return false;
-            };
-            self.stats.eye_passes += 1;
-            for (d, p) in self.direct.iter_mut().zip(direct) {
-                *d += p;
-            }
-            self.kept_grid = None;
-            self.points = points.into_iter().collect();
-            for shade in &mut self.points.shade {
-                let pixel = shade.slot;
-                shade.slot = self.slots.len() as u32;
-                self.slots.push(Slot::new(pixel));
-            }
-        }
-        if self.stats.passes == 0 && self.slots.iter().all(|s| s.primary.radius2() == 0.0) {
-            let r0 = self
-                .initial_radius
-                .unwrap_or_else(|| self.automatic_radius(scene));
-            let indirect = self.indirect_scale.initial_radius(r0);
-            let primary = self.first_pass_radius2(r0 * r0);
-            for s in &mut self.slots {
-                s.primary = Estimate::empty(primary);
-                s.indirect = Estimate::empty(indirect * indirect);
-            }
-            self.initial_radius2 = r0 * r0;
-        }
-        if self.stats.passes == 0 && self.inherited.is_some() {
-            self.stats.kept_share = self.keep_unmoved();
-        }
-        true
+    /// The spatial index of kind `kind` over the points, their radii first copied from their
+    /// `slots` (the hash grid puts the points in its order; the last pass's grid is used
+    /// again, when `reuse` allows, if the points are the same and it serves their radii), and
+    /// each estimate's largest radius².
+    pub fn index(&mut self, slots: &[Slot], kind: IndexKind, reuse: bool) -> (SpatialIndex, [f32; 2]) {
+        let largest = self.points.set_radii(slots);
+        let reach = (largest[0].max(largest[1]) as f64).sqrt();
+        let index = match kind {
+            IndexKind::HashGrid => match self.kept_grid.take() {
+                Some(grid) if reuse && grid.serves(reach) => SpatialIndex::Grid(grid),
+                _ => {
+                    let (grid, mut order) = HashGrid::build(&self.points.reach);
+                    self.points.permute(&mut order);
+                    SpatialIndex::Grid(grid)
+                }
+            },
+            IndexKind::KdTree => SpatialIndex::Kd(KdTree::build(&self.points.reach)),
+        };
+        (index, largest)
     }
 
-    /// Adds one light sample of every area light at each visible point of this pass to the
-    /// per-pixel sums (when direct light is on; see [`direct`]).
-    pub(super) fn sample_area_lights(&mut self, scene: &Scene) {
-        if !self.direct_light || !direct::has_area_lights(scene) {
-            return;
+    /// Keeps the hash grid for the next pass, should its points not change.
+    pub fn keep(&mut self, index: SpatialIndex) {
+        if let SpatialIndex::Grid(grid) = index {
+            self.kept_grid = Some(grid);
         }
-        let start = Instant::now();
-        let (pass, seed) = (self.stream_pass(), self.seed);
-        let shade = &self.points.shade;
-        let key = |k: usize| shade[k].slot as u64;
-        let (slots, stochastic) = (&self.slots, self.stochastic);
-        let (pass_direct, area_direct) = (&mut self.pass_direct, &mut self.area_direct);
-        direct::area_light_pass(scene, &self.points, key, pass, seed, |k, l| {
-            let pixel = slots[shade[k].slot as usize].pixel as usize;
-            if stochastic {
-                pass_direct[pixel] += l.as_vec3();
-            } else {
-                area_direct[pixel] += l;
-            }
-        });
-        self.stats.direct_secs += start.elapsed().as_secs_f64();
     }
+}
+
+/// Classic PPM's one eye pass: an eye ray through each pixel centre, split at glass, rows
+/// in parallel. Per pixel: the directly seen light; per visible point: the point, its
+/// `slot` holding its pixel. `None` when interrupted.
+pub fn trace_classic(job: &EyeJob, scene: &Scene) -> Option<(Vec<DVec3>, Vec<VisiblePoint>)> {
+    let config = job.config;
+    let (w, h) = (config.width as u64, config.height as u64);
+    let pass = job.pass;
+    let (direct_light, seed) = (config.direct_light, config.seed);
+    let interrupt = job.interrupt;
+    let skipped = std::sync::atomic::AtomicBool::new(false);
+    let rays = scene.camera.eye_rays();
+    let rows: Vec<(Vec<DVec3>, Vec<VisiblePoint>)> = (0..h)
+        .into_par_iter()
+        .map(|y| {
+            let (mut direct, mut points) = (Vec::with_capacity(w as usize), Vec::new());
+            if interrupt.is_some_and(|f| f()) {
+                skipped.store(true, std::sync::atomic::Ordering::Relaxed);
+                return (direct, points);
+            }
+            for x in 0..w {
+                let i = y * w + x;
+                let mut rng = stream_rng(seed, streams::EYE, pass * w * h + i);
+                let px = Scene::pixel_center(x as u32, y as u32);
+                direct.push(trace_eye(
+                    scene,
+                    &rays.ray(px, DVec2::ZERO),
+                    i as u32,
+                    Branching::Split,
+                    direct_light,
+                    &mut rng,
+                    &mut |vp| points.push(vp),
+                ));
+            }
+            (direct, points)
+        })
+        .collect();
+    if skipped.into_inner() {
+        return None;
+    }
+    let mut direct = Vec::with_capacity((w * h) as usize);
+    let mut points = Vec::new();
+    for (d, p) in rows {
+        direct.extend(d);
+        points.extend(p);
+    }
+    Some((direct, points))
 }
 
 /// Pixel `i`'s eye-ray numbers in pass `pass`: its place in the pixel, its place on the lens

@@ -11,7 +11,7 @@ use super::photon::PhotonCounts;
 /// primary, 1 indirect; only the primary when the indirect estimate is off, which halves
 /// them), and counts. A pass's flux is summed in f32 (12 bytes instead of 24 per estimate);
 /// τ accumulates the passes.
-pub(super) struct Gathered {
+pub struct Gathered {
     phi: Vec<Vec3>,
     m: Vec<u32>,
     /// Estimates per slot held: 2, or 1 when the indirect estimate is off.

@@ -3,8 +3,9 @@
 
 use glam::DVec3;
 
+use super::hash_grid::HashGrid;
+use super::kd_tree::KdTree;
 use super::points::SearchSphere;
-use super::{HashGrid, KdTree};
 
 /// A built spatial index.
 pub enum SpatialIndex {

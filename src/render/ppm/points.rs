@@ -11,8 +11,8 @@ use rayon::prelude::*;
 #[cfg(test)]
 use super::estimate::Estimate;
 use super::estimate::Slot;
+use super::sweep::SWEEP_BLOCK;
 use super::visible::VisiblePoint;
-use super::SWEEP_BLOCK;
 
 /// A search sphere the spatial indices are built over: a centre and the radius² that reaches
 /// farthest.

@@ -1,21 +1,23 @@
 //! The choice of radii: the automatic initial radius (from the pixel footprint), the indirect
-//! estimate's radius chosen after the first pass ([`Ppm::widen_indirect`]) and the adaptive
+//! estimate's radius chosen after the first pass ([`RadiusPolicy::widen_indirect`]) and the adaptive
 //! radius, narrowed where photons are dense and widened where they are sparse
-//! ([`Ppm::adapt_radii`]; in the spirit of classic photon mapping's k-nearest-neighbour
+//! ([`RadiusPolicy::adapt_radii`]; in the spirit of classic photon mapping's k-nearest-neighbour
 //! radius, Jensen 2001, chosen once and then shrunk by the paper's rule).
 
+use super::estimate::{Estimate, Restart, Slot};
 use super::gathered::Gathered;
-use super::{Estimate, Ppm, PpmOptions, Restart};
+use super::points::VisiblePoints;
 use crate::scene::Scene;
+use crate::settings::RenderParams;
 
 /// How the indirect estimate's radius is chosen ([`RenderParams::indirect_radius_scale`]).
 ///
 /// [`RenderParams::indirect_radius_scale`]: crate::settings::RenderParams::indirect_radius_scale
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(super) enum IndirectScale {
+pub enum IndirectScale {
     /// One estimate for all photons.
     Off,
-    /// From the first pass's photon density ([`Ppm::widen_indirect`]).
+    /// From the first pass's photon density ([`RadiusPolicy::widen_indirect`]).
     Automatic,
     /// This multiple of the initial radius.
     Fixed(f64),
@@ -24,8 +26,8 @@ pub(super) enum IndirectScale {
 impl IndirectScale {
     /// The radius a cold slot's indirect estimate starts at, for the initial radius `r0`: none
     /// when it is off; `r0` while automatic (the first pass measures the photon density, and
-    /// [`Ppm::widen_indirect`] widens it after).
-    pub(super) fn initial_radius(self, r0: f64) -> f64 {
+    /// [`RadiusPolicy::widen_indirect`] widens it after).
+    pub fn initial_radius(self, r0: f64) -> f64 {
         match self {
             IndirectScale::Off => 0.0,
             IndirectScale::Automatic => r0,
@@ -35,62 +37,94 @@ impl IndirectScale {
 }
 
 /// Indirect photons an automatic indirect radius aims to hand each point per pass.
-pub(super) const INDIRECT_PHOTONS: f64 = 32.0;
+pub const INDIRECT_PHOTONS: f64 = 32.0;
 
 /// The widest automatic indirect radius, over the initial radius.
-pub(super) const MAX_INDIRECT_SCALE: f64 = 4.0;
+pub const MAX_INDIRECT_SCALE: f64 = 4.0;
 
 /// Photons a pass should hand a point after the radius is narrowed where photons are dense
-/// ([`Ppm::adapt_radii`]).
-pub(super) const DENSE_PHOTONS: f64 = 64.0;
+/// ([`RadiusPolicy::adapt_radii`]).
+pub const DENSE_PHOTONS: f64 = 64.0;
 
 /// The most an adaptive radius narrows a point's initial radius (in radius, not area).
-pub(super) const MAX_NARROWING: f64 = 4.0;
+pub const MAX_NARROWING: f64 = 4.0;
 
 /// Photons a pass should hand a point after the radius is widened where photons are sparse
-/// ([`Ppm::adapt_radii`]).
-pub(super) const SPARSE_PHOTONS: f64 = 2.0;
+/// ([`RadiusPolicy::adapt_radii`]).
+pub const SPARSE_PHOTONS: f64 = 2.0;
 
 /// The most an adaptive radius widens a point's initial radius (in radius, not area); also
 /// how much wider the first pass gathers.
-pub(super) const MAX_WIDENING: f64 = 2.0;
+pub const MAX_WIDENING: f64 = 2.0;
 
 /// How far, in pixels along each axis, a sparse point looks for denser light before its
-/// radius is widened ([`Ppm::adapt_radii`]): the initial radius is two pixels' footprint.
+/// radius is widened ([`RadiusPolicy::adapt_radii`]): the initial radius is two pixels' footprint.
 const SPARSE_NEIGHBOURHOOD: usize = 2;
 
-impl Ppm {
-    /// The initial radius photon mapping would choose for `scene` by itself (its own
-    /// `initial_radius` ignored): see `Ppm::automatic_radius`. Traces one eye pass.
-    pub fn automatic_initial_radius(scene: &Scene) -> f64 {
-        let mut scene = scene.clone();
-        scene.params.initial_radius = None;
-        let mut ppm = Ppm::new(&scene, PpmOptions::default());
-        if !ppm.eye_pass(&scene) || ppm.initial_radius2 <= 0.0 {
-            return 1e-3;
+/// How a render chooses its radii: the initial radius, the indirect estimate's scale and the
+/// adaptive radius, and what it chose.
+#[derive(Clone, Copy, Debug)]
+pub struct RadiusPolicy {
+    /// The initial radius the render parameters (or a warm restart) give; `None`: automatic
+    /// ([`automatic_radius`]).
+    pub initial_radius: Option<f64>,
+    /// The initial radius², once the first eye pass has chosen it.
+    pub initial_radius2: f64,
+    /// How the indirect estimate's radius is chosen (from the render parameters; then what
+    /// the first pass chose when automatic).
+    pub indirect_scale: IndirectScale,
+    /// Narrow the primary radius where the first pass found photons dense, widen it where
+    /// they are sparse (from the render parameters).
+    pub adaptive_radius: bool,
+}
+
+impl RadiusPolicy {
+    /// The policy `params` choose.
+    pub fn new(params: &RenderParams) -> Self {
+        Self {
+            initial_radius: params.initial_radius,
+            initial_radius2: 0.0,
+            indirect_scale: match params.indirect_radius_scale {
+                None => IndirectScale::Automatic,
+                Some(k) if k > 1.0 => IndirectScale::Fixed(k),
+                Some(_) => IndirectScale::Off,
+            },
+            adaptive_radius: params.adaptive_radius,
         }
-        // The initial radius itself, not the first pass's (wider with an adaptive radius).
-        ppm.initial_radius2.sqrt()
     }
 
-    /// The automatic initial radius: twice the footprint of one pixel at the median distance
-    /// of the visible points from the eye. (smallppm's rule — the visible points' bounding
-    /// box over the image size — explodes for an infinite floor reaching the horizon.)
-    pub(super) fn automatic_radius(&self, scene: &Scene) -> f64 {
-        let cam = &scene.camera;
-        let mut distances: Vec<f64> = self
-            .points
-            .reach
-            .iter()
-            .map(|p| (p.position - cam.position).dot(cam.forward).abs())
-            .collect();
-        if distances.is_empty() {
-            return 1e-3;
+    /// Estimates each slot gathers into: 2, or 1 when the indirect one is off.
+    pub fn estimates(&self) -> usize {
+        if self.indirect_scale == IndirectScale::Off {
+            1
+        } else {
+            2
         }
-        let mid = distances.len() / 2;
-        let median = *distances.select_nth_unstable_by(mid, f64::total_cmp).1;
-        let pixel = 2.0 * (0.5 * cam.fov_y).tan() / self.height as f64;
-        (2.0 * median * pixel).max(1e-9)
+    }
+
+    /// The indirect estimate's radius over the primary's, for the statistics (1: one estimate
+    /// for all photons, or not chosen yet).
+    pub fn indirect_scale_shown(&self) -> f64 {
+        match self.indirect_scale {
+            IndirectScale::Fixed(k) => k,
+            _ => 1.0,
+        }
+    }
+
+    /// After the first eye pass, before any slot has a radius: the initial radius (given, or
+    /// [`automatic_radius`] from `points`), and every slot's radii from it
+    /// ([`RadiusPolicy::first_pass_radius2`], [`IndirectScale::initial_radius`]).
+    pub fn start(&mut self, slots: &mut [Slot], points: &VisiblePoints, scene: &Scene) {
+        let r0 = self
+            .initial_radius
+            .unwrap_or_else(|| automatic_radius(points, scene));
+        let indirect = self.indirect_scale.initial_radius(r0);
+        let primary = self.first_pass_radius2(r0 * r0);
+        for s in slots {
+            s.primary = Estimate::empty(primary);
+            s.indirect = Estimate::empty(indirect * indirect);
+        }
+        self.initial_radius2 = r0 * r0;
     }
 
     /// After the first pass of an automatic indirect radius: widens every slot's indirect
@@ -100,15 +134,15 @@ impl Ppm {
     /// where they are dense (small closed rooms) `k` is 1 and the two estimates merge into
     /// one. The estimate is scaled as PPM's update assumes, for a density uniform within the
     /// radius: N and τ by the area. Counts are deterministic, so is `k`.
-    pub(super) fn widen_indirect(&mut self, gathered: &Gathered) {
-        let slots = self.slots.len().max(1) as f64;
-        let mean = gathered.indirect_counts().map(|c| c as f64).sum::<f64>() / slots;
+    pub fn widen_indirect(&mut self, slots: &mut [Slot], gathered: &Gathered) {
+        let count = slots.len().max(1) as f64;
+        let mean = gathered.indirect_counts().map(|c| c as f64).sum::<f64>() / count;
         let k = (INDIRECT_PHOTONS / mean).sqrt().clamp(1.0, MAX_INDIRECT_SCALE);
         if k == 1.0 {
             // Dense photons: the two estimates would share one radius, so they become one
             // (the second only costs memory and time). Each is brought to the smaller of the
             // two radii — N and τ scaled by the area, as PPM's update does — and summed.
-            for s in &mut self.slots {
+            for s in slots {
                 let r2 = s.primary.radius2().min(s.indirect.radius2());
                 let (p, i) = (s.primary.resized(r2), s.indirect.resized(r2));
                 s.primary = Estimate::new(r2, p.n() + i.n(), p.tau() + i.tau());
@@ -118,7 +152,7 @@ impl Ppm {
             return;
         }
         let area = k * k;
-        for s in &mut self.slots {
+        for s in slots {
             s.indirect = s.indirect.resized(s.indirect.radius2() * area);
         }
         self.indirect_scale = IndirectScale::Fixed(k);
@@ -127,8 +161,8 @@ impl Ppm {
     /// The radius² a cold slot's primary estimate gathers at in the first pass, for the initial
     /// radius² `r0_2`: with an adaptive radius [`MAX_WIDENING`] times wider, so that the pass
     /// counts photons over an area wide enough to tell a sparse point from an empty one
-    /// ([`Ppm::adapt_radii`]); `r0_2` otherwise.
-    pub(super) fn first_pass_radius2(&self, r0_2: f64) -> f64 {
+    /// ([`RadiusPolicy::adapt_radii`]); `r0_2` otherwise.
+    pub fn first_pass_radius2(&self, r0_2: f64) -> f64 {
         if self.adaptive_radius {
             r0_2 * MAX_WIDENING * MAX_WIDENING
         } else {
@@ -139,18 +173,18 @@ impl Ppm {
     /// After the first pass, with an adaptive radius: each cold slot's primary estimate
     /// (caustics, and all light when one estimate is kept) restarts at the second pass with a
     /// radius chosen from `m`, the photons that pass would have handed it within the initial
-    /// radius `R₀` (it gathered over [`MAX_WIDENING`]·`R₀`, [`Ppm::first_pass_radius2`]; `m`
-    /// is that count over the area ratio):
+    /// radius `R₀` (it gathered over [`MAX_WIDENING`]·`R₀`, [`RadiusPolicy::first_pass_radius2`];
+    /// `m` is that count over the area ratio):
     ///
     /// - **dense** (`m > DENSE_PHOTONS`): narrowed so that a pass hands it about that many,
     ///   `R² = R₀² · DENSE_PHOTONS / m`, at most [`MAX_NARROWING`] times narrower. PPM's bias
     ///   (the blur of sharp light such as a caustic's edge) grows with the radius and shrinks
     ///   only pass by pass, while its noise depends on photons per point: where they are dense
     ///   a narrower radius removes blur at once for little noise;
-    /// - **sparse** (`m⁺ < SPARSE_PHOTONS`, `m⁺` the photons a full pass would hand it within
-    ///   `R₀` counting one more than the first pass found, [`Ppm::full_pass_photons`]; and no
-    ///   point of a pixel within [`SPARSE_NEIGHBOURHOOD`] pixels has `2·SPARSE_PHOTONS` or
-    ///   more): widened so that a pass hands it about that many,
+    /// - **sparse** (`m⁺ < SPARSE_PHOTONS`, `m⁺` the photons a full pass of `full_pass`
+    ///   photons would hand it within `R₀` counting one more than the first pass, of
+    ///   `pass_photons`, found; and no point of a pixel within [`SPARSE_NEIGHBOURHOOD`] pixels
+    ///   has `2·SPARSE_PHOTONS` or more): widened so that a pass hands it about that many,
     ///   `R² = R₀² · SPARSE_PHOTONS / m⁺`, at most
     ///   [`MAX_WIDENING`] times wider and no wider than the indirect estimate (none when one
     ///   estimate holds all photons). Where a pass hands a point a photon or none (light
@@ -166,7 +200,15 @@ impl Ppm {
     /// uses. Counts are deterministic, so are the radii. The neighbours' counts matter where
     /// dim light lies beside bright (the focus of `scenes/lens.toml`, seen through the lens):
     /// widened there, a point would blur the bright light into its estimate.
-    pub(super) fn adapt_radii(&mut self, gathered: &Gathered) {
+    ///
+    /// Returns the shares of the slots narrowed and widened.
+    pub fn adapt_radii(
+        &self,
+        slots: &mut [Slot],
+        gathered: &Gathered,
+        (full_pass, pass_photons): (u64, u64),
+        (width, height): (u32, u32),
+    ) -> (f64, f64) {
         let merged = self.indirect_scale == IndirectScale::Off;
         let r0_2 = self.initial_radius2;
         let area = MAX_WIDENING * MAX_WIDENING;
@@ -181,7 +223,7 @@ impl Ppm {
         // kept, the indirect one's too, which gathered at R₀ itself. In f32, exact for counts
         // (quarters of integers below 2²⁴): at 1920×1080 these arrays are the first pass's
         // only extra memory, 8 MiB each.
-        let within: Vec<f32> = (0..self.slots.len())
+        let within: Vec<f32> = (0..slots.len())
             .map(|k| {
                 let wide = gathered.count(k, 0) as f64 / area;
                 (wide + if merged { gathered.count(k, 1) as f64 } else { 0.0 }) as f32
@@ -191,11 +233,11 @@ impl Ppm {
         // the first pass found: the viewer's first pass is smaller (16,384 photons), and its
         // few photons cannot tell a sparse point from one they missed (counting only what it
         // found would widen nearly every point after a cold restart).
-        let full = (self.full_pass_photons as f64 / self.pass_photons.max(1) as f64).max(1.0);
-        let pixels = self.slots.iter().map(|s| s.pixel);
-        let nearby = densest_nearby(pixels, &within, self.width, self.height);
+        let full = (full_pass as f64 / pass_photons.max(1) as f64).max(1.0);
+        let pixels = slots.iter().map(|s| s.pixel);
+        let nearby = densest_nearby(pixels, &within, width, height);
         let (mut narrowed, mut widened) = (0usize, 0usize);
-        for (k, s) in self.slots.iter_mut().enumerate() {
+        for (k, s) in slots.iter_mut().enumerate() {
             // A slot a warm restart kept has its radius already.
             if s.primary.radius2() <= 0.0 || s.prior > 0.0 {
                 continue;
@@ -217,10 +259,28 @@ impl Ppm {
             s.primary = s.primary.resized(r0_2 * factor);
             s.restart = Restart::Pending;
         }
-        let slots = self.slots.len().max(1) as f64;
-        self.stats.narrowed_share = narrowed as f64 / slots;
-        self.stats.widened_share = widened as f64 / slots;
+        let count = slots.len().max(1) as f64;
+        (narrowed as f64 / count, widened as f64 / count)
     }
+}
+
+/// The automatic initial radius: twice the footprint of one pixel at the median distance
+/// of the visible `points` from the eye. (smallppm's rule — the visible points' bounding
+/// box over the image size — explodes for an infinite floor reaching the horizon.)
+pub fn automatic_radius(points: &VisiblePoints, scene: &Scene) -> f64 {
+    let cam = &scene.camera;
+    let mut distances: Vec<f64> = points
+        .reach
+        .iter()
+        .map(|p| (p.position - cam.position).dot(cam.forward).abs())
+        .collect();
+    if distances.is_empty() {
+        return 1e-3;
+    }
+    let mid = distances.len() / 2;
+    let median = *distances.select_nth_unstable_by(mid, f64::total_cmp).1;
+    let pixel = 2.0 * (0.5 * cam.fov_y).tan() / cam.height as f64;
+    (2.0 * median * pixel).max(1e-9)
 }
 
 /// For every slot (its pixel in `pixels`), the most photons `within` gives any slot of a
@@ -260,7 +320,6 @@ fn densest_nearby(
 
 #[cfg(test)]
 mod tests {
-    use super::super::Slot;
     use super::*;
 
     /// One dense pixel in a 9×7 image: it is the densest light of every pixel within

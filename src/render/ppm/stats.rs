@@ -1,5 +1,8 @@
 //! What a photon-mapping render measured ([`PpmStats`]).
 
+use super::photon::PhotonCounts;
+use crate::scene::Scene;
+
 /// Run statistics.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
 pub struct PpmStats {
@@ -51,4 +54,58 @@ pub struct PpmStats {
     pub eye_passes: u32,
     /// Work the scene did not need, in words.
     pub skipped: Vec<String>,
+}
+
+impl PpmStats {
+    /// Adds a completed pass's `emitted` photons and what they did.
+    pub fn count_photons(&mut self, emitted: u64, counts: &PhotonCounts) {
+        self.photons += emitted;
+        self.bounces += counts.bounces;
+        self.deposits += counts.deposits;
+        self.useful_paths += counts.useful;
+    }
+
+    /// After the global schedule's pilot pass: the counts start again at pass 0 (the pilot's
+    /// time stays in the elapsed time; classic PPM keeps its one eye pass).
+    pub fn restart_after_pilot(&mut self, stochastic: bool) {
+        self.passes = 0;
+        self.photons = 0;
+        self.bounces = 0;
+        self.deposits = 0;
+        self.useful_paths = 0;
+        if stochastic {
+            self.eye_passes = 0;
+        }
+        self.skipped.push(
+            "per-point statistics: every pass is an independent estimate (global radius schedule)".into(),
+        );
+    }
+}
+
+/// What a render of `scene` skips because the scene does not need it, in words (the render's
+/// statistics list it); `stochastic`: whether the eye pass is traced anew every pass.
+pub fn skipped_work(scene: &Scene, stochastic: bool) -> Vec<String> {
+    let features = scene.features();
+    let mut skipped = Vec::new();
+    if !stochastic {
+        skipped.push("eye pass traced once and reused (pinhole camera, no anti-aliasing)".to_owned());
+    }
+    if !features.patches {
+        skipped.push("no Bézier patches: no patch intersection set up".to_owned());
+    }
+    if !features.glass {
+        skipped.push("no glass: no refraction paths".to_owned());
+    }
+    if !features.textures {
+        skipped.push("no textures: constant colours, no lookups".to_owned());
+    }
+    if scene.params.direct_light {
+        skipped.push("photons' first diffuse bounce: direct light by light sampling".to_owned());
+    }
+    if let Some(target) = scene.geometry.bounding_sphere() {
+        if scene.lights.iter().any(|l| l.aims_at(target)) {
+            skipped.push("photons from point lights outside the scene aimed at its bounds".to_owned());
+        }
+    }
+    skipped
 }

@@ -34,17 +34,17 @@
 //! An epoch interrupted before its first pass completed hands on what it inherited, so a drag
 //! that moves faster than a pass still warms each step from the last image that was made.
 
-use super::estimate::{Estimate, Restart, Slot};
+use super::estimate::{Estimate, Slot};
 use super::guide::EmissionGuide;
+use super::hash_grid::HashGrid;
+use super::light::PriorLight;
 use super::points::VisiblePoints;
-use super::radius::{IndirectScale, DENSE_PHOTONS, INDIRECT_PHOTONS};
+use super::radius::{IndirectScale, RadiusPolicy, DENSE_PHOTONS, INDIRECT_PHOTONS};
 use super::visible::VisiblePoint;
-use super::Ppm;
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
 use crate::geometry::Aabb;
-use crate::scene::Scene;
 
 /// The most a kept pixel's previous estimate counts for, in passes of the epoch's first pass's
 /// photons (the photon ramp's first pass in the viewer, 16,384 photons: on
@@ -64,25 +64,30 @@ pub struct StreamOffset {
     pub photons: u64,
 }
 
-/// What an epoch hands to the next after an edit ([`Ppm::into_warm_start`]).
+/// What an epoch hands to the next after an edit ([`super::Ppm::into_warm_start`]).
 #[derive(Clone, Debug)]
 pub struct WarmStart {
-    size: (u32, u32),
-    stochastic: bool,
+    /// The image size.
+    pub(super) size: (u32, u32),
+    /// Whether the eye pass was stochastic.
+    pub(super) stochastic: bool,
     /// The statistics, each with its flux counted as [`Slot::prior`] photons (not yet capped),
     /// in pixel order.
-    slots: Vec<Slot>,
+    pub(super) slots: Vec<Slot>,
     /// Each slot's visible point in the last completed eye pass.
-    points: Vec<PointRecord>,
+    pub(super) points: Vec<PointRecord>,
     /// Per pixel, the light seen directly, as sums over the passes they count.
-    light: Vec<PriorLight>,
-    initial_radius2: f64,
-    indirect_scale: IndirectScale,
-    guide: Option<EmissionGuide>,
+    pub(super) light: Vec<PriorLight>,
+    /// The initial radius².
+    pub(super) initial_radius2: f64,
+    /// The indirect estimate's radius choice.
+    pub(super) indirect_scale: IndirectScale,
+    /// The emission guide as it learned.
+    pub(super) guide: Option<EmissionGuide>,
     /// Lights moved since the guide learned (they forget).
-    moved_lights: Vec<usize>,
+    pub(super) moved_lights: Vec<usize>,
     /// The streams after the last completed pass.
-    next: StreamOffset,
+    pub(super) next: StreamOffset,
 }
 
 impl WarmStart {
@@ -94,41 +99,17 @@ impl WarmStart {
     }
 }
 
-/// A pixel's light seen directly, kept by a warm restart: sums over as many earlier eye passes
-/// (emission and point lights) and passes (area lights), added to the epoch's own.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub(super) struct PriorLight {
-    pub(super) direct: DVec3,
-    pub(super) direct_passes: f64,
-    pub(super) area: DVec3,
-    pub(super) area_passes: f64,
-}
-
-impl PriorLight {
-    /// The same means, counted as at most `passes` passes, scaled by `factor`.
-    fn capped(self, passes: f64, factor: DVec3) -> Self {
-        let d = self.direct_passes.min(passes);
-        let a = self.area_passes.min(passes);
-        Self {
-            direct: self.direct / self.direct_passes.max(1.0) * d * factor,
-            direct_passes: d,
-            area: self.area / self.area_passes.max(1.0) * a * factor,
-            area_passes: a,
-        }
-    }
-}
-
 /// A slot's visible point, kept compactly (36 bytes) for the next epoch to compare with; all
 /// zero for a slot without one.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub(super) struct PointRecord {
+pub struct PointRecord {
     position: Vec3,
     normal: Vec3,
     weight: Vec3,
 }
 
 /// Each of `slots` slots' visible point among `points` (each point names its slot).
-pub(super) fn records(slots: usize, points: &VisiblePoints) -> Vec<PointRecord> {
+pub fn records(slots: usize, points: &VisiblePoints) -> Vec<PointRecord> {
     let mut out = vec![PointRecord::default(); slots];
     for (r, s) in points.reach.iter().zip(&points.shade) {
         out[s.slot as usize] = PointRecord {
@@ -164,7 +145,7 @@ fn carry(old: &PointRecord, new: &PointRecord, radius2: f64) -> Option<DVec3> {
 
 /// How a kept estimate is reopened for the new epoch ([`Reopen::prior`]).
 #[derive(Clone, Copy, Debug)]
-struct Reopen {
+pub(super) struct Reopen {
     /// Photons of the epoch's first pass (a prior is worth at most [`PRIOR_PASSES`] of them,
     /// [`Reopen::cap`]).
     first_pass: f64,
@@ -181,14 +162,14 @@ impl Reopen {
     }
 
     /// A previous slot as a prior for a new point, its flux scaled by `factor` for the new
-    /// point's weight. It is worth at most [`Reopen::cap`] photons: flux and count `N` scaled
+    /// point's weight. It is worth at most `Reopen::cap` photons: flux and count `N` scaled
     /// down with the photons it counts, so that it behaves as an estimate that gathered that
     /// many. And
-    /// each estimate is widened ([`Reopen::widened`]) where its converged, narrow radius would
+    /// each estimate is widened (`Reopen::widened`) where its converged, narrow radius would
     /// hand the new epoch's first passes too few photons: at the old radius those few new
     /// photons are noisier than a cold start's (on the built-in teapot a warm restart reached
     /// the error 1e-2 later than a cold one).
-    fn prior(&self, mut slot: Slot, factor: DVec3) -> Slot {
+    pub fn prior(&self, mut slot: Slot, factor: DVec3) -> Slot {
         let prior = slot.prior as f64;
         let cap = self.cap();
         let scale = if prior > cap { cap / prior } else { 1.0 };
@@ -208,8 +189,8 @@ impl Reopen {
     }
 
     /// `e` (an estimate that counts `photons` emitted photons) brought to the radius at which
-    /// a first pass would hand it about `aim` photons — as [`Ppm::adapt_radii`] and
-    /// [`Ppm::widen_indirect`] choose a cold slot's — never narrower than it is nor wider than
+    /// a first pass would hand it about `aim` photons — as [`RadiusPolicy::adapt_radii`] and
+    /// [`RadiusPolicy::widen_indirect`] choose a cold slot's — never narrower than it is nor wider than
     /// a cold slot's `ceiling2`; `N` and `τ` scaled by the area as PPM's update assumes, so its
     /// value is unchanged. Its density is taken from `N`, which grows by `α M` a pass; the
     /// photons counted then fell within radii at least as wide, so it errs towards less
@@ -249,150 +230,91 @@ fn runs(slots: &[Slot]) -> Vec<(u32, std::ops::Range<usize>)> {
     out
 }
 
-impl Ppm {
+/// An epoch's part in warm restarts: where its random streams start, what it inherited, and
+/// the points of its last completed stochastic pass.
+#[derive(Default)]
+pub(super) struct Epoch {
+    /// Where this epoch's random streams start (after the previous epoch's, when warm).
+    pub offset: StreamOffset,
+    /// What a warm restart inherited, until the first pass completes.
+    pub inherited: Option<WarmStart>,
+    /// Per slot, its visible point in the last completed stochastic pass, with
+    /// [`PpmOptions::warm_restarts`] ([`records`]).
+    ///
+    /// [`PpmOptions::warm_restarts`]: super::PpmOptions::warm_restarts
+    pub last_points: Vec<PointRecord>,
+}
+
+impl Epoch {
     /// Whether this epoch continues an earlier one's estimates (it inherited a warm start).
     pub fn is_warm(&self) -> bool {
         self.offset != StreamOffset::default()
     }
 
-    /// Each slot's visible point of the last eye pass (see [`records`]).
-    pub(super) fn point_records(&self) -> Vec<PointRecord> {
-        records(self.slots.len(), &self.points)
-    }
-
-    /// What this epoch hands to the next after an edit: `None` when it learned nothing (no
-    /// pass completed and nothing inherited).
-    pub fn into_warm_start(mut self) -> Option<WarmStart> {
-        if self.global.is_some() {
-            // Every pass of the global schedule is its own estimate at a scheduled radius:
-            // there are no per-point statistics to keep.
-            return None;
-        }
-        if self.stats.passes == 0 {
-            return self.inherited;
-        }
-        // A stochastic eye pass interrupted since the last completed pass left its points
-        // half written: the records kept at that pass count (see `update`).
-        let points = if self.stochastic {
-            std::mem::take(&mut self.last_points)
-        } else {
-            self.point_records()
-        };
-        let light = (0..self.direct.len())
-            .map(|i| {
-                let prior = self.prior_light.get(i).copied().unwrap_or_default();
-                PriorLight {
-                    direct: self.direct[i] + prior.direct,
-                    direct_passes: self.seen.passes(i, self.stats.eye_passes) as f64 + prior.direct_passes,
-                    area: self.area_direct.get(i).copied().unwrap_or_default() + prior.area,
-                    area_passes: self.stats.passes as f64 + prior.area_passes,
-                }
-            })
-            .collect();
-        let emitted = self.stats.photons as f64;
-        let restarted = (self.stats.photons - self.first_pass_photons) as f64;
-        let slots = self
-            .slots
-            .iter()
-            .map(|s| {
-                // Both estimates brought to one count of photons: the indirect one's.
-                let all = emitted + s.prior as f64;
-                let primary = match s.restart {
-                    Restart::Restarted => restarted + s.prior as f64,
-                    _ => all,
-                };
-                let mut kept = *s;
-                kept.primary.scale_tau(DVec3::splat(all / primary.max(1.0)));
-                kept.prior = all as f32;
-                kept.restart = Restart::None;
-                kept
-            })
-            .collect();
-        Some(WarmStart {
-            size: (self.width, self.height),
-            stochastic: self.stochastic,
-            slots,
-            points,
-            light,
-            initial_radius2: self.initial_radius2,
-            indirect_scale: self.indirect_scale,
-            guide: self.guide,
-            moved_lights: Vec::new(),
-            next: StreamOffset {
-                passes: self.offset.passes + self.stats.passes as u64,
-                photons: self.offset.photons + self.stats.photons,
-            },
-        })
-    }
-
-    /// Starts this (new, edited) epoch from `warm`: the radius choices, the guide and the
-    /// random streams now; the statistics of unmoved pixels at the first eye pass
-    /// (`Ppm::keep_unmoved`). Ignored when the image size or the kind of eye pass differ,
-    /// or the points are missing (a stochastic render without [`PpmOptions::warm_restarts`]).
-    ///
-    /// [`PpmOptions::warm_restarts`]: super::PpmOptions::warm_restarts
-    pub fn inherit(&mut self, scene: &Scene, warm: WarmStart) {
-        if self.global.is_some()
-            || warm.size != (self.width, self.height)
-            || warm.stochastic != self.stochastic
-            || warm.points.len() != warm.slots.len()
-            || self.stats.passes > 0
-        {
-            return;
-        }
-        self.initial_radius = Some(warm.initial_radius2.sqrt());
-        self.indirect_scale = warm.indirect_scale;
-        if let (Some(guide), true) = (&warm.guide, self.guide.is_some()) {
-            let cap = (PRIOR_PASSES * self.photons_per_pass as f64) as u64;
-            if let Some(prior) = guide.as_prior(scene, cap, &warm.moved_lights) {
-                self.guide = Some(prior);
-            }
-        }
-        // The first eye pass repeats the previous epoch's last one, so that unmoved points
-        // come out equal; photons continue after the previous epoch's.
+    /// Inherits `warm`: the first eye pass repeats the previous epoch's last one, so that
+    /// unmoved points come out equal; photons continue after the previous epoch's.
+    pub fn inherit(&mut self, warm: WarmStart) {
         self.offset = StreamOffset {
             passes: warm.next.passes.saturating_sub(1),
             photons: warm.next.photons,
         };
         self.inherited = Some(warm);
     }
+}
 
-    /// How this epoch reopens the estimates it keeps ([`Reopen`]): after its first eye pass,
-    /// when the initial radius is set.
-    fn reopen(&self) -> Reopen {
-        let r0_2 = self.initial_radius2;
-        let indirect = self.indirect_scale.initial_radius(r0_2.sqrt());
+/// What a warm restart kept at the epoch's first eye pass ([`WarmStart::keep_unmoved`]).
+pub(super) struct Kept {
+    /// Share of the pixels whose slots were kept.
+    pub kept_share: f64,
+    /// Share of the pixels warmed by an estimate near their moved points.
+    pub nearby_share: f64,
+    /// Per pixel, the light seen directly that was kept.
+    pub light: Vec<PriorLight>,
+}
+
+impl Reopen {
+    /// How an epoch whose radius choices are `radius` (after its first eye pass, when the
+    /// initial radius is set), with `alpha` and `first_pass` photons in its first pass,
+    /// reopens the estimates it keeps.
+    pub fn new(radius: &RadiusPolicy, alpha: f64, first_pass: u64) -> Self {
+        let r0_2 = radius.initial_radius2;
+        let indirect = radius.indirect_scale.initial_radius(r0_2.sqrt());
         Reopen {
-            first_pass: self.photons_per_pass as f64,
-            alpha: self.alpha,
+            first_pass: first_pass as f64,
+            alpha,
             ceiling2: [r0_2, indirect * indirect],
         }
     }
+}
 
-    /// After the first eye pass of an inheriting epoch: every pixel whose visible points are
-    /// where they were (or moved by at most [`NEAR`] of their radius) keeps its slots'
-    /// statistics, the flux capped to a prior of [`PRIOR_PASSES`] first passes. Returns the
-    /// share of pixels kept.
-    pub(super) fn keep_unmoved(&mut self) -> f64 {
-        let Some(warm) = &self.inherited else {
-            return 0.0;
-        };
-        let reopen = self.reopen();
-        let now = self.point_records();
-        let mut light = vec![PriorLight::default(); self.direct.len()];
-        let mut carried = vec![false; self.slots.len()];
+impl WarmStart {
+    /// After the first eye pass of an epoch that inherited this (of a `size` image, whose
+    /// `slots` have their visible points `now`): every pixel whose visible points are where
+    /// they were (or moved by at most [`NEAR`] of their radius) keeps its slots' statistics,
+    /// the flux capped to a prior of [`PRIOR_PASSES`] first passes; the slots of moved points
+    /// near a previous point take its estimate (`WarmStart::carry_nearby`).
+    pub(super) fn keep_unmoved(
+        &self,
+        slots: &mut [Slot],
+        now: &[PointRecord],
+        reopen: &Reopen,
+        size: (u32, u32),
+    ) -> Kept {
+        let pixels = size.0 as usize * size.1 as usize;
+        let mut light = vec![PriorLight::default(); pixels];
+        let mut carried = vec![false; slots.len()];
         // Pixels and their slots, as runs of slots: one slot a pixel (stochastic) needs no
         // search, so both sides are simply zipped.
-        let (old, new) = if self.stochastic && warm.slots.len() == self.slots.len() {
+        let (old, new) = if self.stochastic && self.slots.len() == slots.len() {
             let one = |s: &[Slot]| {
                 s.iter()
                     .enumerate()
                     .map(|(k, s)| (s.pixel, k..k + 1))
                     .collect::<Vec<_>>()
             };
-            (one(&warm.slots), one(&self.slots))
+            (one(&self.slots), one(slots))
         } else {
-            (runs(&warm.slots), runs(&self.slots))
+            (runs(&self.slots), runs(slots))
         };
         // Whether each run's points all carry, decided in parallel.
         let carries: Vec<Option<(usize, DVec3)>> = new
@@ -408,7 +330,7 @@ impl Ppm {
                 (old_range.len() == range.len()).then_some(())?;
                 let mut first = None;
                 for (from, to) in old_range.clone().zip(range.clone()) {
-                    let f = carry(&warm.points[from], &now[to], warm.slots[from].primary.radius2())?;
+                    let f = carry(&self.points[from], &now[to], self.slots[from].primary.radius2())?;
                     first.get_or_insert((o?, f));
                 }
                 first
@@ -420,30 +342,35 @@ impl Ppm {
                 continue;
             };
             let old_range = &old[o].1;
-            light[*pixel as usize] = warm.light[*pixel as usize].capped(PRIOR_PASSES, first);
+            light[*pixel as usize] = self.light[*pixel as usize].capped(PRIOR_PASSES, first);
             for (from, to) in old_range.clone().zip(range.clone()) {
-                let factor = carry(&warm.points[from], &now[to], warm.slots[from].primary.radius2())
+                let factor = carry(&self.points[from], &now[to], self.slots[from].primary.radius2())
                     .unwrap_or(DVec3::ONE);
-                self.slots[to] = reopen.prior(warm.slots[from], factor);
+                slots[to] = reopen.prior(self.slots[from], factor);
             }
             kept += 1;
             carried[range.clone()].iter_mut().for_each(|c| *c = true);
         }
-        self.prior_light = light;
-        let nearby = self.carry_nearby(&now, &carried, &reopen);
-        let pixels = (self.width as f64 * self.height as f64).max(1.0);
-        self.stats.nearby_share = nearby as f64 / pixels;
-        kept as f64 / pixels
+        let nearby = self.carry_nearby(slots, now, &carried, reopen);
+        let pixels = (size.0 as f64 * size.1 as f64).max(1.0);
+        Kept {
+            kept_share: kept as f64 / pixels,
+            nearby_share: nearby as f64 / pixels,
+            light,
+        }
     }
 
     /// For each slot of a moved pixel whose new visible point lies within the radius of a
     /// previous one (any pixel's, facing the same way): that estimate as its prior, the flux
     /// scaled by the ratio of the two points' weights (the estimate's density of arriving
     /// light is the same there, up to PPM's own blur). Returns the pixels so warmed.
-    fn carry_nearby(&mut self, now: &[PointRecord], carried: &[bool], reopen: &Reopen) -> usize {
-        let Some(warm) = &self.inherited else {
-            return 0;
-        };
+    fn carry_nearby(
+        &self,
+        slots: &mut [Slot],
+        now: &[PointRecord],
+        carried: &[bool],
+        reopen: &Reopen,
+    ) -> usize {
         // Only previous points near the points left to warm are looked among.
         let left = now
             .iter()
@@ -453,8 +380,8 @@ impl Ppm {
         if left.is_empty() {
             return 0;
         }
-        let near = left.padded(warm.initial_radius2.sqrt());
-        let old: Vec<VisiblePoint> = warm
+        let near = left.padded(self.initial_radius2.sqrt());
+        let old: Vec<VisiblePoint> = self
             .points
             .par_iter()
             .enumerate()
@@ -464,10 +391,10 @@ impl Ppm {
                 position: r.position.as_dvec3(),
                 normal: r.normal.as_dvec3(),
                 weight: r.weight.as_dvec3(),
-                radius2: warm.slots[k].primary.radius2(),
+                radius2: self.slots[k].primary.radius2(),
             })
             .collect();
-        let (grid, order) = super::HashGrid::build(&old);
+        let (grid, order) = HashGrid::build(&old);
         let old: Vec<VisiblePoint> = order.iter().map(|&k| old[k as usize]).collect();
         // Each slot left: the nearest previous point whose radius holds it, found in parallel.
         let found: Vec<(usize, u32, DVec3)> = now
@@ -496,9 +423,9 @@ impl Ppm {
             .collect();
         let mut warmed = std::collections::BTreeSet::new();
         for (to, from, factor) in found {
-            let mut slot = reopen.prior(warm.slots[from as usize], factor);
-            slot.pixel = self.slots[to].pixel;
-            self.slots[to] = slot;
+            let mut slot = reopen.prior(self.slots[from as usize], factor);
+            slot.pixel = slots[to].pixel;
+            slots[to] = slot;
             warmed.insert(slot.pixel);
         }
         warmed.len()
