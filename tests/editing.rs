@@ -77,6 +77,11 @@ fn viewer<'h>(h: &'h App<'_>) -> &'h Viewer {
     h.state().as_ref().expect("viewer")
 }
 
+/// The control points as edited.
+fn edited_patches(h: &App<'_>) -> Vec<BezierPatch> {
+    viewer(h).patches().copied().collect()
+}
+
 /// The selected control points (light handles left out).
 fn selected_points(v: &Viewer) -> Vec<PointRef> {
     v.selection().filter_map(Handle::control).collect()
@@ -142,7 +147,7 @@ fn last_move(commands: &[Command], r: PointRef) -> Option<DVec3> {
 #[test]
 fn click_selects_drag_moves_by_the_camera_geometry_and_undo_redo_restore() {
     let mut h = editing_app();
-    let original: Vec<BezierPatch> = viewer(&h).patches().to_vec();
+    let original: Vec<BezierPatch> = edited_patches(&h);
     let (r, s) = isolated_point(viewer(&h));
     let near = s + Vec2::new(3.0, 2.0);
 
@@ -159,7 +164,7 @@ fn click_selects_drag_moves_by_the_camera_geometry_and_undo_redo_restore() {
     drag(&mut h, near, by, PointerButton::Primary);
     let p0 = original[r.patch].points[r.index];
     let p1 = last_move(&sent(&h), r).expect("the drag sent moves");
-    assert_eq!(viewer(&h).patches()[r.patch].points[r.index], p1);
+    assert_eq!(edited_patches(&h)[r.patch].points[r.index], p1);
     let cam = &viewer(&h).scene().camera;
     let depth = |p: DVec3| (p - cam.position).dot(cam.forward);
     assert!((depth(p1) - depth(p0)).abs() < 1e-6 * depth(p0), "depth changed");
@@ -175,12 +180,12 @@ fn click_selects_drag_moves_by_the_camera_geometry_and_undo_redo_restore() {
     // Undo restores the scene exactly (and tells the session); redo re-applies.
     h.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);
     h.step();
-    assert_eq!(viewer(&h).patches(), &original[..]);
+    assert_eq!(edited_patches(&h), original);
     assert_eq!(last_move(&sent(&h), r), Some(p0));
     assert!(!viewer(&h).unsaved_edits());
     h.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, egui::Key::Z);
     h.step();
-    assert_eq!(viewer(&h).patches()[r.patch].points[r.index], p1);
+    assert_eq!(edited_patches(&h)[r.patch].points[r.index], p1);
 
     // Dragging empty image space pans the image, moving no point.
     let before = sent(&h).len();
@@ -200,7 +205,7 @@ fn a_seam_point_moves_with_its_twins_so_the_patches_stay_joined() {
     let mut h = editing_app();
     let v = viewer(&h);
     let proj = v.projection().expect("placed").clone();
-    let patches = v.patches().to_vec();
+    let patches: Vec<BezierPatch> = v.patches().copied().collect();
     let all: Vec<(PointRef, DVec3)> = control_points(&patches).collect();
     // A point shared by two patches, with no other point near it on screen.
     let (r, s) = all
@@ -218,11 +223,11 @@ fn a_seam_point_moves_with_its_twins_so_the_patches_stay_joined() {
     drag(&mut h, s, by, PointerButton::Primary);
     let twins: Vec<PointRef> = selected_points(viewer(&h));
     assert!(twins.len() >= 2 && twins.contains(&r), "{twins:?}");
-    let moved = viewer(&h).patches()[r.patch].points[r.index];
+    let moved = edited_patches(&h)[r.patch].points[r.index];
     assert_ne!(moved, patches[r.patch].points[r.index]);
     for t in &twins {
         assert_eq!(
-            viewer(&h).patches()[t.patch].points[t.index],
+            edited_patches(&h)[t.patch].points[t.index],
             moved,
             "{t:?} left behind"
         );
@@ -232,7 +237,7 @@ fn a_seam_point_moves_with_its_twins_so_the_patches_stay_joined() {
 #[test]
 fn a_whole_patch_moves_as_one_and_the_arrow_keys_nudge_it() {
     let mut h = editing_app();
-    let original: Vec<BezierPatch> = viewer(&h).patches().to_vec();
+    let original: Vec<BezierPatch> = edited_patches(&h);
     let (r, s) = isolated_point(viewer(&h));
     pointer(&mut h, s, PointerButton::Primary, true, Modifiers::NONE);
     pointer(&mut h, s, PointerButton::Primary, false, Modifiers::NONE);
@@ -250,7 +255,7 @@ fn a_whole_patch_moves_as_one_and_the_arrow_keys_nudge_it() {
         .all(|s| s.patch == r.patch || own.contains(&original[s.patch].points[s.index])));
     h.key_press(egui::Key::ArrowRight);
     h.step();
-    let moved = &viewer(&h).patches()[r.patch];
+    let moved = edited_patches(&h)[r.patch];
     let delta = moved.points[0] - original[r.patch].points[0];
     assert!(delta.length() > 0.0);
     for k in 0..16 {
@@ -261,7 +266,7 @@ fn a_whole_patch_moves_as_one_and_the_arrow_keys_nudge_it() {
     assert!(delta.normalize().dot(cam.right) > 0.999999);
     h.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);
     h.step();
-    assert_eq!(viewer(&h).patches(), &original[..]);
+    assert_eq!(edited_patches(&h), original);
 }
 
 #[test]
@@ -286,6 +291,62 @@ fn the_camera_orbits_from_the_view_and_undo_puts_it_back() {
     assert_eq!(viewer(&h).scene().camera, camera);
 }
 
+/// The scene `opened` with `commands` applied as the render session applies them.
+fn replayed(mut scene: Scene, commands: &[Command]) -> Scene {
+    for command in commands {
+        match command {
+            Command::SetParams(p) => scene.params = p.clone(),
+            Command::SetCamera(c) => scene.camera = c.clone(),
+            Command::MoveControlPoint {
+                patch,
+                index,
+                position,
+            } => assert!(scene.geometry.set_control_point(*patch, *index, *position)),
+            Command::SetLight { light, value } => assert!(scene.set_light(*light, *value)),
+            _ => {}
+        }
+    }
+    scene
+}
+
+#[test]
+fn the_commands_sent_bring_the_sessions_scene_to_the_edited_one() {
+    use caustic::app::action::Action;
+    let mut h = editing_app();
+    let opened = viewer(&h).scene().clone();
+    // A point dragged, a light moved, the camera orbited, α and the lens changed: each from
+    // where a person does it.
+    let (r, at) = isolated_point(viewer(&h));
+    drag(&mut h, at, Vec2::new(25.0, -15.0), PointerButton::Primary);
+    let view = viewer(&h).projection().expect("placed").view;
+    drag(
+        &mut h,
+        view.center(),
+        Vec2::new(40.0, 10.0),
+        PointerButton::Secondary,
+    );
+    let lamp = light_handle(0, LightPart::Place);
+    let place = viewer(&h).handle_position(lamp).expect("the lamp");
+    let v = h.state_mut().as_mut().expect("viewer");
+    v.apply(Action::SetPoint(lamp, place + DVec3::new(0.1, 0.0, -0.05)));
+    let mut p = v.params();
+    p.render.alpha = 0.5;
+    p.aperture = 0.01;
+    v.apply(Action::SetParams(p));
+    h.run_steps(2);
+
+    let edited = viewer(&h).scene().clone();
+    assert_ne!(edited_patches(&h)[r.patch], opened.geometry.patches()[r.patch].0);
+    assert_ne!(edited.lights, opened.lights);
+    assert_ne!(edited.camera.position, opened.camera.position);
+    assert_eq!((edited.params.alpha, edited.camera.aperture), (0.5, 0.01));
+    let session = replayed(opened, &sent(&h));
+    assert_eq!(session.params, edited.params);
+    assert_eq!(session.camera, edited.camera);
+    assert_eq!(session.lights, edited.lights);
+    assert_eq!(session.geometry.patches(), edited.geometry.patches());
+}
+
 #[test]
 fn the_edited_scene_saves_and_loads_back_with_the_same_patches() {
     let mut h = editing_app();
@@ -306,7 +367,7 @@ fn the_edited_scene_saves_and_loads_back_with_the_same_patches() {
     assert!(!viewer(&h).unsaved_edits());
     let back = Scene::load(&path).expect("the saved scene loads");
     let patches: Vec<BezierPatch> = back.geometry.patches().iter().map(|(p, _)| *p).collect();
-    assert_eq!(patches, viewer(&h).patches());
+    assert_eq!(patches, edited_patches(&h));
     assert_ne!(patches[r.patch], Scene::builtin().geometry.patches()[r.patch].0);
     // Saving again over it asks first; Cancel keeps the file byte for byte.
     let before = std::fs::read(&path).expect("saved");

@@ -145,7 +145,7 @@ fn each_slider_sends_its_command() {
         ("Max depth", 3.0, |p| p.max_depth = 3),
     ];
     for (label, value, change) in cases {
-        let mut expected = viewer(&h).params.render.clone();
+        let mut expected = viewer(&h).params().render.clone();
         change(&mut expected);
         set_slider(&mut h, label, value);
         assert_eq!(
@@ -173,7 +173,7 @@ fn each_slider_sends_its_command() {
         .click();
     h.step();
     h.step();
-    let radius = viewer(&h).params.manual.get("initial_radius").copied();
+    let radius = viewer(&h).params().manual.get("initial_radius").copied();
     assert!(radius.is_some_and(|r| r > 0.0), "the slider's value: {radius:?}");
     assert_eq!(initial_radius(&h), radius);
     set_slider(&mut h, "Initial radius", 0.01);
@@ -395,7 +395,7 @@ fn a_render_thread_panic_is_shown_and_the_renderer_can_restart() {
     // the way a real one arrives.
     let calls = std::sync::atomic::AtomicU32::new(0);
     let failing = RenderSession::start_with(
-        viewer(&h).edited_scene(),
+        viewer(&h).scene().clone(),
         SessionOptions::default(),
         Some(Box::new(move || {
             if calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed) == 1 {
@@ -664,7 +664,7 @@ fn the_replace_and_restart_questions_answer_enter_and_escape() {
     step_until(&mut h, "two passes", |v| v.frame().is_some_and(|f| f.pass >= 2));
     let paused = caustic::app::params::PanelParams {
         paused: true,
-        ..viewer(&h).params.clone()
+        ..viewer(&h).params()
     };
     viewer_mut(&mut h).set_params(paused);
     for (key, replaced) in [(egui::Key::Escape, false), (egui::Key::Enter, true)] {
@@ -732,7 +732,7 @@ fn watching_a_folder_merges_each_new_part_and_skips_what_does_not_belong() {
     let w = viewer(&h).watching().expect("watching").clone();
     assert_eq!((w.total, w.parts), (6, 1));
     assert!(w.relative_error.is_some_and(|e| e > 0.0 && e.is_finite()));
-    assert!(viewer(&h).params.paused, "the renderer pauses while watching");
+    assert!(viewer(&h).paused(), "the renderer pauses while watching");
     // A new part lands: the image now holds 4 passes.
     write_part(&scene, 1, 3, 6, &dir.path().join("part_1.exr"));
     step_until(&mut h, "the second part", |v| {
@@ -788,7 +788,7 @@ fn watching_a_folder_merges_each_new_part_and_skips_what_does_not_belong() {
     h.step();
     h.step();
     assert!(viewer(&h).watching().is_none());
-    assert!(!viewer(&h).params.paused, "rendering again");
+    assert!(!viewer(&h).paused(), "rendering again");
 }
 
 #[test]

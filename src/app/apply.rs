@@ -5,7 +5,6 @@
 use glam::DVec3;
 
 use super::action::{Action, AfterDiscard};
-use super::editor::Editor;
 use super::editor::{Edit, Gesture};
 use super::handle::{Handle, PointRef};
 use super::settings::EXPOSURE_LIMIT;
@@ -96,12 +95,12 @@ impl Viewer {
                 }
             }
             Action::Select { point, add } => {
-                if !self.editor.exists(point) {
+                if !self.editor.exists(&self.document, point) {
                     return;
                 }
                 // A point shared by patches (a seam) is selected with its twins, so the
                 // patches stay joined when it moves.
-                let welded = self.editor.welded(point);
+                let welded = self.editor.welded(&self.document, point);
                 if !add {
                     self.editor.selection = welded.into_iter().collect();
                 } else if self.editor.selection.contains(&point) {
@@ -125,20 +124,23 @@ impl Viewer {
                 };
                 let inside: Vec<Handle> = self
                     .editor
-                    .handles()
+                    .handles(&self.document)
                     .filter(|(_, q)| projection.to_screen(*q).is_some_and(|s| rect.contains(s)))
                     .map(|(r, _)| r)
                     .collect();
                 for r in inside {
-                    let welded = self.editor.welded(r);
+                    let welded = self.editor.welded(&self.document, r);
                     self.editor.selection.extend(welded);
                 }
                 self.editor.touch();
             }
             Action::SelectPatch(patch) => {
-                if patch < self.editor.patches.len() {
+                if patch < self.document.patches().len() {
                     let points = (0..16).map(|index| Handle::Control(PointRef { patch, index }));
-                    self.editor.selection = points.flat_map(|r| self.editor.welded(r)).collect();
+                    let state = &mut self.state;
+                    state.editor.selection = points
+                        .flat_map(|r| state.editor.welded(&state.document, r))
+                        .collect();
                     self.editor.touch();
                 }
             }
@@ -154,15 +156,21 @@ impl Viewer {
     fn apply_gesture(&mut self, action: Action) {
         match action {
             Action::BeginPointDrag { grab, press } => {
-                let on_screen = self.editor.exists(grab).then(|| self.editor.point(grab));
+                let doc = &self.state.document;
+                let on_screen = self
+                    .editor
+                    .exists(doc, grab)
+                    .then(|| self.editor.point(doc, grab));
                 let on_screen = on_screen.and_then(|q| self.projection.as_ref()?.to_screen(q));
                 if let Some(grab_screen) = on_screen {
                     // Dragging an unselected point selects it (with its twins at seams).
                     if !self.editor.selection.contains(&grab) {
-                        self.editor.selection = self.editor.welded(grab).into_iter().collect();
+                        let state = &mut self.state;
+                        state.editor.selection =
+                            state.editor.welded(&state.document, grab).into_iter().collect();
                         self.editor.touch();
                     }
-                    let start = self.editor.selected_points();
+                    let start = self.editor.selected_points(&self.document);
                     self.editor.gesture = Some(Gesture::Points {
                         grab,
                         grab_screen,
@@ -180,7 +188,7 @@ impl Viewer {
             Action::BeginCameraDrag(how) => {
                 self.editor.gesture = Some(Gesture::Camera {
                     how,
-                    start: (self.scene.camera.clone(), self.editor.pivot),
+                    start: (self.scene().camera.clone(), self.editor.pivot),
                 });
             }
             Action::DragCamera(delta) => {
@@ -204,17 +212,18 @@ impl Viewer {
             }
             Action::Nudge(step) => {
                 if let Some(proj) = &self.projection {
-                    let moves = self.editor.nudge(proj, step);
+                    let moves = self.editor.nudge(&self.document, proj, step);
                     let changed = self.move_points(&moves);
                     self.record(Edit::Points(changed));
                 }
             }
             Action::FrameSelection => {
-                let before = (self.scene.camera.clone(), self.editor.pivot);
-                let (centre, radius) = self.editor.selection_sphere();
-                let camera = super::navigate::frame(&self.scene.camera, centre, radius, self.editor.world_up);
+                let before = (self.scene().camera.clone(), self.editor.pivot);
+                let (centre, radius) = self.editor.selection_sphere(&self.document);
+                let camera =
+                    super::navigate::frame(&self.scene().camera, centre, radius, self.editor.world_up);
                 self.set_camera(camera, centre);
-                let after = (self.scene.camera.clone(), self.editor.pivot);
+                let after = (self.scene().camera.clone(), self.editor.pivot);
                 self.record(Edit::Camera { before, after });
             }
             Action::Undo => {
@@ -248,13 +257,13 @@ impl Viewer {
             Some(Gesture::Points { start, .. }) => {
                 let moves = start
                     .into_iter()
-                    .map(|(r, before)| (r, before, self.editor.point(r)))
+                    .map(|(r, before)| (r, before, self.editor.point(&self.document, r)))
                     .filter(|(_, a, b)| a != b)
                     .collect();
                 self.record(Edit::Points(moves));
             }
             Some(Gesture::Camera { start, .. }) => {
-                let after = (self.scene.camera.clone(), self.editor.pivot);
+                let after = (self.scene().camera.clone(), self.editor.pivot);
                 self.record(Edit::Camera { before: start, after });
             }
             None => {}
@@ -272,30 +281,20 @@ impl Viewer {
         }
     }
 
-    /// Moves handles (control points, lights) and tells the render session; returns what
-    /// changed.
+    /// Moves handles (control points, lights) in the document and sends the render session
+    /// the changes; returns what moved.
     fn move_points(&mut self, moves: &[(Handle, DVec3)]) -> Vec<(Handle, DVec3, DVec3)> {
-        let changed = self.editor.set_points(moves);
-        for (h, _, position) in &changed {
-            if let Handle::Control(r) = h {
-                self.send(Command::MoveControlPoint {
-                    patch: r.patch,
-                    index: r.index,
-                    position: *position,
-                });
-            }
-        }
-        for light in Editor::lights_in(&changed) {
-            let value = self.editor.lights[light];
-            self.send(Command::SetLight { light, value });
+        let state = &mut self.state;
+        let (changed, changes) = state.editor.set_points(&mut state.document, moves);
+        for change in changes {
+            self.send_change(change);
         }
         changed
     }
 
-    /// Places the camera (pose from `camera`, lens from the panel's parameters) and the
-    /// orbit pivot, and tells the render session.
+    /// Places the camera (pose from `camera`, lens the document's) and the orbit pivot, and
+    /// tells the render session.
     fn set_camera(&mut self, camera: Camera, pivot: DVec3) {
-        let camera = self.params.lens_on(&camera);
         if !(camera.position.is_finite() && camera.forward.is_finite() && pivot.is_finite()) {
             self.status = Some(Status::Error(
                 "camera move ignored: it left the scene's numbers".into(),
@@ -303,9 +302,8 @@ impl Viewer {
             return;
         }
         self.editor.pivot = pivot;
-        if camera != self.scene.camera {
-            self.scene.camera = camera.clone();
-            self.send(Command::SetCamera(camera));
+        if let Some(change) = self.state.document.set_pose(&camera) {
+            self.send_change(change);
         }
     }
 }

@@ -116,7 +116,7 @@ impl DragStage {
         self.frames += 1;
         let Some(at) = self.sent else {
             if self.press.is_none() {
-                let point = viewer.patches()[DRAG_POINT.patch].points[DRAG_POINT.index];
+                let point = viewer.document.patch(DRAG_POINT.patch)?.points[DRAG_POINT.index];
                 self.press = viewer.projection().and_then(|p| p.to_screen(point));
             }
             let screen = self.press?;
@@ -260,7 +260,7 @@ impl Automation {
                 *total_ui / *frames as f64,
             );
             // Then the same with the renderer paused: what the UI costs by itself here.
-            let mut p = viewer.params.clone();
+            let mut p = viewer.params();
             if *paused {
                 self.fps_paused = Some(figures);
                 p.paused = false;
@@ -282,7 +282,7 @@ impl Automation {
         match sent {
             None => {
                 // Move the aperture slider's value, exactly as a drag would.
-                let mut p = viewer.params.clone();
+                let mut p = viewer.params();
                 let open = viewer.ranges.aperture_max * 0.02;
                 p.aperture = if *round % 2 == 0 { open } else { 0.0 };
                 viewer.set_params(p);
@@ -295,7 +295,7 @@ impl Automation {
                     *round += 1;
                     *sent = None;
                     if *round == LATENCY_ROUNDS {
-                        self.stage = if viewer.patches().is_empty() {
+                        self.stage = if viewer.patches().len() == 0 {
                             Stage::Screenshot { requested: false }
                         } else {
                             Stage::Drag(DragStage {
@@ -406,7 +406,7 @@ impl Automation {
                 println!("  UI frame rate while dragging:  {fps:.1} fps");
             }
             let secs = crate::bench::time_reprepare(
-                &viewer.edited_scene().geometry,
+                &viewer.scene().geometry,
                 DRAG_POINT.patch,
                 DRAG_POINT.index,
                 21,
@@ -444,10 +444,10 @@ const PREVIEW_REFERENCE_PASSES: u32 = 100;
 fn drag_preview_error(viewer: &Viewer) -> Result<String, String> {
     use crate::bench::edit::{measure_edit, EditPlan, ON_SCREEN_AFTER};
     use crate::bench::timings::median;
-    let edited = viewer.edited_scene();
+    let edited = viewer.scene();
     let position = edited.geometry.patches()[DRAG_POINT.patch].0.points[DRAG_POINT.index];
     let mut before = edited.clone();
-    let start = viewer.scene().geometry.patches()[DRAG_POINT.patch].0.points[DRAG_POINT.index];
+    let start = viewer.document.loaded_patches()[DRAG_POINT.patch].points[DRAG_POINT.index];
     before
         .geometry
         .set_control_point(DRAG_POINT.patch, DRAG_POINT.index, start);

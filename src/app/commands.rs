@@ -223,7 +223,7 @@ pub const COMMANDS: &[Command] = &[
         shortcuts: &[(NONE, Key::Space)],
         menu: Menu::None,
         action: |v| {
-            let mut p = v.params.clone();
+            let mut p = v.params();
             p.paused = !p.paused;
             Some(Action::SetParams(p))
         },

@@ -47,7 +47,7 @@ pub fn menu_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Action>) {
         });
         ui.menu_button("Help", |ui| commands::menu_ui(viewer, Menu::Help, ui, out));
         ui.separator();
-        ui.label(RichText::new(viewer.scene.source.display().to_string()).weak())
+        ui.label(RichText::new(viewer.scene().source.display().to_string()).weak())
             .on_hover_text("The scene file being rendered");
     });
 }
@@ -119,15 +119,16 @@ pub fn side_panel_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Acti
         watching_ui(w, ui, out);
         ui.separator();
     }
-    let mut p = viewer.params.clone();
+    let shown = viewer.params();
+    let mut p = shown.clone();
     render_section_ui(viewer, &mut p, ui, out);
     renderer_section_ui(&mut p, viewer.ranges, ui);
     camera_section_ui(&mut p, viewer.ranges, ui);
-    if p != viewer.params {
+    if p != shown {
         out.push(Action::SetParams(p));
     }
 
-    if !(viewer.patches().is_empty() && viewer.lights().is_empty()) {
+    if !(viewer.patches().len() == 0 && viewer.lights().is_empty()) {
         ui.separator();
         super::edit_panel::edit_panel_ui(viewer, ui, out);
     }
@@ -224,7 +225,7 @@ fn camera_section_ui(p: &mut PanelParams, ranges: Ranges, ui: &mut egui::Ui) {
 fn statistics_ui(viewer: &ViewerState, ui: &mut egui::Ui) {
     ui.heading("Statistics");
     if viewer.restart_pending() {
-        let what = if viewer.params.render.renderer.progressive() {
+        let what = if viewer.scene().params.renderer.progressive() {
             "Restarting: first pass of the new settings..."
         } else {
             "Rendering the frame..."

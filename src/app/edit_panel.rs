@@ -5,6 +5,7 @@ use egui::RichText;
 
 use super::action::Action;
 use super::commands::{Menu, COMMANDS};
+use super::document::Document;
 use super::editor::Editor;
 use super::handle::{Handle, LightPart};
 use super::state::ViewerState;
@@ -38,7 +39,7 @@ pub fn edit_panel_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Acti
     {
         out.push(Action::ShowWireframe(nets));
     }
-    selection_ui(editor, ui, out);
+    selection_ui(editor, &viewer.document, ui, out);
     // The Edit menu's commands, as buttons.
     ui.horizontal_wrapped(|ui| {
         for c in COMMANDS.iter().filter(|c| c.menu == Menu::Edit) {
@@ -71,18 +72,18 @@ pub fn edit_panel_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Acti
 
 /// What is selected: a hint when nothing is, one handle's name and exact x/y/z fields, or a
 /// count of the points, patches and light handles.
-fn selection_ui(editor: &Editor, ui: &mut egui::Ui, out: &mut Vec<Action>) {
+fn selection_ui(editor: &Editor, doc: &Document, ui: &mut egui::Ui, out: &mut Vec<Action>) {
     let n = editor.selection.len();
     match editor.selection.first() {
         None => {
             ui.label(RichText::new("Click a control point or a light to select it (Shift adds).").weak());
         }
         Some(&first) if n == 1 => {
-            let (label, size) = handle_label(editor, first);
+            let (label, size) = handle_label(editor, doc, first);
             ui.label(label);
             // A drag of the field moves about a thousandth of the patch (or scene) per point.
             let speed = (size * 1e-3).max(1e-6);
-            if let Some(p) = coordinates_ui(ui, editor.point(first), speed) {
+            if let Some(p) = coordinates_ui(ui, editor.point(doc, first), speed) {
                 out.push(Action::SetPoint(first, p));
             }
         }
@@ -105,7 +106,7 @@ fn selection_ui(editor: &Editor, ui: &mut egui::Ui, out: &mut Vec<Action>) {
 /// A handle's name in the panel and the size its fields step by a thousandth of: its patch's
 /// diagonal, or for a light four times its aim distance (the scene's diagonal until a drag of
 /// the aim changed it).
-fn handle_label(editor: &Editor, h: Handle) -> (String, f64) {
+fn handle_label(editor: &Editor, doc: &Document, h: Handle) -> (String, f64) {
     match h {
         Handle::Control(r) => (
             format!(
@@ -115,7 +116,7 @@ fn handle_label(editor: &Editor, h: Handle) -> (String, f64) {
                 r.index / 4,
                 r.index % 4
             ),
-            editor.patches[r.patch].bounds().diagonal().length(),
+            doc.patch(r.patch).map_or(1.0, |p| p.bounds().diagonal().length()),
         ),
         Handle::Light(l) => (
             format!(

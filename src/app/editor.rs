@@ -1,7 +1,9 @@
-//! Shaping patches and placing lights by hand: the control points and lights as edited, the
-//! selection and hover of their handles ([`Handle`]), the gesture in progress (dragging
-//! handles, or orbiting/panning/dollying the camera), and the undo history. The editor only keeps state and does the geometry of a gesture; the viewer
-//! ([`super::Viewer::apply`]) carries actions out and tells the render session.
+//! Shaping patches and placing lights by hand: the selection and hover of their handles
+//! ([`Handle`]), the gesture in progress (dragging handles, or orbiting/panning/dollying the
+//! camera), and the undo history. The control points and lights themselves are the
+//! document's ([`Document`]): the editor keeps the state of editing and does the geometry of a
+//! gesture; the viewer ([`super::Viewer::apply`]) carries actions out and sends the document's
+//! changes to the render session.
 
 use std::collections::BTreeSet;
 use std::sync::Arc;
@@ -9,10 +11,10 @@ use std::sync::Arc;
 use egui::{Pos2, Vec2};
 use glam::DVec3;
 
+use super::document::{Change, Document};
 use super::handle::{light_handles, light_place, Handle, LightPart, LightRef};
 use super::navigate;
 use super::overlay::{control_points, overlay_geometry, OverlayProjection, PICK_RADIUS};
-use crate::geometry::BezierPatch;
 use crate::gpu::wireframe::WireframeGeometry;
 use crate::scene::{Camera, Light, Scene};
 
@@ -138,12 +140,6 @@ impl History {
 
 /// The editing state of the open scene.
 pub struct Editor {
-    /// Control points as edited (geometry order).
-    pub patches: Vec<BezierPatch>,
-    /// Control points as the scene file gave them.
-    pub loaded: Vec<BezierPatch>,
-    /// Lights as edited (scene order).
-    pub lights: Vec<Light>,
     /// Each light's aim distance: a spot's [`LightPart::Aim`] handle lies this far along its
     /// axis (where the last drag of it left it).
     pub aims: Vec<f64>,
@@ -170,7 +166,6 @@ pub struct Editor {
 impl Editor {
     /// The editor for a freshly opened scene.
     pub fn new(scene: &Scene) -> Self {
-        let patches: Vec<BezierPatch> = scene.geometry.patches().iter().map(|(p, _)| *p).collect();
         let cam = &scene.camera;
         let bounds = scene.geometry.bounds();
         let aim = if bounds.is_empty() {
@@ -179,9 +174,6 @@ impl Editor {
             (0.25 * bounds.diagonal().length()).max(1e-3)
         };
         Self {
-            loaded: patches.clone(),
-            patches,
-            lights: scene.lights.clone(),
             aims: vec![aim; scene.lights.len()],
             selection: BTreeSet::new(),
             rubber_band: None,
@@ -197,11 +189,11 @@ impl Editor {
     }
 
     /// Position of a handle: a control point, a light's place, a spot's aim point.
-    pub fn point(&self, h: Handle) -> DVec3 {
+    pub fn point(&self, doc: &Document, h: Handle) -> DVec3 {
         match h {
-            Handle::Control(r) => self.patches[r.patch].points[r.index],
+            Handle::Control(r) => doc.patch(r.patch).map_or(DVec3::ZERO, |p| p.points[r.index]),
             Handle::Light(LightRef { light, part }) => {
-                let l = &self.lights[light];
+                let l = &doc.lights()[light];
                 match (part, l) {
                     (LightPart::Aim, Light::Spot { direction, .. }) => {
                         light_place(l) + *direction * self.aims[light]
@@ -215,48 +207,50 @@ impl Editor {
     /// `h` and every other control point at the same place (within a billionth of its patch's
     /// size): the points a seam or a collapsed edge shares, which move together. A light's
     /// handle has no twins.
-    pub fn welded(&self, h: Handle) -> Vec<Handle> {
-        if !self.exists(h) {
+    pub fn welded(&self, doc: &Document, h: Handle) -> Vec<Handle> {
+        if !self.exists(doc, h) {
             return Vec::new();
         }
         let Handle::Control(r) = h else {
             return vec![h];
         };
-        let p = self.point(h);
-        let tolerance = 1e-9 * self.patches[r.patch].bounds().diagonal().length();
-        let twins = control_points(&self.patches).filter(|(o, q)| *o != r && (*q - p).length() <= tolerance);
+        let p = self.point(doc, h);
+        let tolerance = doc
+            .patch(r.patch)
+            .map_or(0.0, |q| 1e-9 * q.bounds().diagonal().length());
+        let twins = control_points(doc.patches()).filter(|(o, q)| *o != r && (*q - p).length() <= tolerance);
         std::iter::once(h)
             .chain(twins.map(|(o, _)| Handle::Control(o)))
             .collect()
     }
 
     /// Whether `h` names a handle of this scene.
-    pub fn exists(&self, h: Handle) -> bool {
+    pub fn exists(&self, doc: &Document, h: Handle) -> bool {
         match h {
-            Handle::Control(r) => r.patch < self.patches.len() && r.index < 16,
-            Handle::Light(l) => self
-                .lights
+            Handle::Control(r) => r.patch < doc.patches().len() && r.index < 16,
+            Handle::Light(l) => doc
+                .lights()
                 .get(l.light)
                 .is_some_and(|light| light_handles(l.light, light).any(|x| x == l)),
         }
     }
 
     /// Every handle with its position: control points patch by patch, then the lights'.
-    pub fn handles(&self) -> impl Iterator<Item = (Handle, DVec3)> + '_ {
-        let controls = control_points(&self.patches).map(|(r, q)| (Handle::Control(r), q));
-        let lights = self
-            .lights
+    pub fn handles<'a>(&'a self, doc: &'a Document) -> impl Iterator<Item = (Handle, DVec3)> + 'a {
+        let controls = control_points(doc.patches()).map(|(r, q)| (Handle::Control(r), q));
+        let lights = doc
+            .lights()
             .iter()
             .enumerate()
             .flat_map(|(k, l)| light_handles(k, l))
-            .map(|r| (Handle::Light(r), self.point(Handle::Light(r))));
+            .map(move |r| (Handle::Light(r), self.point(doc, Handle::Light(r))));
         controls.chain(lights)
     }
 
     /// The handle nearest `pointer` within [`PICK_RADIUS`], if any.
-    pub fn pick(&self, proj: &OverlayProjection, pointer: Pos2) -> Option<Handle> {
+    pub fn pick(&self, doc: &Document, proj: &OverlayProjection, pointer: Pos2) -> Option<Handle> {
         let mut best: Option<(f32, Handle)> = None;
-        for (h, q) in self.handles() {
+        for (h, q) in self.handles(doc) {
             let Some(s) = proj.to_screen(q) else {
                 continue;
             };
@@ -274,19 +268,19 @@ impl Editor {
     }
 
     /// The overlay's geometry, rebuilt if something changed.
-    pub fn overlay(&mut self) -> Arc<WireframeGeometry> {
+    pub fn overlay(&mut self, doc: &Document) -> Arc<WireframeGeometry> {
         if self.overlay_stale {
-            let lights: Vec<(Light, DVec3)> = (0..self.lights.len())
+            let lights: Vec<(Light, DVec3)> = (0..doc.lights().len())
                 .map(|k| {
                     let aim = LightRef {
                         light: k,
                         part: LightPart::Aim,
                     };
-                    (self.lights[k], self.point(Handle::Light(aim)))
+                    (doc.lights()[k], self.point(doc, Handle::Light(aim)))
                 })
                 .collect();
             self.overlay = Arc::new(overlay_geometry(
-                &self.patches,
+                doc.patches(),
                 &lights,
                 self.hovered,
                 &self.selection,
@@ -297,60 +291,69 @@ impl Editor {
         self.overlay.clone()
     }
 
-    /// Puts handles at positions, in order (a light's place before its aim: the aim turns the
-    /// spot from where it then is); returns `(handle, before, after)` for those that changed.
-    pub fn set_points(&mut self, moves: &[(Handle, DVec3)]) -> Vec<(Handle, DVec3, DVec3)> {
+    /// Puts handles at positions in `doc`, in order (a light's place before its aim: the aim
+    /// turns the spot from where it then is); returns `(handle, before, after)` for those that
+    /// changed, and the changes for the render session: the control points' (moved together,
+    /// in one update of the geometry), then each changed light's last.
+    pub fn set_points(
+        &mut self,
+        doc: &mut Document,
+        moves: &[(Handle, DVec3)],
+    ) -> (Vec<(Handle, DVec3, DVec3)>, Vec<Change>) {
         let mut changed = Vec::new();
+        let mut controls = Vec::new();
+        let mut lights: Vec<(usize, Change)> = Vec::new();
         for &(h, p) in moves {
-            if !self.exists(h) || !p.is_finite() {
+            if !self.exists(doc, h) || !p.is_finite() {
                 continue;
             }
-            let before = self.point(h);
+            let before = self.point(doc, h);
             if before == p {
                 continue;
             }
             match h {
-                Handle::Control(r) => self.patches[r.patch].points[r.index] = p,
+                Handle::Control(r) => {
+                    controls.push((r, p));
+                    changed.push((h, before, p));
+                }
                 Handle::Light(LightRef { light, part }) => {
-                    let l = self.lights[light];
+                    let l = doc.lights()[light];
                     let place = light_place(&l);
-                    match part {
-                        LightPart::Place => self.lights[light] = l.translated(p - place),
+                    let (moved, reach) = match part {
+                        LightPart::Place => (l.translated(p - place), None),
                         LightPart::Aim => {
                             let reach = (p - place).length();
                             if reach <= 1e-9 * (1.0 + place.length()) {
                                 continue;
                             }
-                            self.lights[light] = l.aimed(p - place);
-                            self.aims[light] = reach;
+                            (l.aimed(p - place), Some(reach))
                         }
+                    };
+                    let Some(change) = doc.set_light(light, moved) else {
+                        continue;
+                    };
+                    if let Some(reach) = reach {
+                        self.aims[light] = reach;
                     }
+                    match lights.iter_mut().find(|(k, _)| *k == light) {
+                        Some((_, last)) => *last = change,
+                        None => lights.push((light, change)),
+                    }
+                    changed.push((h, before, self.point(doc, h)));
                 }
             }
-            changed.push((h, before, self.point(h)));
         }
+        let mut changes = doc.move_control_points(&controls);
+        changes.extend(lights.into_iter().map(|(_, c)| c));
         if !changed.is_empty() {
             self.touch();
         }
-        changed
-    }
-
-    /// The lights whose handles are among `changed` (each once, in order).
-    pub fn lights_in(changed: &[(Handle, DVec3, DVec3)]) -> Vec<usize> {
-        let mut out: Vec<usize> = changed
-            .iter()
-            .filter_map(|(h, _, _)| match h {
-                Handle::Light(l) => Some(l.light),
-                Handle::Control(_) => None,
-            })
-            .collect();
-        out.dedup();
-        out
+        (changed, changes)
     }
 
     /// The selected points and where they are: what a drag moves.
-    pub fn selected_points(&self) -> Vec<(Handle, DVec3)> {
-        self.selection.iter().map(|r| (*r, self.point(*r))).collect()
+    pub fn selected_points(&self, doc: &Document) -> Vec<(Handle, DVec3)> {
+        self.selection.iter().map(|r| (*r, self.point(doc, *r))).collect()
     }
 
     /// Where the dragged points go with the cursor at `pointer`: parallel to the image plane
@@ -419,25 +422,25 @@ impl Editor {
 
     /// A step of `points` screen points in the image plane, at the selection's depth: what
     /// the arrow keys move the selection by.
-    pub fn nudge(&self, proj: &OverlayProjection, step: Vec2) -> Vec<(Handle, DVec3)> {
+    pub fn nudge(&self, doc: &Document, proj: &OverlayProjection, step: Vec2) -> Vec<(Handle, DVec3)> {
         let Some(first) = self.selection.first() else {
             return Vec::new();
         };
         let c = &proj.camera;
-        let scale = proj.world_per_point(proj.depth(self.point(*first)));
+        let scale = proj.world_per_point(proj.depth(self.point(doc, *first)));
         let delta = (step.x as f64 * c.right - step.y as f64 * c.up) * scale;
         self.selection
             .iter()
-            .map(|r| (*r, self.point(*r) + delta))
+            .map(|r| (*r, self.point(doc, *r) + delta))
             .collect()
     }
 
     /// Centre and radius of the selection (all patches when nothing is selected).
-    pub fn selection_sphere(&self) -> (DVec3, f64) {
+    pub fn selection_sphere(&self, doc: &Document) -> (DVec3, f64) {
         let points: Vec<DVec3> = if self.selection.is_empty() {
-            self.patches.iter().flat_map(|p| p.points).collect()
+            doc.patches().flat_map(|p| p.points).collect()
         } else {
-            self.selection.iter().map(|r| self.point(*r)).collect()
+            self.selection.iter().map(|r| self.point(doc, *r)).collect()
         };
         if points.is_empty() {
             return (self.pivot, 1.0);

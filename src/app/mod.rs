@@ -4,14 +4,17 @@
 //!
 //! Built with the `viewer` feature (on by default); the render core never depends on it.
 //!
-//! - [`viewer`]: state and layout ([`Viewer::ui`] is what eframe and the tests run).
+//! - [`document`]: the scene being edited, the one copy of it; each edit answers with the
+//!   commands that bring the render session along.
+//! - [`viewer`], [`state`]: what runs the viewer and what its widgets read; `window`: the
+//!   frame ([`Viewer::ui`] is what eframe and the tests run).
 //! - [`action`]: every request as an [`action::Action`]; [`Viewer::apply`] carries them out.
 //! - [`controls`], [`edit_panel`]: menu, side panel, status bar, dialog windows.
 //! - [`overlay`], [`editor`], [`view_input`], [`navigate`]: the control-net overlay's
 //!   projection and geometry, the editing state and undo history, the mouse over the image,
 //!   and camera moves (drawn by [`crate::gpu::wireframe`]).
 //! - [`image_view`]: texture, fit / 1:1 / zoom / pan, probe.
-//! - [`params`]: parameters and the session commands their changes send; [`setting_ui`]:
+//! - [`params`]: what the side panel edits (the document's parameters and lens, pause); [`setting_ui`]:
 //!   each render setting's control, from the table of settings.
 //! - [`error_plot`]: the error estimate (and the true error against a reference) plotted
 //!   against time; [`mod@reference`], [`difference`]: the reference image, the difference views
@@ -29,6 +32,7 @@ pub mod automation;
 pub mod commands;
 pub mod controls;
 pub mod difference;
+pub mod document;
 pub mod edit_panel;
 pub mod editor;
 pub mod error_plot;
@@ -53,6 +57,7 @@ pub mod view_input;
 pub mod viewer;
 pub mod watch;
 mod watch_folder;
+mod window;
 
 use std::path::PathBuf;
 

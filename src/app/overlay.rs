@@ -124,8 +124,10 @@ impl OverlayProjection {
 }
 
 /// Every control point of `patches` with its position, patch by patch.
-pub fn control_points(patches: &[BezierPatch]) -> impl Iterator<Item = (PointRef, DVec3)> + '_ {
-    patches.iter().enumerate().flat_map(|(patch, p)| {
+pub fn control_points<'a>(
+    patches: impl IntoIterator<Item = &'a BezierPatch> + 'a,
+) -> impl Iterator<Item = (PointRef, DVec3)> + 'a {
+    patches.into_iter().enumerate().flat_map(|(patch, p)| {
         p.points
             .iter()
             .enumerate()
@@ -151,8 +153,8 @@ const CIRCLE_SEGMENTS: usize = 32;
 /// and columns), each patch's four boundary curves, a marker per control point, and the lights'
 /// gizmos (`light_gizmos`); hovered and selected handles, and the nets of patches with a
 /// selected point, stand out.
-pub fn overlay_geometry(
-    patches: &[BezierPatch],
+pub fn overlay_geometry<'a>(
+    patches: impl IntoIterator<Item = &'a BezierPatch>,
     lights: &[(Light, DVec3)],
     hovered: Option<Handle>,
     selection: &BTreeSet<Handle>,
@@ -164,7 +166,7 @@ pub fn overlay_geometry(
         color,
         width,
     };
-    for (k, p) in patches.iter().enumerate() {
+    for (k, p) in patches.into_iter().enumerate() {
         let active =
             selection.iter().any(|s| s.patch() == Some(k)) || hovered.is_some_and(|h| h.patch() == Some(k));
         let (net, width) = if active { (NET_SELECTED, 1.6) } else { (NET, 1.0) };

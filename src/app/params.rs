@@ -1,15 +1,16 @@
-//! What the side panel edits — the render parameters, the lens, pause — the scene's scale for
-//! their sliders, and the commands a change sends to the render session. Which controls the
-//! render parameters have comes from the table of settings ([`super::setting_ui`]).
+//! What the side panel edits — the render parameters and the lens (the document's), pause —
+//! and the scene's scale for their sliders. Which controls the render parameters have comes
+//! from the table of settings ([`super::setting_ui`]).
 
-use crate::render::session::Command;
-use crate::scene::{Camera, Scene};
+use crate::scene::Scene;
 use crate::settings::RenderParams;
 
-/// Values shown by the side panel (start from the scene file).
+/// Values shown by the side panel: a form the widgets fill in, made each frame from the
+/// document and the panel's own choices ([`PanelParams::of`]); a changed one is handed to
+/// [`super::Viewer::set_params`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct PanelParams {
-    /// The render parameters the session receives whole ([`Command::SetParams`]).
+    /// The render parameters the session receives whole ([`crate::render::session::Command::SetParams`]).
     pub render: RenderParams,
     /// What the slider of each automatic setting shows (its value when automatic is off).
     pub manual: std::collections::BTreeMap<&'static str, f64>,
@@ -33,51 +34,34 @@ pub struct Ranges {
     pub focal: (f64, f64),
 }
 
+/// What the side panel holds that is not the scene's: each automatic setting's manual value
+/// and whether rendering is paused.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PanelChoices {
+    /// What the slider of each automatic setting shows (its value when automatic is off).
+    pub manual: std::collections::BTreeMap<&'static str, f64>,
+    /// Rendering paused.
+    pub paused: bool,
+}
+
 impl PanelParams {
-    /// The scene file's values.
-    pub fn from_scene(scene: &Scene) -> Self {
+    /// What the panel shows for `scene` (the document's) with `choices`.
+    pub fn of(scene: &Scene, choices: &PanelChoices) -> Self {
         Self {
             render: scene.params.clone(),
-            manual: Default::default(),
+            manual: choices.manual.clone(),
             aperture: scene.camera.aperture,
             focal_distance: scene.camera.focal_distance,
-            paused: false,
+            paused: choices.paused,
         }
     }
 
-    /// `camera` with this lens.
-    pub fn lens_on(&self, camera: &Camera) -> Camera {
-        Camera {
-            aperture: self.aperture,
-            focal_distance: self.focal_distance,
-            ..camera.clone()
+    /// The panel's own part of these values.
+    pub fn choices(&self) -> PanelChoices {
+        PanelChoices {
+            manual: self.manual.clone(),
+            paused: self.paused,
         }
-    }
-
-    /// Writes these values into a scene (for restarting the renderer with them).
-    pub fn apply_to(&self, scene: &mut Scene) {
-        scene.params = self.render.clone();
-        scene.camera = self.lens_on(&scene.camera);
-    }
-
-    /// The commands that take the session from `old` to `self` (`camera` is the pose the
-    /// lens goes on), in a fixed order.
-    pub fn commands_from(&self, old: &PanelParams, camera: &Camera) -> Vec<Command> {
-        let mut out = Vec::new();
-        if self.render != old.render {
-            out.push(Command::SetParams(self.render.clone()));
-        }
-        if (self.aperture, self.focal_distance) != (old.aperture, old.focal_distance) {
-            out.push(Command::SetCamera(self.lens_on(camera)));
-        }
-        if self.paused != old.paused {
-            out.push(if self.paused {
-                Command::Pause
-            } else {
-                Command::Resume
-            });
-        }
-        out
     }
 }
 

@@ -82,7 +82,7 @@ impl Viewer {
     /// Compares with `reference` from now on, if it has the scene's image size (else the
     /// status bar says why not and any open reference stays).
     pub fn set_reference(&mut self, reference: Reference) {
-        let (w, h) = (self.scene.camera.width, self.scene.camera.height);
+        let (w, h) = (self.scene().camera.width, self.scene().camera.height);
         if let Err(e) = reference.check_size(w, h) {
             self.status = Some(Status::Error(format!("Reference not opened: {e}")));
             return;

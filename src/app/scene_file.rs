@@ -53,8 +53,8 @@ impl Viewer {
 
     /// The scene's own file, when it was opened from one.
     fn scene_file(&self) -> Option<PathBuf> {
-        self.scene.base_dir.as_ref()?;
-        Some(self.scene.source.clone()).filter(|p| p.is_file())
+        self.scene().base_dir.as_ref()?;
+        Some(self.scene().source.clone()).filter(|p| p.is_file())
     }
 
     /// Saves to the scene's own file (after confirming), or asks where.
@@ -70,8 +70,10 @@ impl Viewer {
         if self.scene_dialog.is_some() {
             return;
         }
-        let name = match self.scene.source.file_stem() {
-            Some(stem) if self.scene.base_dir.is_some() => format!("{}-edited.toml", stem.to_string_lossy()),
+        let name = match self.scene().source.file_stem() {
+            Some(stem) if self.scene().base_dir.is_some() => {
+                format!("{}-edited.toml", stem.to_string_lossy())
+            }
             _ => "scene.toml".to_owned(),
         };
         let request = FileRequest {
@@ -135,15 +137,11 @@ impl Viewer {
     }
 
     fn write_scene(&mut self, path: PathBuf, overwrite: bool) {
-        let mut scene = self.edited_scene();
-        match save_scene(&scene, &self.editor.loaded, &path, overwrite) {
+        let doc = &self.state.document;
+        match save_scene(doc.scene(), doc.loaded_patches(), &path, overwrite) {
             Ok(text) => {
                 // The file now holds the scene as edited: it is what "saved" means from here.
-                scene.text = text.into();
-                scene.source = path.clone();
-                scene.base_dir = path.parent().map(|d| d.to_path_buf());
-                self.scene = scene;
-                self.editor.loaded = self.editor.patches.clone();
+                self.state.document.saved_as(&path, text);
                 self.editor.history.mark_saved();
                 if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
                     self.settings.last_directory = Some(dir.to_path_buf());

@@ -1,5 +1,5 @@
-//! The viewer's state: everything its widgets read (the scene and its parameters, the newest
-//! frame, the edits, the open questions and flows, the messages), apart from what runs it
+//! The viewer's state: everything its widgets read (the scene being edited — the
+//! [`Document`] —, the panel's own choices, the newest frame, the edits, the open questions and flows, the messages), apart from what runs it
 //! (the render session, the dialogs and loads under way, the texture), which stays in
 //! [`super::viewer::Viewer`]. Widgets read a `&ViewerState` and answer with
 //! [`super::action::Action`]s; `Viewer::apply` carries them out.
@@ -8,16 +8,18 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use super::action::AfterDiscard;
+use super::document::Document;
 use super::editor::Editor;
 use super::error_plot::Convergence;
 use super::image_view::Probe;
-use super::params::{PanelParams, Ranges};
+use super::params::{PanelChoices, PanelParams, Ranges};
 use super::reference::ReferenceState;
 use super::save::SaveFlow;
 use super::settings::ViewerSettings;
 use crate::geometry::BezierPatch;
 use crate::render::compare::{Reference, ReferenceErrors};
 use crate::render::session::Frame;
+use crate::scene::Light;
 use crate::scene::Scene;
 
 /// A line in the status bar.
@@ -33,12 +35,12 @@ pub enum Status {
 pub struct ViewerState {
     /// Persisted preferences.
     pub settings: ViewerSettings,
-    /// The scene as loaded (parameters as in its file).
-    pub(super) scene: Scene,
+    /// The scene being edited: the one copy of it in the viewer.
+    pub(super) document: Document,
     /// Slider ranges for the scene.
     pub(super) ranges: Ranges,
-    /// Current parameter values.
-    pub params: PanelParams,
+    /// What the side panel holds that is not the scene's (manual values, pause).
+    pub(super) panel: PanelChoices,
     /// Newest frame of the newest epoch seen.
     pub(super) frame: Option<Frame>,
     pub(super) probe: Option<Probe>,
@@ -96,12 +98,13 @@ impl ViewerState {
     /// The state of a viewer that has just opened `scene` (parameters as in its file, with
     /// `paused`), with `settings` from storage.
     pub(super) fn new(scene: Scene, settings: ViewerSettings, paused: bool) -> Self {
-        let mut params = PanelParams::from_scene(&scene);
-        params.paused = paused;
         Self {
             settings,
             ranges: Ranges::for_scene(&scene),
-            params,
+            panel: PanelChoices {
+                paused,
+                ..PanelChoices::default()
+            },
             frame: None,
             probe: None,
             convergence: Convergence::default(),
@@ -121,13 +124,24 @@ impl ViewerState {
             confirm_restart: false,
             reference: ReferenceState::default(),
             watching: None,
-            scene,
+            document: Document::new(scene),
         }
     }
 
-    /// The scene being rendered (as loaded).
+    /// The scene as edited: parameters, lens and camera, control points and lights.
     pub fn scene(&self) -> &Scene {
-        &self.scene
+        self.document.scene()
+    }
+
+    /// What the side panel shows: the document's parameters and lens with the panel's own
+    /// choices.
+    pub fn params(&self) -> PanelParams {
+        PanelParams::of(self.document.scene(), &self.panel)
+    }
+
+    /// Whether rendering is paused.
+    pub fn paused(&self) -> bool {
+        self.panel.paused
     }
 
     /// The newest frame shown.
@@ -170,44 +184,21 @@ impl ViewerState {
         self.pending_restart.is_some()
     }
 
-    /// The scene as edited: the panel's parameters, the camera, the control points and the
-    /// lights.
-    pub fn edited_scene(&self) -> Scene {
-        let mut scene = self.scene.clone();
-        self.params.apply_to(&mut scene);
-        let edits: Vec<(usize, BezierPatch)> = self
-            .editor
-            .patches
-            .iter()
-            .zip(scene.geometry.patches())
-            .enumerate()
-            .filter(|(_, (edited, (current, _)))| *edited != current)
-            .map(|(k, (edited, _))| (k, *edited))
-            .collect();
-        if !edits.is_empty() {
-            scene.geometry.update_patches(&edits);
-        }
-        for (k, light) in self.editor.lights.iter().enumerate() {
-            if scene.lights.get(k) != Some(light) {
-                scene.set_light(k, *light);
-            }
-        }
-        scene
-    }
-
     /// The control points as edited (geometry order).
-    pub fn patches(&self) -> &[BezierPatch] {
-        &self.editor.patches
+    pub fn patches(&self) -> impl ExactSizeIterator<Item = &BezierPatch> + Clone + '_ {
+        self.document.patches()
     }
 
     /// The lights as edited (scene order).
-    pub fn lights(&self) -> &[crate::scene::Light] {
-        &self.editor.lights
+    pub fn lights(&self) -> &[Light] {
+        self.document.lights()
     }
 
     /// Where a handle (control point or light) is now, if the scene has it.
     pub fn handle_position(&self, h: super::handle::Handle) -> Option<glam::DVec3> {
-        self.editor.exists(h).then(|| self.editor.point(h))
+        self.editor
+            .exists(&self.document, h)
+            .then(|| self.editor.point(&self.document, h))
     }
 
     /// The selected handles (control points and lights).
@@ -227,7 +218,8 @@ impl ViewerState {
 
     /// Whether the overlay is shown and can be edited.
     pub fn editing(&self) -> bool {
-        self.settings.show_wireframe && !(self.editor.patches.is_empty() && self.editor.lights.is_empty())
+        self.settings.show_wireframe
+            && !(self.document.patches().len() == 0 && self.document.lights().is_empty())
     }
 
     /// The open reference.

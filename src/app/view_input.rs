@@ -6,6 +6,7 @@
 use egui::{PointerButton, Pos2, Response};
 
 use super::action::Action;
+use super::document::Document;
 use super::editor::{CameraMove, Editor, Gesture};
 use super::handle::Handle;
 use super::overlay::OverlayProjection;
@@ -14,15 +15,17 @@ use super::overlay::OverlayProjection;
 /// placed in the last frame), if the overlay is shown.
 pub fn grab_at(
     editor: &Editor,
+    doc: &Document,
     projection: Option<&OverlayProjection>,
     press: Option<Pos2>,
 ) -> Option<Handle> {
-    editor.pick(projection?, press?)
+    editor.pick(doc, projection?, press?)
 }
 
 /// Actions for this frame's pointer activity over the image view.
 pub fn view_actions(
     editor: &Editor,
+    doc: &Document,
     projection: &OverlayProjection,
     response: &Response,
     editing: bool,
@@ -33,19 +36,19 @@ pub fn view_actions(
         let hovered = response
             .hover_pos()
             .filter(|_| editing)
-            .and_then(|p| editor.pick(projection, p));
+            .and_then(|p| editor.pick(doc, projection, p));
         if hovered != editor.hovered {
             out.push(Action::Hover(hovered));
         }
     }
-    if box_select_actions(editor, projection, response, editing, out) {
+    if box_select_actions(editor, doc, projection, response, editing, out) {
         return;
     }
-    drag_actions(editor, projection, response, editing, out);
+    drag_actions(editor, doc, projection, response, editing, out);
     // Clicks select.
     if response.clicked() && editing {
         let shift = response.ctx.input(|i| i.modifiers.shift);
-        match response.hover_pos().and_then(|p| editor.pick(projection, p)) {
+        match response.hover_pos().and_then(|p| editor.pick(doc, projection, p)) {
             Some(point) => out.push(Action::Select { point, add: shift }),
             None if !shift && !editor.selection.is_empty() => out.push(Action::ClearSelection),
             None => {}
@@ -57,6 +60,7 @@ pub fn view_actions(
 /// takes the pointer: no click or drag else this frame).
 fn box_select_actions(
     editor: &Editor,
+    doc: &Document,
     projection: &OverlayProjection,
     response: &Response,
     editing: bool,
@@ -68,7 +72,7 @@ fn box_select_actions(
     let starts = response.drag_started_by(PointerButton::Primary)
         && editing
         && shift
-        && grab_at(editor, Some(projection), press).is_none();
+        && grab_at(editor, doc, Some(projection), press).is_none();
     let Some(from) = editor
         .rubber_band
         .map(|(from, _)| from)
@@ -89,6 +93,7 @@ fn box_select_actions(
 /// Drags: points with the left button, the camera with the right or middle one.
 fn drag_actions(
     editor: &Editor,
+    doc: &Document,
     projection: &OverlayProjection,
     response: &Response,
     editing: bool,
@@ -96,7 +101,7 @@ fn drag_actions(
 ) {
     let (modifiers, press) = response.ctx.input(|i| (i.modifiers, i.pointer.press_origin()));
     if response.drag_started_by(PointerButton::Primary) && editing {
-        if let (Some(grab), Some(press)) = (grab_at(editor, Some(projection), press), press) {
+        if let (Some(grab), Some(press)) = (grab_at(editor, doc, Some(projection), press), press) {
             out.push(Action::BeginPointDrag { grab, press });
         }
     }

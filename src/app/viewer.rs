@@ -1,27 +1,24 @@
-//! The viewer's state and its frame: render session, newest frame, parameters, open/save
-//! flows, messages. The eframe app ([`super::CausticApp`]) and the kittest tests both drive
-//! [`Viewer::ui`].
+//! The viewer's core: its state ([`ViewerState`]) and what runs it — the render session and
+//! what it is sent, opening and saving, the newest frame. The window's frame
+//! ([`Viewer::poll`], [`Viewer::ui`], which the eframe app ([`super::CausticApp`]) and the
+//! kittest tests drive) is in `window.rs`, the one file that calls into all the others.
 
 use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use super::action::Action;
-use super::controls;
+use super::document::{Change, Document};
 use super::editor::Editor;
-use super::file_dialog::{self, FileDialog, FileRequest, Finished, NativeDialog};
-use super::image_view::{frame_image, Comparison, ImageView};
-use super::job::{Job, Poll};
-use super::keys;
+use super::file_dialog::{self, FileDialog, FileRequest, NativeDialog};
+use super::image_view::{frame_image, ImageView};
+use super::job::Job;
 use super::overlay::OverlayProjection;
-use super::params::{PanelParams, Ranges};
-use super::reference::is_reference_file;
+use super::params::{PanelChoices, PanelParams, Ranges};
 use super::save::{default_file_name, SaveEvent, Snapshot};
 use super::settings::{ViewerSettings, Zoom};
 pub use super::state::Status;
 use super::state::ViewerState;
 use super::tev_send::TevSend;
-use super::view_input;
 use crate::render::image_metadata;
 use crate::render::session::{Command, Frame, RenderSession, SessionOptions};
 use crate::scene::{RendererKind, Scene};
@@ -37,12 +34,12 @@ pub struct Viewer {
     /// What the widgets read.
     pub state: ViewerState,
     pub(super) ctx: egui::Context,
-    session: RenderSession,
+    pub(super) session: RenderSession,
     pub(super) image_view: ImageView,
-    picking: Option<FileDialog>,
+    pub(super) picking: Option<FileDialog>,
     /// How native file dialogs are shown.
     native_dialog: NativeDialog,
-    loading: Option<(Job<Result<Scene, String>>, PathBuf)>,
+    pub(super) loading: Option<(Job<Result<Scene, String>>, PathBuf)>,
     recent_commands: VecDeque<Command>,
     created: Instant,
     /// Where the image and its overlay were placed in the last UI frame.
@@ -158,7 +155,17 @@ impl Viewer {
 
     /// Sends a command to the render session, remembering it (and when a restart was asked).
     pub fn send(&mut self, command: Command) {
-        if command.restarts(&self.params.render) {
+        let restarts = command.restarts(&self.document.scene().params);
+        self.send_command(command, restarts);
+    }
+
+    /// Sends the render session what an edit of the document changed.
+    pub(super) fn send_change(&mut self, change: Change) {
+        self.send_command(change.command, change.restarts);
+    }
+
+    fn send_command(&mut self, command: Command, restarts: bool) {
+        if restarts {
             let epoch = self.frame.as_ref().map_or(0, |f| f.epoch);
             self.pending_restart = Some((Instant::now(), epoch));
         }
@@ -169,20 +176,34 @@ impl Viewer {
         self.session.send(command);
     }
 
-    /// Sets parameters, sending the commands their changes need.
+    /// Sets what the side panel edits: the document's render parameters and lens, and the
+    /// panel's choices (manual values, pause), sending the render session what changed.
     pub fn set_params(&mut self, params: PanelParams) {
-        for command in params.commands_from(&self.params, &self.scene.camera) {
-            self.send(command);
+        let changes = [
+            self.state.document.set_params(&params.render),
+            self.state
+                .document
+                .set_lens(params.aperture, params.focal_distance),
+        ];
+        for change in changes.into_iter().flatten() {
+            self.send_change(change);
         }
-        self.scene.camera = params.lens_on(&self.scene.camera);
-        self.params = params;
+        let choices = params.choices();
+        if choices.paused != self.panel.paused {
+            self.send(if choices.paused {
+                Command::Pause
+            } else {
+                Command::Resume
+            });
+        }
+        self.panel = choices;
     }
 
     /// Starts a new render session for the current scene and parameters (after a renderer
     /// failure, or on another scene).
     pub fn restart_renderer(&mut self) {
-        let scene = self.edited_scene();
-        self.session = start_session(&self.ctx, scene, self.params.paused);
+        let scene = self.document.scene().clone();
+        self.session = start_session(&self.ctx, scene, self.panel.paused);
         self.render_failure = None;
         self.frame = None;
         self.convergence.reset();
@@ -207,11 +228,12 @@ impl Viewer {
     /// The handle (control point or light) a press at `pointer` would grab, with the overlay
     /// as placed in the last frame.
     pub fn handle_at(&self, pointer: egui::Pos2) -> Option<super::handle::Handle> {
-        self.editor.pick(self.projection.as_ref()?, pointer)
+        self.editor
+            .pick(&self.document, self.projection.as_ref()?, pointer)
     }
 
     /// Replaces the scene (a successful open).
-    fn replace_scene(&mut self, scene: Scene) {
+    pub(super) fn replace_scene(&mut self, scene: Scene) {
         self.replace_scene_with(scene, false);
     }
 
@@ -222,12 +244,14 @@ impl Viewer {
 
     fn replace_scene_with(&mut self, scene: Scene, paused: bool) {
         let scene = photon_mapped(scene);
-        self.params = PanelParams::from_scene(&scene);
-        self.params.paused = paused;
+        self.panel = PanelChoices {
+            paused,
+            ..PanelChoices::default()
+        };
         self.ranges = Ranges::for_scene(&scene);
         self.editor = Editor::new(&scene);
         self.projection = None;
-        self.scene = scene;
+        self.document = Document::new(scene);
         self.restart_renderer();
         self.settings.zoom = Zoom::Fit;
         self.image_view.recentre();
@@ -270,16 +294,16 @@ impl Viewer {
         let renderer = frame.stats.renderer().name();
         // The parameters the panel changes are added below; the base pairs (scene file, seed,
         // size) do not depend on them.
-        let scene = self.edited_scene();
-        let text = crate::scene::save::scene_toml(&scene, &self.editor.loaded, None).ok();
-        let mut metadata = image_metadata(&scene, renderer, text);
+        let scene = self.document.scene();
+        let text = crate::scene::save::scene_toml(scene, self.document.loaded_patches(), None).ok();
+        let mut metadata = image_metadata(scene, renderer, text);
         metadata.push(("caustic:passes".into(), frame.pass.to_string()));
         metadata.push(("caustic:photons".into(), frame.photons.to_string()));
-        metadata.push(("caustic:alpha".into(), self.params.render.alpha.to_string()));
-        metadata.push(("caustic:aperture".into(), self.params.aperture.to_string()));
+        metadata.push(("caustic:alpha".into(), scene.params.alpha.to_string()));
+        metadata.push(("caustic:aperture".into(), scene.camera.aperture.to_string()));
         metadata.push((
             "caustic:focal_distance".into(),
-            self.params.focal_distance.to_string(),
+            scene.camera.focal_distance.to_string(),
         ));
         metadata.push((
             crate::render::provenance::EXPOSURE.into(),
@@ -299,7 +323,7 @@ impl Viewer {
             self.status = Some(Status::Error("nothing to save yet: no frame has arrived".into()));
             return;
         };
-        let name = default_file_name(&self.scene.source, snapshot.pass);
+        let name = default_file_name(&self.scene().source, snapshot.pass);
         let dir = self.settings.last_directory.clone();
         self.state
             .save
@@ -332,7 +356,7 @@ impl Viewer {
         }
     }
 
-    fn on_save_event(&mut self, event: SaveEvent) {
+    pub(super) fn on_save_event(&mut self, event: SaveEvent) {
         self.status = Some(match event {
             SaveEvent::Saved { path, pass } => {
                 self.remember_folder_of(&path);
@@ -341,54 +365,6 @@ impl Viewer {
             SaveEvent::Failed(e) => Status::Error(format!("Not saved: {e}")),
             SaveEvent::Cancelled => Status::Info("Save cancelled".into()),
         });
-    }
-
-    /// Takes new frames, failures and finished jobs; call once per UI frame.
-    pub fn poll(&mut self) {
-        // Newest frame of the newest epoch.
-        while let Ok(frame) = self.session.frames().try_recv() {
-            self.show_frame(frame);
-        }
-        if self.render_failure.is_none() {
-            self.render_failure = self.session.failure();
-        }
-        match file_dialog::take_finished(&mut self.picking) {
-            Some(Finished::Chosen(path)) => self.open_scene(path),
-            Some(Finished::Lost) => self.status = Some(Status::Error("the file dialog failed".into())),
-            Some(Finished::Cancelled) | None => {}
-        }
-        if let Some((job, path)) = &self.loading {
-            let path = path.clone();
-            let loaded = match job.poll() {
-                Poll::Pending => None,
-                Poll::Ready(r) => Some(r),
-                Poll::Lost => Some(Err(format!("{}: loading failed unexpectedly", path.display()))),
-            };
-            if let Some(result) = loaded {
-                self.loading = None;
-                match result {
-                    Ok(scene) => {
-                        self.remember_folder_of(&path);
-                        self.replace_scene(scene);
-                        self.scene_error = None;
-                        self.status = Some(Status::Info(format!("Opened {}", path.display())));
-                    }
-                    Err(e) => {
-                        self.status = Some(Status::Error(format!("Could not open {}", path.display())));
-                        self.scene_error = Some(e);
-                    }
-                }
-            }
-        }
-        if let Some(event) = self.state.save.poll(&self.ctx) {
-            self.on_save_event(event);
-        }
-        self.poll_scene_dialog();
-        self.poll_reference();
-        self.poll_watch();
-        if let Some(status) = self.tev.poll() {
-            self.status = Some(status);
-        }
     }
 
     /// Shows `frame` as the newest image if it is newer (a later epoch, or a later pass of
@@ -428,70 +404,6 @@ impl Viewer {
         self.image_view.invalidate();
     }
 
-    /// The whole window: menu, side panel, status bar, image with its overlay, dialogs. The
-    /// parts emit [`Action`]s, carried out at the end of the frame by [`Viewer::apply`].
-    pub fn ui(&mut self, ui: &mut egui::Ui) {
-        self.poll();
-        let mut actions = Vec::new();
-        // An open question or the window's own file dialog takes the keyboard (Enter, Escape).
-        if !self.file_dialog_in_window() && !self.question_open() {
-            keys::handle(self, ui.ctx(), &mut actions);
-        }
-        // Files dropped on the window open as scenes (the first one); images (.exr, .pfm)
-        // open as the reference.
-        let dropped: Option<PathBuf> = ui.input(|i| {
-            i.raw
-                .dropped_files
-                .iter()
-                .map(|f| f.path().to_path_buf())
-                .find(|p| !p.as_os_str().is_empty())
-        });
-        actions.extend(dropped.map(|p| match is_reference_file(&p) {
-            true => Action::OpenReference(p),
-            false => Action::OpenScene(p),
-        }));
-        // Closing with unsaved edits asks first.
-        if ui.input(|i| i.viewport().close_requested()) && !self.allow_close && self.editor.history.unsaved()
-        {
-            ui.ctx().send_viewport_cmd(egui::ViewportCommand::CancelClose);
-            actions.push(Action::Close);
-        }
-        let state = &self.state;
-        if let Some(frame) = &state.frame {
-            let comparison = Comparison {
-                reference: state.reference.open.as_ref().map(|r| &r.image.pixels[..]),
-                show_reference: state.reference.show_reference,
-            };
-            self.image_view.update_texture(
-                ui.ctx(),
-                frame,
-                state.settings.display,
-                state.settings.exposure_stops,
-                comparison,
-            );
-        }
-
-        egui::Panel::top("caustic-menu").show(ui, |ui| controls::menu_ui(self, ui, &mut actions));
-        egui::Panel::bottom("caustic-status").show(ui, |ui| controls::status_ui(self, ui));
-        if self.settings.show_side_panel {
-            egui::Panel::right("caustic-controls")
-                .resizable(true)
-                .default_size(290.0)
-                .show(ui, |ui| {
-                    egui::ScrollArea::vertical()
-                        .show(ui, |ui| controls::side_panel_ui(self, ui, &mut actions));
-                });
-        }
-        egui::CentralPanel::no_frame().show(ui, |ui| self.central_ui(ui, &mut actions));
-        controls::dialogs_ui(self, ui.ctx(), &mut actions);
-        for dialog in self.file_dialogs() {
-            dialog.ui(ui.ctx());
-        }
-        for action in actions {
-            self.apply(action);
-        }
-    }
-
     /// Sends the current frame to tev at `address` (`HOST:PORT`) as the image
     /// `caustic: <scene file>`; the status bar says how it went.
     pub fn send_to_tev(&mut self, address: &str) {
@@ -501,30 +413,12 @@ impl Viewer {
         };
         let name = format!(
             "caustic: {}",
-            self.scene
+            self.scene()
                 .source
                 .file_name()
                 .map_or("scene".into(), |n| n.to_string_lossy())
         );
         self.tev.send(&self.ctx, frame, name, address);
-    }
-
-    /// The file dialogs under way (at most one of each kind).
-    fn file_dialogs(&self) -> impl Iterator<Item = &FileDialog> {
-        [
-            self.picking.as_ref(),
-            self.scene_dialog.as_ref(),
-            self.reference.picking.as_ref(),
-            self.watch_picking.as_ref(),
-            self.save.file_dialog(),
-        ]
-        .into_iter()
-        .flatten()
-    }
-
-    /// Whether a file dialog is showing inside the window (no native one could be shown).
-    pub fn file_dialog_in_window(&self) -> bool {
-        self.file_dialogs().any(FileDialog::in_window)
     }
 
     /// How native file dialogs are shown.
@@ -536,72 +430,5 @@ impl Viewer {
     /// nothing at once counts as one that could not be shown, and the window's own opens.
     pub fn set_native_dialog(&mut self, native: NativeDialog) {
         self.native_dialog = native;
-    }
-
-    /// The image, the control-net overlay over it, and the mouse.
-    fn central_ui(&mut self, ui: &mut egui::Ui, actions: &mut Vec<Action>) {
-        let Some(frame) = &self.frame else {
-            self.probe = None;
-            let waiting;
-            let text = if let Some(w) = &self.watching {
-                waiting = format!("Watching {}: waiting for the first part...", w.dir.display());
-                waiting.as_str()
-            } else if self.params.paused {
-                "Paused before the first pass: press Space or Resume"
-            } else {
-                "Rendering the first pass..."
-            };
-            ui.centered_and_justified(|ui| ui.label(text));
-            return;
-        };
-        let size = [frame.width, frame.height];
-        // A left drag that starts on a control point moves it; elsewhere it pans the image.
-        let press = ui.input(|i| i.pointer.press_origin());
-        let box_selecting =
-            self.editor.rubber_band.is_some() || (self.editing() && ui.input(|i| i.modifiers.shift));
-        let grabbing = box_selecting
-            || matches!(self.editor.gesture, Some(super::editor::Gesture::Points { .. }))
-            || (self.editing()
-                && view_input::grab_at(&self.editor, self.projection.as_ref(), press).is_some());
-        let shown = self.image_view.ui(ui, self.settings.zoom, size, !grabbing);
-        self.probe = shown.probe;
-        if shown.zoom != self.settings.zoom {
-            actions.push(Action::SetZoom {
-                zoom: shown.zoom,
-                recentre: false,
-            });
-        }
-        let mut camera = self.scene.camera.clone();
-        (camera.width, camera.height) = (size[0], size[1]);
-        let projection = OverlayProjection::new(&camera, shown.image, shown.view);
-        view_input::view_actions(
-            &self.editor,
-            &projection,
-            &shown.response,
-            self.editing(),
-            actions,
-        );
-        if self.editing() && self.overlay_installed {
-            let callback = crate::gpu::wireframe::WireframeCallback {
-                uniforms: projection.uniforms(ui.ctx().pixels_per_point()),
-                geometry: self.editor.overlay(),
-                generation: self.editor.generation,
-            };
-            ui.painter_at(shown.view)
-                .add(eframe::egui_wgpu::Callback::new_paint_callback(
-                    shown.view, callback,
-                ));
-        }
-        if let Some((from, to)) = self.editor.rubber_band {
-            let band = egui::Rect::from_two_pos(from, to);
-            let stroke = egui::Stroke::new(1.0, ui.visuals().selection.stroke.color);
-            let painter = ui.painter_at(shown.view);
-            painter.rect_filled(band, 0.0, ui.visuals().selection.bg_fill.gamma_multiply(0.25));
-            painter.rect_stroke(band, 0.0, stroke, egui::StrokeKind::Inside);
-        }
-        self.projection = Some(projection);
-        if let Some(legend) = self.image_view.legend {
-            super::difference::legend_ui(ui, shown.view, legend);
-        }
     }
 }

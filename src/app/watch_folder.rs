@@ -44,7 +44,7 @@ impl Viewer {
             )));
             return;
         }
-        let mut p = self.params.clone();
+        let mut p = self.params();
         p.paused = true;
         self.set_params(p);
         self.frame = None;
@@ -84,7 +84,7 @@ impl Viewer {
             self.status = Some(Status::Info(format!("Stopped watching {}", w.dir().display())));
         }
         self.watching = None;
-        self.params.paused = false;
+        self.panel.paused = false;
         self.restart_renderer();
     }
 
