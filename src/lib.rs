@@ -11,7 +11,9 @@
 //! * [`scene`]: the TOML scene format, validation, camera, materials, textures, lights.
 //! * [`render`]: the Whitted ray tracer, the film and its PNG/EXR output, random streams.
 //! * [`assets`]: the data the binary carries built in (Newell's teapot).
-//! * [`mod@bench`]: measurement harnesses used by `caustic bench`.
+//! * [`mod@bench`]: every benchmark of `caustic bench`, and the harnesses `view --bench`
+//!   shares with them; [`run`]: a scene from a file or built in, a render session followed
+//!   to its end, a progress bar; [`args`]: flag groups the commands share.
 //! * [`farm`]: the Slurm script and Kubernetes manifest of a sharded render, every value
 //!   quoted by one function.
 //! * [`tev`]: streaming frames to a running tev viewer.
@@ -25,6 +27,7 @@
 
 #[cfg(feature = "viewer")]
 pub mod app;
+pub mod args;
 pub mod assets;
 pub mod bench;
 pub mod color;
@@ -35,6 +38,7 @@ pub mod geometry;
 pub mod gpu;
 pub mod input_file;
 pub mod render;
+pub mod run;
 pub mod scene;
 pub mod settings;
 pub mod tev;

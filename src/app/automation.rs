@@ -12,6 +12,9 @@ use std::time::{Duration, Instant};
 use super::action::Action;
 use super::overlay::PointRef;
 use super::viewer::Viewer;
+use crate::bench::convergence::reference;
+use crate::bench::edit_run::{EditPlan, WarmCold, ON_SCREEN_AFTER};
+use crate::bench::output::BenchOutput;
 
 /// What to do besides showing the window.
 #[derive(Clone, Debug)]
@@ -433,17 +436,15 @@ impl Automation {
     }
 }
 
-/// Passes of the converged render the drag preview is measured against.
+/// Passes of the reference the drag preview is measured against.
 const PREVIEW_REFERENCE_PASSES: u32 = 100;
 
 /// The drag preview's figure: the RMSE of what is on screen [`ON_SCREEN_AFTER`] a move of the
-/// dragged point (from where it was to where the drag left it), against a converged render of
-/// the edited scene, with warm restarts (the viewer's) and with the cold restart and preview
-/// the viewer had before them; medians of 3 runs each, in the viewer's kind of render session
-/// without the window.
+/// dragged point (from where it was to where the drag left it), against the reference of the
+/// edited scene that `bench edit` uses (cached), with warm restarts (the viewer's) and with
+/// the cold restart and preview the viewer had before them; medians of 3 runs each (`bench
+/// edit`'s harness, [`WarmCold`]), in the viewer's kind of render session without the window.
 fn drag_preview_error(viewer: &Viewer) -> Result<String, String> {
-    use crate::bench::edit::{measure_edit, EditPlan, ON_SCREEN_AFTER};
-    use crate::bench::timings::median;
     let edited = viewer.scene();
     let position = edited.geometry.patches()[DRAG_POINT.patch].0.points[DRAG_POINT.index];
     let mut before = edited.clone();
@@ -451,47 +452,28 @@ fn drag_preview_error(viewer: &Viewer) -> Result<String, String> {
     before
         .geometry
         .set_control_point(DRAG_POINT.patch, DRAG_POINT.index, start);
-    let reference = {
-        let options = crate::render::session::SessionOptions {
-            max_passes: Some(PREVIEW_REFERENCE_PASSES),
-            every_frame: true,
-            ..Default::default()
-        };
-        let mut reference = edited.clone();
-        reference.params.seed ^= 0x5eed;
-        let session = crate::render::session::RenderSession::start_with(reference, options, None);
-        let last = session.frames().iter().last();
-        session.failure().map_or(Ok(()), Err)?;
-        last.ok_or("no reference frame")?.radiance.to_vec()
+    let mut out = BenchOutput::new(false, "view");
+    let what = format!(
+        "control point {} of patch {} moved to {position:?}",
+        DRAG_POINT.index, DRAG_POINT.patch
+    );
+    let reference = reference(edited, PREVIEW_REFERENCE_PASSES, None, Some(what), &mut out)
+        .map_err(|e| format!("{e:#}"))?;
+    let plan = EditPlan {
+        edit: crate::render::session::Command::MoveControlPoint {
+            patch: DRAG_POINT.patch,
+            index: DRAG_POINT.index,
+            position,
+        },
+        before_passes: 8,
+        warm: true,
+        target: 0.0,
+        limit: std::time::Duration::from_secs(3),
     };
-    let (mut figures, mut first) = ([Vec::new(), Vec::new()], [Vec::new(), Vec::new()]);
-    for _ in 0..3 {
-        for (k, warm) in [true, false].into_iter().enumerate() {
-            let plan = EditPlan {
-                edit: crate::render::session::Command::MoveControlPoint {
-                    patch: DRAG_POINT.patch,
-                    index: DRAG_POINT.index,
-                    position,
-                },
-                before_passes: 8,
-                warm,
-                target: 0.0,
-                limit: std::time::Duration::from_secs(3),
-            };
-            let run = measure_edit(before.clone(), &plan, &reference)?;
-            figures[k].push(run.on_screen);
-            first[k].push(run.first);
-        }
-    }
-    let [warm, cold] = figures.map(median);
-    let [(wt, we), (ct, ce)] = first.map(|runs| {
-        (
-            median(runs.iter().map(|r| r.0).collect()),
-            median(runs.iter().map(|r| r.1).collect()),
-        )
-    });
+    let m = WarmCold::measure(&before, &plan, 3, &reference, |_, _, _| {})?.medians();
+    let ([warm, cold], [(wt, we), (ct, ce)]) = (m.on_screen, m.first);
     Ok(format!(
-        "  drag preview, against a {PREVIEW_REFERENCE_PASSES}-pass render of the edited scene (medians of 3 moves): the new epoch's first image has RMSE {we:.3e} at {:.0} ms with warm restarts, {ce:.3e} at {:.0} ms with the cold restart's ¼-resolution preview of before ({:.2}x); on screen {} ms after the move: {warm:.3e} and {cold:.3e} ({:.2}x)",
+        "  drag preview, against a {PREVIEW_REFERENCE_PASSES}-pass reference of the edited scene (medians of 3 moves): the new epoch's first image has RMSE {we:.3e} at {:.0} ms with warm restarts, {ce:.3e} at {:.0} ms with the cold restart's ¼-resolution preview of before ({:.2}x); on screen {} ms after the move: {warm:.3e} and {cold:.3e} ({:.2}x)",
         wt * 1e3,
         ct * 1e3,
         we / ce,

@@ -1,105 +1,186 @@
-//! What an edit looks like while it renders: one control point moved in the viewer's kind of
-//! render session ([`SessionOptions::interactive`]), every frame of the new epoch compared with
-//! a reference of the edited scene. Behind `caustic bench edit` (time to an error, warm and
-//! cold restarts) and `caustic view --bench` (what is on screen 100 ms after an edit).
+//! `caustic bench edit`: how soon an edit shows converged. One control point is moved by a
+//! few per cent of its patch's size while the viewer's kind of session renders; the time from
+//! the edit to relative MSE 1e-2 against a (cached) reference of the edited scene is measured
+//! with the new epoch started warm and cold, runs interleaved, medians printed.
 
-use std::time::{Duration, Instant};
+use std::path::PathBuf;
+use std::time::Duration;
 
-use crate::render::error::errors;
-use crate::render::session::{Command, RenderSession, SessionOptions};
-use crate::scene::Scene;
+use anyhow::{bail, Result};
+use clap::Parser;
+use glam::DVec3;
 
-/// How long a pass before the edit may take at most.
-const BEFORE_EDIT_WAIT: Duration = Duration::from_secs(120);
+use super::edit_run::{EditPlan, WarmCold, ON_SCREEN_AFTER};
+use super::output::BenchOutput;
+use crate::args::Threads;
+use crate::render::session::Command;
+use crate::scene::{RendererKind, Scene};
 
-/// How long after an edit the picture on screen is judged (the drag preview's target).
-pub const ON_SCREEN_AFTER: Duration = Duration::from_millis(100);
-
-/// How one edit is measured.
-#[derive(Clone, Debug)]
-pub struct EditPlan {
-    /// The edit (a [`Command::MoveControlPoint`]).
-    pub edit: Command,
+/// `caustic bench edit`.
+#[derive(Parser)]
+pub struct EditArgs {
+    /// Scene file with Bézier patches (default: scenes/inline_patch.toml, built in).
+    pub scene: Option<PathBuf>,
+    /// The patch whose control point moves.
+    #[arg(long, default_value_t = 0)]
+    patch: usize,
+    /// The control point that moves (4i + j; default an inner one).
+    #[arg(long, default_value_t = 5)]
+    point: usize,
+    /// How far it moves, as a share of the patch's bounding-box diagonal, along the surface's
+    /// normal there.
+    #[arg(long, default_value_t = 0.03)]
+    distance: f64,
     /// Passes rendered before the edit (the image a person was looking at).
-    pub before_passes: u32,
-    /// Start the new epoch warm (else cold, with the low-resolution preview, as before warm
-    /// restarts existed).
-    pub warm: bool,
-    /// Stop once the relative MSE is at most this.
-    pub target: f64,
-    /// Give up after this long.
-    pub limit: Duration,
+    #[arg(long, default_value_t = 16)]
+    before_passes: u32,
+    /// Runs of each kind of restart (warm and cold, interleaved; the medians are printed).
+    #[arg(long, default_value_t = 5)]
+    runs: u32,
+    /// The relative MSE to reach.
+    #[arg(long, default_value_t = 1e-2)]
+    target: f64,
+    /// Give up on a run after this many seconds.
+    #[arg(long, default_value_t = 60.0)]
+    limit: f64,
+    /// Passes of the edited scene's reference render (cached, as `bench convergence`'s).
+    #[arg(long, default_value_t = 400)]
+    reference_passes: u32,
+    /// Where reference renders are cached (default: ~/.cache/caustic/references).
+    #[arg(long, value_name = "DIR")]
+    reference_dir: Option<PathBuf>,
+    /// `--threads`: the worker pool's size.
+    #[command(flatten)]
+    pub threads: Threads,
 }
 
-/// What one edit measured; errors against the reference of the edited scene.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct EditRun {
-    /// Seconds from the edit to the target relative MSE (`None`: not within the limit).
-    pub to_target: Option<f64>,
-    /// Seconds to the new epoch's first image, and its RMSE.
-    pub first: (f64, f64),
-    /// RMSE of the newest image there was [`ON_SCREEN_AFTER`] the edit (the previous epoch's
-    /// last when none of the new one had come).
-    pub on_screen: f64,
+/// The edit a run makes.
+struct Edit {
+    patch: usize,
+    index: usize,
+    position: DVec3,
 }
 
-/// Renders `scene` in an interactive session, makes the edit after `before_passes` passes and
-/// follows the new epoch until the target (or the limit). `Err` when the renderer failed.
-pub fn measure_edit(scene: Scene, plan: &EditPlan, reference: &[[f32; 3]]) -> Result<EditRun, String> {
-    let mut options = SessionOptions {
-        every_frame: true,
-        ..SessionOptions::interactive()
-    };
-    options.warm_restarts = plan.warm;
-    let session = RenderSession::start_with(scene, options, None);
-    let frames = session.frames();
-    let mut edited_at: Option<Instant> = None;
-    let mut first = None;
-    let mut on_screen = None;
-    let mut last = f64::NAN;
-    let mut run = None;
-    // Before the edit, passes may take long; after it, the limit counts.
-    let wait = |edited_at: Option<Instant>| match edited_at {
-        None => BEFORE_EDIT_WAIT,
-        Some(at) => plan.limit.saturating_sub(at.elapsed()),
-    };
-    while let Ok(frame) = frames.recv_timeout(wait(edited_at)) {
-        let rmse = errors(&frame.radiance, reference).0;
-        let Some(at) = edited_at else {
-            last = rmse;
-            if frame.pass >= plan.before_passes && !frame.preview {
-                session.send(plan.edit.clone());
-                edited_at = Some(Instant::now());
-            }
-            continue;
-        };
-        if frame.epoch == 0 {
-            last = rmse;
-            continue;
-        }
-        let secs = at.elapsed();
-        if secs > ON_SCREEN_AFTER {
-            on_screen.get_or_insert(last);
-        }
-        last = rmse;
-        first.get_or_insert((secs.as_secs_f64(), rmse));
-        let rel_mse = errors(&frame.radiance, reference).1;
-        if rel_mse <= plan.target {
-            run = Some(secs.as_secs_f64());
-            break;
-        }
-        if secs > plan.limit {
-            break;
-        }
+/// Runs the measurement.
+pub fn bench_edit(args: EditArgs, out: &mut BenchOutput) -> Result<()> {
+    if args.runs == 0 || args.before_passes == 0 {
+        bail!("--runs and --before-passes must be at least 1");
     }
-    let failure = session.failure();
-    session.shutdown();
-    if let Some(f) = failure {
-        return Err(format!("the renderer failed: {f}"));
+    if !(args.target > 0.0 && args.limit > 0.0 && args.distance.is_finite()) {
+        bail!("--target and --limit must be positive, --distance finite");
     }
-    Ok(EditRun {
-        to_target: run,
-        first: first.unwrap_or((f64::NAN, f64::NAN)),
-        on_screen: on_screen.unwrap_or(last),
+    let mut scene = crate::run::scene_or_built_in(
+        args.scene.as_deref(),
+        crate::assets::INLINE_PATCH_SCENE,
+        "inline_patch",
+    )?;
+    scene.params.renderer = RendererKind::Ppm;
+    let edit = edit(&scene, &args)?;
+    let mut edited = scene.clone();
+    edited
+        .geometry
+        .set_control_point(edit.patch, edit.index, edit.position);
+    let reference = super::convergence::reference(
+        &edited,
+        args.reference_passes,
+        args.reference_dir.as_deref(),
+        Some(format!(
+            "control point {} of patch {} moved to {:?}",
+            edit.index, edit.patch, edit.position
+        )),
+        out,
+    )?;
+    out.say(format!(
+        "Edit of {}: control point {} of patch {} moved by {} % of the patch's size; {} passes before the edit, {}x{}",
+        scene.source.display(),
+        edit.index,
+        edit.patch,
+        100.0 * args.distance,
+        args.before_passes,
+        scene.camera.width,
+        scene.camera.height
+    ));
+    let plan = EditPlan {
+        edit: Command::MoveControlPoint {
+            patch: edit.patch,
+            index: edit.index,
+            position: edit.position,
+        },
+        before_passes: args.before_passes,
+        warm: true,
+        target: args.target,
+        limit: Duration::from_secs_f64(args.limit),
+    };
+    let runs = WarmCold::measure(&scene, &plan, args.runs, &reference, |run, warm, r| {
+        eprintln!(
+            "  run {} {}: {}",
+            run + 1,
+            if warm { "warm" } else { "cold" },
+            r.to_target.map_or("not reached".into(), |t| format!("{t:.3} s"))
+        );
     })
+    .map_err(|e| anyhow::anyhow!(e))?;
+    report(&runs, args.target, out);
+    Ok(())
+}
+
+/// The moved point: `--distance` of the patch's diagonal along the surface normal at it.
+fn edit(scene: &Scene, args: &EditArgs) -> Result<Edit> {
+    let patches = scene.geometry.patches();
+    let Some((patch, _)) = patches.get(args.patch) else {
+        bail!(
+            "--patch {}: {} has {} patches",
+            args.patch,
+            scene.source.display(),
+            patches.len()
+        );
+    };
+    if args.point >= 16 {
+        bail!(
+            "--point {}: a bicubic patch has control points 0 to 15",
+            args.point
+        );
+    }
+    let (i, j) = (args.point / 4, args.point % 4);
+    let normal = patch.normal(i as f64 / 3.0, j as f64 / 3.0).unwrap_or(DVec3::Y);
+    let bounds = patch.bounds();
+    let size = (bounds.max - bounds.min).length();
+    Ok(Edit {
+        patch: args.patch,
+        index: args.point,
+        position: patch.points[args.point] + normal * (args.distance * size),
+    })
+}
+
+/// Prints the medians: the time to the target, then the first image after the edit and what
+/// is on screen [`ON_SCREEN_AFTER`] it.
+fn report(runs: &WarmCold, target: f64, out: &mut BenchOutput) {
+    let m = runs.medians();
+    let [w, c] = m.to_target;
+    out.say(format!(
+        "edit to relative MSE {target:.0e}: warm {w:.2} s, cold {c:.2} s  (medians of {} runs each)",
+        runs.warm.len()
+    ));
+    let [(wt, we), (ct, ce)] = m.first;
+    out.say(format!(
+        "first image after the edit: warm at {:.0} ms, RMSE {we:.3e}; cold at {:.0} ms, RMSE {ce:.3e}",
+        wt * 1e3,
+        ct * 1e3
+    ));
+    let [ws, cs] = m.on_screen;
+    out.say(format!(
+        "on screen {} ms after the edit: RMSE warm {ws:.3e}, cold {cs:.3e} ({:.2}x)",
+        ON_SCREEN_AFTER.as_millis(),
+        ws / cs
+    ));
+    out.set("on_screen_rmse", [ws, cs]);
+    out.set("warm_secs", w);
+    out.set("cold_secs", c);
+    out.set("warm_first_image", [wt, we]);
+    out.set("cold_first_image", [ct, ce]);
+    for (name, runs) in [("warm_runs", &runs.warm), ("cold_runs", &runs.cold)] {
+        for r in runs {
+            out.push(name, r.to_target);
+        }
+    }
 }

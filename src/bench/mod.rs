@@ -1,12 +1,29 @@
-//! Measurement harnesses behind `caustic bench`: deterministic inputs, figures printed, never
-//! asserted (tests assert correctness; benches report speed). Error against time lives in
-//! [`error_curves`] (curves, CSV), [`plot`] (log-log PNG) and [`mod@reference`] (the cached
-//! reference render).
+//! Measurement: every benchmark of `caustic bench` and the harnesses they and the viewer's
+//! `view --bench` share. Figures are printed, never asserted (tests assert correctness;
+//! benches report speed); inputs are deterministic.
+//!
+//! - [`command`]: the subcommands and [`command::run`]; [`output`]: text or one JSON document.
+//! - One file a bench, flags and all: [`intersect`], [`scaling`] (`ppm`, `whitted`),
+//!   [`convergence`], [`edit`], [`memory`], [`shards`], [`tessellation`], and [`all`] (the
+//!   README's table from the others' JSON).
+//! - Harnesses: [`edit_run`] (an edit in the viewer's kind of session, warm or cold),
+//!   [`error_curves`] (curves, CSV), [`plot`] (log-log PNG), [`mod@reference`] (the cached
+//!   reference render), [`timings`] (medians, interleaved runs).
 
+pub mod all;
+pub mod command;
+pub mod convergence;
 pub mod edit;
+pub mod edit_run;
 pub mod error_curves;
+pub mod intersect;
+pub mod memory;
+pub mod output;
 pub mod plot;
 pub mod reference;
+pub mod scaling;
+pub mod shards;
+pub mod tessellation;
 pub mod timings;
 
 use std::borrow::Cow;

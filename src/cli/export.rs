@@ -5,11 +5,11 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 
-use super::runs::load_scene;
-use super::shared_args::Overwrite;
+use caustic::args::Overwrite;
 use caustic::files::write_atomically;
 use caustic::geometry::freeform::{write_freeform_obj, DomainPatch};
 use caustic::geometry::tessellate::{tessellate, write_obj};
+use caustic::run::load_scene;
 
 /// `caustic export-obj`'s flags.
 #[derive(clap::Args)]

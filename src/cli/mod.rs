@@ -1,22 +1,12 @@
 //! The `caustic` command line: argument parsing and dispatch; each command lives in a file of
-//! its own ([`view`], [`render`], [`export`], [`bench`], [`bench_convergence`], [`memory`]).
+//! its own ([`view`], [`render`], [`shard`], [`farm`], [`export`]). `caustic bench`'s
+//! subcommands are the library's ([`caustic::bench::command`]), parsed here and run there.
 
-mod bench;
-mod bench_all;
-mod bench_convergence;
-mod bench_edit;
-mod bench_output;
-mod bench_scaling;
-mod bench_shards;
 mod export;
 mod farm;
-mod memory;
 mod render;
 mod render_report;
-mod runs;
 mod shard;
-mod shared_args;
-mod tessellation;
 mod view;
 
 use anyhow::{bail, Context, Result};
@@ -53,7 +43,7 @@ enum Command {
         #[arg(long, global = true)]
         json: bool,
         #[command(subcommand)]
-        what: bench::BenchCommand,
+        what: caustic::bench::command::BenchCommand,
     },
 }
 
@@ -76,7 +66,7 @@ pub fn run() -> Result<()> {
         Command::ExportObj(args) => export::export_obj(args),
         Command::Merge(args) => shard::merge(args),
         Command::Farm(args) => farm::farm(args),
-        Command::Bench { what, json } => bench::bench(what, json),
+        Command::Bench { what, json } => caustic::bench::command::run(what, json),
     }
 }
 

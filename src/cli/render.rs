@@ -9,8 +9,7 @@ use std::time::Duration;
 use anyhow::{bail, Result};
 
 use super::render_report::Report;
-use super::runs::{load_scene, render_session};
-use super::shared_args::{Overwrite, Threads};
+use caustic::args::{Overwrite, Threads};
 use caustic::render::compare::Reference;
 use caustic::render::error::pixel_error_estimate;
 use caustic::render::provenance::{software, Recorded};
@@ -18,6 +17,7 @@ use caustic::render::session::{Frame, FrameStats, SessionOptions};
 use caustic::render::shard::sums::passes_text;
 use caustic::render::shard::{PartHeader, PassSet};
 use caustic::render::{image_metadata, Image, Layer};
+use caustic::run::{load_scene, render_session};
 use caustic::scene::{RendererKind, Scene};
 use caustic::settings::limits;
 use caustic::settings::{RadiusSchedule, SettingFlags};

@@ -69,7 +69,8 @@ impl Report {
 
     /// A progress bar over `len` steps (drawn only on a terminal, on stderr).
     pub fn bar(&self, len: u64, template: &str, message: String) -> indicatif::ProgressBar {
-        super::runs::progress_bar(len, template, message).unwrap_or_else(|_| indicatif::ProgressBar::hidden())
+        caustic::run::progress_bar(len, template, message)
+            .unwrap_or_else(|_| indicatif::ProgressBar::hidden())
     }
 
     /// The bar lines are printed above while it runs.

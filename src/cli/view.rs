@@ -7,7 +7,7 @@ use anyhow::bail;
 use anyhow::Result;
 use clap::Parser;
 
-use super::shared_args::{Overwrite, Threads};
+use caustic::args::{Overwrite, Threads};
 
 /// `caustic view` (also what `caustic` alone runs, with these defaults).
 #[derive(Parser)]

@@ -11,10 +11,12 @@
 
 pub mod folder;
 pub mod part;
+pub mod render_part;
 pub mod sums;
 
 pub use folder::{FolderMerge, RenderInFolder, ScanReport};
 pub use part::{MergeError, Part, PartError, PartHeader, RenderKey};
+pub use render_part::{merge_parts, shard_part};
 pub use sums::PassSums;
 
 /// Which of a render's passes one process renders: pass `i` when `i mod count == index`.

@@ -11,15 +11,15 @@ use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 
-use super::bench_output::BenchOutput;
-use super::runs::load_scene;
-use super::shared_args::{CurveFiles, Threads};
-use caustic::bench::plot::{draw_series, write_png, Frame, Series};
-use caustic::files::write_atomically;
-use caustic::geometry::{PatchMethod, SubdivisionParams};
-use caustic::render::error::errors;
-use caustic::render::render_whitted;
-use caustic::scene::Scene;
+use super::output::BenchOutput;
+use super::plot::{draw_series, write_png, Frame, Series};
+use crate::args::{CurveFiles, Threads};
+use crate::files::write_atomically;
+use crate::geometry::{PatchMethod, SubdivisionParams};
+use crate::render::error::errors;
+use crate::render::render_whitted;
+use crate::run::load_scene;
+use crate::scene::Scene;
 
 /// `bench tessellation`'s flags.
 #[derive(clap::Args)]
@@ -38,6 +38,7 @@ pub struct TessellationArgs {
     /// Rows (method, segments, triangles, seconds, RMSE) and the plot of RMSE against seconds.
     #[command(flatten)]
     files: CurveFiles,
+    /// `--threads`: the worker pool's size.
     #[command(flatten)]
     pub threads: Threads,
 }
@@ -71,7 +72,7 @@ pub fn bench_tessellation(args: TessellationArgs, out: &mut BenchOutput) -> Resu
         );
     }
     args.files.check()?;
-    caustic::settings::limits::image_side(args.width).map_err(|e| anyhow::anyhow!("--width {e}"))?;
+    crate::settings::limits::image_side(args.width).map_err(|e| anyhow::anyhow!("--width {e}"))?;
     scene.camera.resize(Some(args.width), None);
     let (w, h) = (scene.camera.width, scene.camera.height);
     let patches = scene.geometry.patches().len();
@@ -169,7 +170,7 @@ fn write_rows(rows: &[Row], path: &std::path::Path, force: bool, out: &mut Bench
         let _ = writeln!(
             text,
             "{},{segments},{},{:.6},{:.6},{:.6e}",
-            caustic::bench::csv_field(&r.method),
+            super::csv_field(&r.method),
             r.triangles,
             r.prepare_secs,
             r.render_secs,

@@ -8,12 +8,12 @@ use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 
-use super::bench_output::BenchOutput;
-use super::runs::load_scene;
-use super::shard::{merge_parts, shard_part};
-use super::shared_args::Threads;
-use caustic::render::shard::{PassSet, Shard};
-use caustic::scene::Scene;
+use super::output::BenchOutput;
+use crate::args::Threads;
+use crate::render::shard::{merge_parts, shard_part};
+use crate::render::shard::{PassSet, Shard};
+use crate::run::load_scene;
+use crate::scene::Scene;
 
 /// `bench shards`'s flags.
 #[derive(clap::Args)]
@@ -47,6 +47,7 @@ pub struct ShardsArgs {
     /// For the projection: machines.
     #[arg(long, default_value_t = 64)]
     project_machines: u32,
+    /// `--threads`: the worker pool's size.
     #[command(flatten)]
     pub threads: Threads,
 }
@@ -131,7 +132,7 @@ pub fn bench_shards(args: ShardsArgs, out: &mut BenchOutput) -> Result<()> {
     }
     let mut scene = load_scene(args.scene.as_deref())?;
     for (flag, v) in [("--width", args.width), ("--height", args.height)] {
-        caustic::settings::limits::image_side(v).map_err(|e| anyhow::anyhow!("{flag} {e}"))?;
+        crate::settings::limits::image_side(v).map_err(|e| anyhow::anyhow!("{flag} {e}"))?;
     }
     scene.camera.resize(Some(args.width), Some(args.height));
     if let Some(n) = args.photons {

@@ -5,8 +5,8 @@ use std::path::Path;
 
 use anyhow::{bail, Context, Result};
 
-use caustic::render::session::{Frame, RenderSession, SessionOptions};
-use caustic::scene::Scene;
+use crate::render::session::{Frame, RenderSession, SessionOptions};
+use crate::scene::Scene;
 
 /// A progress bar over `len` steps (drawn only on a terminal).
 pub fn progress_bar(len: u64, template: &str, message: String) -> Result<indicatif::ProgressBar> {
@@ -21,7 +21,7 @@ pub fn progress_bar(len: u64, template: &str, message: String) -> Result<indicat
 
 /// The scene a photon-mapping bench measures: the file, or smallppm's built-in scene.
 pub fn photon_scene(path: Option<&Path>) -> Result<Scene> {
-    scene_or_built_in(path, caustic::assets::SMALLPPM_SCENE, "smallppm")
+    scene_or_built_in(path, crate::assets::SMALLPPM_SCENE, "smallppm")
 }
 
 /// The scene file at `path`, or when none is given the scene text `built_in` (a bench's

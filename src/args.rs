@@ -38,6 +38,7 @@ pub struct CurveFiles {
     /// Write the log-log plot of the measured error to this PNG file.
     #[arg(long)]
     pub plot: Option<PathBuf>,
+    /// `--force` for both files.
     #[command(flatten)]
     pub overwrite: Overwrite,
 }

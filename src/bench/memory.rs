@@ -6,11 +6,11 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Result};
 
-use super::bench_output::BenchOutput;
-use super::runs::{load_scene, render_session};
-use super::shared_args::Threads;
-use caustic::render::session::SessionOptions;
-use caustic::scene::RendererKind;
+use super::output::BenchOutput;
+use crate::args::Threads;
+use crate::render::session::SessionOptions;
+use crate::run::{load_scene, render_session};
+use crate::scene::RendererKind;
 
 /// `bench memory`'s flags.
 #[derive(clap::Args)]
@@ -32,6 +32,7 @@ pub struct MemoryArgs {
     /// Photons per pass (small: the eye pass and its visible points are what grows).
     #[arg(long, default_value_t = 20_000)]
     photons: u64,
+    /// `--threads`: the worker pool's size.
     #[command(flatten)]
     pub threads: Threads,
 }
@@ -48,7 +49,7 @@ pub(super) fn resident_mib() -> Option<(f64, f64)> {
 }
 
 /// Where the prepared geometry's bytes go, in all and per Bézier patch.
-fn geometry_memory(scene: &caustic::scene::Scene, out: &mut BenchOutput) {
+fn geometry_memory(scene: &crate::scene::Scene, out: &mut BenchOutput) {
     let stats = scene.geometry.stats();
     let parts = scene.geometry.memory();
     let total: usize = parts.iter().map(|(_, b)| b).sum();
@@ -91,7 +92,7 @@ pub fn bench_memory(args: MemoryArgs, out: &mut BenchOutput) -> Result<()> {
     }
     let mut scene = load_scene(args.scene.as_deref())?;
     for (flag, v) in [("--width", args.width), ("--height", args.height)] {
-        caustic::settings::limits::image_side(v).map_err(|e| anyhow::anyhow!("{flag} {e}"))?;
+        crate::settings::limits::image_side(v).map_err(|e| anyhow::anyhow!("{flag} {e}"))?;
     }
     (scene.camera.width, scene.camera.height) = (args.width, args.height);
     // An open aperture: stochastic PPM, a new eye pass (and new visible points) every pass.

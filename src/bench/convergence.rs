@@ -7,17 +7,17 @@ use std::time::Duration;
 
 use anyhow::{bail, Context, Result};
 
-use super::bench_output::BenchOutput;
-use super::runs::render_session;
-use super::shared_args::{CurveFiles, Threads};
-use caustic::bench::error_curves::{errors, write_csv, Checkpoint, Curve};
-use caustic::bench::plot::write_plot;
-use caustic::bench::reference::{default_cache_dir, ReferenceRecord};
-use caustic::render::ppm::Ppm;
-use caustic::render::session::SessionOptions;
-use caustic::scene::{RendererKind, Scene};
-use caustic::settings::setting::Kind;
-use caustic::settings::RenderParams;
+use super::error_curves::{errors, write_csv, Checkpoint, Curve};
+use super::output::BenchOutput;
+use super::plot::write_plot;
+use super::reference::{default_cache_dir, ReferenceRecord};
+use crate::args::{CurveFiles, Threads};
+use crate::render::ppm::Ppm;
+use crate::render::session::SessionOptions;
+use crate::run::render_session;
+use crate::scene::{RendererKind, Scene};
+use crate::settings::setting::Kind;
+use crate::settings::RenderParams;
 
 /// A configuration measured: the scene's settings changed as its text says, through the table
 /// of settings — `default`, `photons-only` (photon mapping as the paper has it: every switch
@@ -50,7 +50,7 @@ impl Config {
             let (key, value) = change
                 .split_once('=')
                 .ok_or_else(|| format!("{change:?}: expected KEY=VALUE, default or photons-only"))?;
-            let setting = caustic::settings::find_setting(key.trim())
+            let setting = crate::settings::find_setting(key.trim())
                 .ok_or_else(|| format!("{key:?} is not a render setting (see scenes/FORMAT.md)"))?;
             changes.push((setting.key, value.trim().to_owned()));
         }
@@ -70,7 +70,7 @@ impl Config {
     fn params(&self, base: &RenderParams, auto_radius: f64) -> Result<RenderParams> {
         let defaults = RenderParams::default();
         let mut p = base.clone();
-        for s in caustic::settings::SETTINGS {
+        for s in crate::settings::SETTINGS {
             let switch = matches!(s.kind, Kind::Bool | Kind::Auto);
             if s.renderers == [RendererKind::Ppm] && switch {
                 if let Some(v) = defaults.get(s.key) {
@@ -130,13 +130,14 @@ pub struct ConvergenceArgs {
     /// Rows (configuration, pass, seconds, RMSE, relMSE) and the plot of RMSE against seconds.
     #[command(flatten)]
     files: CurveFiles,
+    /// `--threads`: the worker pool's size.
     #[command(flatten)]
     pub threads: Threads,
 }
 
 /// Runs the measurement and prints the table.
 pub fn bench_convergence(args: ConvergenceArgs, out: &mut BenchOutput) -> Result<()> {
-    let mut scene = super::runs::photon_scene(args.scene.as_deref())?;
+    let mut scene = crate::run::photon_scene(args.scene.as_deref())?;
     check(
         &args.width,
         args.seconds,
@@ -207,7 +208,7 @@ pub fn bench_convergence(args: ConvergenceArgs, out: &mut BenchOutput) -> Result
 }
 
 fn check(width: &u32, seconds: f64, baseline: Option<f64>, passes: u32) -> Result<()> {
-    caustic::settings::limits::image_side(*width).map_err(|e| anyhow::anyhow!("--width {e}"))?;
+    crate::settings::limits::image_side(*width).map_err(|e| anyhow::anyhow!("--width {e}"))?;
     for (flag, s) in [("--seconds", Some(seconds)), ("--baseline-seconds", baseline)] {
         if let Some(s) = s {
             if !(s.is_finite() && s > 0.0 && s <= 86_400.0) {
@@ -229,7 +230,7 @@ fn check(width: &u32, seconds: f64, baseline: Option<f64>, passes: u32) -> Resul
 /// further where photons are dense (a fixed-radius reference keeps the caustics blurred by the
 /// initial radius for hundreds of passes, and would count a sharper caustic as error).
 /// `edit` describes a change made to the scene after it was read (part of the cache's key).
-pub(super) fn reference(
+pub fn reference(
     scene: &Scene,
     passes: u32,
     dir: Option<&Path>,
@@ -250,7 +251,7 @@ pub(super) fn reference(
         out.set("reference", record.path_in(&dir).display().to_string());
         return Ok(pixels);
     }
-    let bar = super::runs::progress_bar(
+    let bar = crate::run::progress_bar(
         passes as u64,
         "{msg} [{bar:40}] pass {pos}/{len}, {elapsed} (eta {eta})",
         "reference".into(),

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 
-use super::bench_output::BenchOutput;
+use super::output::BenchOutput;
 
 /// `bench all`'s flags.
 #[derive(clap::Args)]
@@ -219,7 +219,7 @@ pub fn bench_all(args: AllArgs, out: &mut BenchOutput) -> Result<()> {
                     command: format!("caustic bench {}", bench.args.join(" ")),
                     date: date.clone(),
                     machine: machine.clone(),
-                    program: caustic::render::provenance::software(),
+                    program: crate::render::provenance::software(),
                 });
             }
         }

@@ -1,6 +1,6 @@
 //! `caustic bench ppm` and `caustic bench whitted`: a renderer's throughput at several thread
 //! counts, and how it scales. With `--repeat N` the thread counts' runs interleave N times and
-//! each count reports its best and median run (see [`caustic::bench::timings`]): on a shared
+//! each count reports its best and median run (see [`super::timings`]): on a shared
 //! machine one run's scaling can be off by 15 % either way.
 
 use std::path::PathBuf;
@@ -8,12 +8,12 @@ use std::path::PathBuf;
 use anyhow::{bail, Result};
 use clap::Args;
 
-use super::bench_output::BenchOutput;
-use super::runs::{load_scene, photon_scene, render_session};
-use caustic::bench::timings::{interleaved, Timings};
-use caustic::render::render_whitted;
-use caustic::render::session::SessionOptions;
-use caustic::scene::RendererKind;
+use super::output::BenchOutput;
+use super::timings::{interleaved, Timings};
+use crate::render::render_whitted;
+use crate::render::session::SessionOptions;
+use crate::run::{load_scene, photon_scene, render_session};
+use crate::scene::RendererKind;
 
 /// Thread counts to measure and how often.
 #[derive(Args)]
@@ -229,7 +229,7 @@ fn runs_text(repeat: usize) -> String {
 
 /// The photons a photon-mapped frame's epoch traced and the seconds spent tracing them, from
 /// the statistics photon mapping describes (`photon_mapping` in its JSON).
-fn photon_work(frame: &caustic::render::session::Frame) -> Result<(u64, f64)> {
+fn photon_work(frame: &crate::render::session::Frame) -> Result<(u64, f64)> {
     let stats = &frame.stats.json["photon_mapping"];
     match (stats["photons"].as_u64(), stats["photon_secs"].as_f64()) {
         (Some(photons), Some(secs)) => Ok((photons, secs)),

@@ -18,7 +18,7 @@ impl BenchOutput {
     pub fn new(json: bool, bench: &str) -> Self {
         let mut doc = Map::new();
         doc.insert("bench".into(), bench.into());
-        doc.insert("program".into(), caustic::render::provenance::software().into());
+        doc.insert("program".into(), crate::render::provenance::software().into());
         Self { json, doc }
     }
 
