@@ -99,37 +99,48 @@ fn every_light_kind_over_a_plane_gives_the_closed_form() {
     }
 }
 
-/// The Cornell box (glass and mirror spheres, an area light): the path tracer's converged
-/// image mean agrees with photon mapping's within 1 %, channel by channel. The teapot's
-/// Phong lobe is turned off: photon mapping gathers only the diffuse part of a `phong`
-/// material (with the lobe, the path tracer's mean is 0.75 % higher, which is the lobe).
+/// The Cornell box (glass and mirror spheres, an area light, a teapot with a Phong lobe): the
+/// path tracer's converged image mean agrees with photon mapping's, channel by channel, with
+/// the lobe and without it. Photon mapping gathers the diffuse part of a `phong` material at
+/// its visible points (the lobe reaches them by photons that bounced off it), so with the lobe
+/// its mean may stay up to 0.5 % below the path tracer's; without it, within 0.4 % either way.
 #[test]
 fn the_cornell_box_converges_to_photon_mappings_mean() {
     use caustic::scene::MaterialKind;
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell.toml");
-    let mut scene = Scene::load(&path).expect("cornell");
-    (scene.camera.width, scene.camera.height) = (40, 30);
-    for m in &mut scene.materials {
+    let mut phong = Scene::load(&path).expect("cornell");
+    (phong.camera.width, phong.camera.height) = (40, 30);
+    phong.params.photons_per_pass = 50_000;
+    let mut lambert = phong.clone();
+    for m in &mut lambert.materials {
         if let MaterialKind::Diffuse { specular, .. } = &mut m.kind {
             *specular = 0.0;
         }
     }
-    let traced = path_traced(&scene, 2048);
-    scene.params.photons_per_pass = 50_000;
-    let mut ppm = Ppm::new(&scene, PpmOptions::default());
-    for _ in 0..300 {
-        ppm.run_pass(&scene, &mut |_| Control::Continue);
-    }
-    let mapped = ppm.radiance();
-    for c in 0..3 {
-        let mean = |image: &[[f32; 3]]| image.iter().map(|p| p[c] as f64).sum::<f64>() / image.len() as f64;
-        let (pt, pm) = (mean(&traced), mean(&mapped));
-        eprintln!("channel {c}: path traced {pt:.5}, photon mapped {pm:.5}");
-        assert!(
-            (pt / pm - 1.0).abs() < 0.01,
-            "channel {c}: path traced / photon mapped = {}",
-            pt / pm
-        );
+    for (name, scene, low, high) in [
+        ("phong", &phong, -0.005, 0.003),
+        ("lambert", &lambert, -0.004, 0.004),
+    ] {
+        let traced = path_traced(scene, 2048);
+        let mut ppm = Ppm::new(scene, PpmOptions::default());
+        for _ in 0..300 {
+            ppm.run_pass(scene, &mut |_| Control::Continue);
+        }
+        let mapped = ppm.radiance();
+        for c in 0..3 {
+            let mean =
+                |image: &[[f32; 3]]| image.iter().map(|p| p[c] as f64).sum::<f64>() / image.len() as f64;
+            let (pt, pm) = (mean(&traced), mean(&mapped));
+            let gap = pm / pt - 1.0;
+            eprintln!(
+                "{name} channel {c}: path traced {pt:.5}, photon mapped {pm:.5} ({:+.3} %)",
+                100.0 * gap
+            );
+            assert!(
+                (low..=high).contains(&gap),
+                "{name} channel {c}: photon mapped / path traced - 1 = {gap}"
+            );
+        }
     }
 }
 

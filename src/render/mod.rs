@@ -4,6 +4,7 @@
 //! ([`compare`], [`error`]), deterministic random streams and low-discrepancy sequences, and
 //! independent passes split across processes and merged ([`shard`]).
 
+pub mod bsdf;
 pub mod compare;
 pub mod control;
 pub mod error;

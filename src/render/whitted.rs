@@ -8,7 +8,6 @@
 //! Radiance is physically scaled: a diffuse surface of reflectance ρ lit by a point light of
 //! intensity I at distance r reflects `ρ/π · I cos θ / r²`.
 
-use std::f64::consts::PI;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
@@ -17,12 +16,12 @@ use rand::Rng;
 use rand_pcg::Pcg64Mcg;
 use rayon::prelude::*;
 
+use super::bsdf::Bsdf;
 use super::film::Image;
 use super::rng::{mix64, stream_rng, streams};
-use crate::geometry::Ray;
+use crate::geometry::{Hit, Ray};
 use crate::scene::camera::{concentric_disk, EyeRays};
-use crate::scene::material::{dielectric, reflect};
-use crate::scene::{MaterialKind, Scene};
+use crate::scene::Scene;
 
 /// What a render did.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
@@ -112,72 +111,71 @@ impl Tracer<'_> {
         if scene.objects[hit.object as usize].emission.is_some() || depth >= scene.params.max_depth {
             return emitted;
         }
-        let surface = scene.surface(&hit, ray.dir);
-        let (color, front, n) = (surface.color, surface.front, surface.normal);
-        match surface.material.kind {
-            MaterialKind::Diffuse { specular, shininess } => {
-                let wo = -ray.dir;
-                let mut radiance = emitted + scene.params.ambient * color;
-                for (k, light) in scene.lights.iter().enumerate() {
-                    let samples = if light.is_area() {
-                        scene.params.light_samples
-                    } else {
-                        1
-                    };
-                    let grid = (samples as f64).sqrt().ceil() as u32;
-                    let mut sum = DVec3::ZERO;
-                    let mut visible = 0u32;
-                    for s in 0..samples {
-                        // Stratified over a grid × grid square, jittered.
-                        let cell = DVec2::new((s % grid) as f64, (s / grid % grid) as f64);
-                        let jitter = DVec2::new(state.rng.random(), state.rng.random());
-                        let u = (cell + jitter) / grid as f64;
-                        let Some(ls) = light.sample(hit.point, u) else {
-                            continue;
-                        };
-                        let cos = n.dot(ls.wi);
-                        if cos <= 0.0 {
-                            continue;
-                        }
-                        if scene.occluded_from_hit(&hit, k, &ls) {
-                            continue;
-                        }
-                        visible += 1;
-                        let mut f = color / PI;
-                        if specular > 0.0 {
-                            let r = reflect(-ls.wi, n);
-                            let c = r.dot(wo).max(0.0);
-                            f += DVec3::splat(specular * (shininess + 2.0) / (2.0 * PI) * c.powf(shininess));
-                        }
-                        sum += f * ls.incident * cos;
-                    }
-                    // Shadow boundaries are edges too: fully lit, partly lit, or dark.
-                    let lit = if visible == 0 {
-                        0
-                    } else if visible == samples {
-                        2
-                    } else {
-                        1
-                    };
-                    state.touch(((k as u64) << 2) | lit);
-                    radiance += sum / samples as f64;
-                }
-                radiance
-            }
-            MaterialKind::Mirror => {
-                let dir = reflect(ray.dir, n);
-                emitted + color * self.trace(&hit.spawn(dir), depth + 1, state)
-            }
-            MaterialKind::Glass { ior } => {
-                let glass = dielectric(ray.dir, n, ior, front);
-                let mut radiance = emitted;
-                radiance += glass.fresnel * self.trace(&hit.spawn(glass.reflected), depth + 1, state);
-                if let Some(t) = glass.refracted {
-                    radiance += (1.0 - glass.fresnel) * color * self.trace(&hit.spawn(t), depth + 1, state);
-                }
-                radiance
-            }
+        let bsdf = Bsdf::at(&scene.surface(&hit, ray.dir));
+        let wo = -ray.dir;
+        let mut radiance = emitted;
+        if bsdf.has_smooth() {
+            radiance += scene.params.ambient * bsdf.diffuse_reflectance();
+            radiance = self.add_direct_light(radiance, &hit, &bsdf, wo, state);
         }
+        for lobe in bsdf.specular_lobes(wo).iter() {
+            radiance += lobe.share * lobe.tint * self.trace(&hit.spawn(lobe.wi), depth + 1, state);
+        }
+        radiance
+    }
+
+    /// `radiance` plus the light arriving straight from each light at a smooth surface,
+    /// reflected towards `wo`: point and spot lights by one shadow ray, area lights by
+    /// `light_samples` stratified ones.
+    fn add_direct_light(
+        &self,
+        mut radiance: DVec3,
+        hit: &Hit,
+        bsdf: &Bsdf,
+        wo: DVec3,
+        state: &mut PathState,
+    ) -> DVec3 {
+        let scene = self.scene;
+        let n = bsdf.normal();
+        for (k, light) in scene.lights.iter().enumerate() {
+            let samples = if light.is_area() {
+                scene.params.light_samples
+            } else {
+                1
+            };
+            let grid = (samples as f64).sqrt().ceil() as u32;
+            let mut sum = DVec3::ZERO;
+            let mut visible = 0u32;
+            for s in 0..samples {
+                // Stratified over a grid × grid square, jittered.
+                let cell = DVec2::new((s % grid) as f64, (s / grid % grid) as f64);
+                let jitter = DVec2::new(state.rng.random(), state.rng.random());
+                let u = (cell + jitter) / grid as f64;
+                let Some(ls) = light.sample(hit.point, u) else {
+                    continue;
+                };
+                let cos = n.dot(ls.wi);
+                if cos <= 0.0 {
+                    continue;
+                }
+                if scene.occluded_from_hit(hit, k, &ls) {
+                    continue;
+                }
+                visible += 1;
+                sum += bsdf.eval(wo, ls.wi) * ls.incident * cos;
+            }
+            // Shadow boundaries are edges too: fully lit, partly lit, or dark.
+            let lit = if visible == 0 {
+                0
+            } else if visible == samples {
+                2
+            } else {
+                1
+            };
+            state.touch(((k as u64) << 2) | lit);
+            radiance += sum / samples as f64;
+        }
+        radiance
     }
 }
 

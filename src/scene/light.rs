@@ -238,6 +238,35 @@ impl Light {
             } => sample_sphere((*center, *radius), *radiance, point, u),
         }
     }
+
+    /// The solid-angle density with which [`Light::sample`] picks the direction from `from`
+    /// to the point `on` of this light's surface (0 for point and spot lights, which it
+    /// samples exactly): what multiple importance sampling weighs a BSDF sample that hit the
+    /// light against.
+    pub fn pdf(&self, from: DVec3, on: DVec3) -> f64 {
+        match self {
+            Light::Quad { edge_u, edge_v, .. } => {
+                let n = edge_u.cross(*edge_v);
+                let area = n.length();
+                let d = on - from;
+                let cos = (d.normalize().dot(n / area)).abs();
+                if cos <= 0.0 {
+                    0.0
+                } else {
+                    d.length_squared() / (area * cos)
+                }
+            }
+            Light::Sphere { center, radius, .. } => {
+                let dc2 = (*center - from).length_squared();
+                if dc2 <= radius * radius {
+                    return 0.0;
+                }
+                let cos_max = (1.0 - radius * radius / dc2).max(0.0).sqrt();
+                1.0 / (std::f64::consts::TAU * (1.0 - cos_max))
+            }
+            Light::Point { .. } | Light::Spot { .. } => 0.0,
+        }
+    }
 }
 
 /// A uniform sample of the quad `(corner, edge_u, edge_v)` of radiance `radiance` seen from

@@ -1,11 +1,13 @@
 //! A unidirectional path tracer: an unbiased cross-check of photon mapping in the same
 //! program (Kajiya 1986), in the manner of pbrt-v4's `PathIntegrator`:
 //!
-//! - next-event estimation at every diffuse (and Phong) vertex: one shadow ray to each light;
-//!   for area lights (spheres, quads) weighted by multiple importance sampling against the
-//!   BSDF sample that may hit the same light (Veach 1997, the power heuristic);
-//! - cosine-weighted BSDF sampling, perfect mirrors, and glass choosing reflection or
-//!   refraction by its Fresnel reflectance;
+//! - scattering asked of the BSDF seam ([`crate::render::bsdf`]): at a vertex with a smooth
+//!   part, next-event estimation (one shadow ray to each light; for area lights, spheres and
+//!   quads, weighted by multiple importance sampling against the BSDF sample that may hit the
+//!   same light: Veach 1997, the power heuristic, with the light's own density
+//!   [`crate::scene::Light::pdf`]) and a direction sampled from the BSDF; at a specular one,
+//!   one delta lobe picked with its share (glass: reflection or refraction by its Fresnel
+//!   reflectance);
 //! - Russian roulette on the path throughput after the third bounce;
 //! - one sample per pixel per pass, the pixel position on Sobol's (0,2)-sequence and the lens
 //!   position on R4, randomised per pixel, as the photon mapper's stochastic eye pass places
@@ -16,7 +18,6 @@
 //! The image is the mean of the passes' samples. Emitters reflect nothing (as everywhere in
 //! caustic); a path ends when it meets one.
 
-use std::f64::consts::PI;
 use std::time::Instant;
 
 use glam::{DVec2, DVec3};
@@ -31,8 +32,7 @@ use super::Control;
 use crate::render::provenance;
 use crate::render::rng::stream_rng;
 use crate::render::sequence;
-use crate::scene::light::{cosine_hemisphere, Light};
-use crate::scene::material::{dielectric, reflect, MaterialKind};
+use crate::render::bsdf::Bsdf;
 use crate::scene::Scene;
 use crate::settings::RendererKind;
 
@@ -91,44 +91,6 @@ fn power_heuristic(pdf: f64, other: f64) -> f64 {
     }
 }
 
-/// The solid-angle density with which [`Light::sample`] picks the direction from `from` to the
-/// point `on` of area light `light` (0 for lights sampled exactly).
-fn light_pdf(light: &Light, from: DVec3, on: DVec3) -> f64 {
-    match light {
-        Light::Quad { edge_u, edge_v, .. } => {
-            let n = edge_u.cross(*edge_v);
-            let area = n.length();
-            let d = on - from;
-            let cos = (d.normalize().dot(n / area)).abs();
-            if cos <= 0.0 {
-                0.0
-            } else {
-                d.length_squared() / (area * cos)
-            }
-        }
-        Light::Sphere { center, radius, .. } => {
-            let dc2 = (*center - from).length_squared();
-            if dc2 <= radius * radius {
-                return 0.0;
-            }
-            let cos_max = (1.0 - radius * radius / dc2).max(0.0).sqrt();
-            1.0 / (std::f64::consts::TAU * (1.0 - cos_max))
-        }
-        Light::Point { .. } | Light::Spot { .. } => 0.0,
-    }
-}
-
-/// The BRDF of a diffuse surface of colour `color` with its Phong lobe, for light arriving
-/// along `wi` and leaving along `wo` (both away from the surface, unit normal `n`).
-fn brdf(color: DVec3, (specular, shininess): (f64, f64), n: DVec3, wo: DVec3, wi: DVec3) -> DVec3 {
-    let mut f = color / PI;
-    if specular > 0.0 {
-        let c = reflect(-wi, n).dot(wo).max(0.0);
-        f += DVec3::splat(specular * (shininess + 2.0) / (2.0 * PI) * c.powf(shininess));
-    }
-    f
-}
-
 /// One pixel sample's path: its radiance and how many segments and shadow rays it traced.
 struct Path<'s> {
     scene: &'s Scene,
@@ -140,9 +102,10 @@ struct Path<'s> {
 }
 
 impl Path<'_> {
-    /// Light sampled at a diffuse vertex: one shadow ray to each light, area lights weighted
-    /// against the BSDF sample.
-    fn next_event(&mut self, hit: &Hit, n: DVec3, wo: DVec3, color: DVec3, lobe: (f64, f64)) -> DVec3 {
+    /// Light sampled at a vertex with a smooth BSDF: one shadow ray to each light, area
+    /// lights weighted against the BSDF sample.
+    fn next_event(&mut self, hit: &Hit, bsdf: &Bsdf, wo: DVec3) -> DVec3 {
+        let n = bsdf.normal();
         let scene = self.scene;
         let mut sum = DVec3::ZERO;
         for (k, light) in scene.lights.iter().enumerate() {
@@ -160,11 +123,11 @@ impl Path<'_> {
             }
             let weight = if light.is_area() {
                 let on = hit.point + ls.wi * ls.distance;
-                power_heuristic(light_pdf(light, hit.point, on), cos / PI)
+                power_heuristic(light.pdf(hit.point, on), bsdf.pdf(wo, ls.wi))
             } else {
                 1.0
             };
-            sum += brdf(color, lobe, n, wo, ls.wi) * ls.incident * cos * weight;
+            sum += bsdf.eval(wo, ls.wi) * ls.incident * cos * weight;
         }
         sum
     }
@@ -174,7 +137,7 @@ impl Path<'_> {
         let scene = self.scene;
         let max_bounces = scene.params.max_depth.max(1) * 4;
         let (mut radiance, mut beta) = (DVec3::ZERO, DVec3::ONE);
-        // The last bounce's origin and BSDF density (None: specular or the camera).
+        // The last bounce's origin and BSDF density (None: a specular lobe or the camera).
         let mut last_diffuse: Option<(DVec3, f64)> = None;
         for bounce in 0..=max_bounces {
             self.segments += 1;
@@ -185,7 +148,7 @@ impl Path<'_> {
             if emitted != DVec3::ZERO {
                 let weight = match (last_diffuse, self.light_of[hit.object as usize]) {
                     (Some((from, bsdf_pdf)), Some(k)) => {
-                        power_heuristic(bsdf_pdf, light_pdf(&scene.lights[k], from, hit.point))
+                        power_heuristic(bsdf_pdf, scene.lights[k].pdf(from, hit.point))
                     }
                     _ => 1.0,
                 };
@@ -194,39 +157,24 @@ impl Path<'_> {
             if scene.objects[hit.object as usize].emission.is_some() || bounce == max_bounces {
                 return radiance;
             }
-            let surface = scene.surface(&hit, ray.dir);
-            let (color, n) = (surface.color, surface.normal);
-            match surface.material.kind {
-                MaterialKind::Diffuse { specular, shininess } => {
-                    let wo = -ray.dir;
-                    radiance += beta * self.next_event(&hit, n, wo, color, (specular, shininess));
-                    let wi = cosine_hemisphere(n, DVec2::new(self.rng.random(), self.rng.random()));
-                    let cos = n.dot(wi);
-                    if cos <= 0.0 {
-                        return radiance;
-                    }
-                    // f · cos / pdf with pdf = cos/π.
-                    beta *= brdf(color, (specular, shininess), n, wo, wi) * PI;
-                    last_diffuse = Some((hit.point, cos / PI));
-                    ray = hit.spawn(wi);
-                }
-                MaterialKind::Mirror => {
-                    beta *= color;
-                    last_diffuse = None;
-                    ray = hit.spawn(reflect(ray.dir, n));
-                }
-                MaterialKind::Glass { ior } => {
-                    let glass = dielectric(ray.dir, n, ior, surface.front);
-                    let dir = match glass.refracted {
-                        Some(t) if self.rng.random::<f64>() >= glass.fresnel => {
-                            beta *= color;
-                            t
-                        }
-                        _ => glass.reflected,
-                    };
-                    last_diffuse = None;
-                    ray = hit.spawn(dir);
-                }
+            let bsdf = Bsdf::at(&scene.surface(&hit, ray.dir));
+            let wo = -ray.dir;
+            if bsdf.has_smooth() {
+                radiance += beta * self.next_event(&hit, &bsdf, wo);
+                let Some(s) = bsdf.sample(wo, &mut self.rng) else {
+                    return radiance;
+                };
+                beta *= s.weight;
+                last_diffuse = Some((hit.point, s.pdf));
+                ray = hit.spawn(s.wi);
+            } else {
+                let lobes = bsdf.specular_lobes(wo);
+                let Some(lobe) = lobes.choose(|| self.rng.random()) else {
+                    return radiance;
+                };
+                beta *= lobe.tint;
+                last_diffuse = None;
+                ray = hit.spawn(lobe.wi);
             }
             // Russian roulette after the third bounce, on the throughput.
             if bounce >= 3 {

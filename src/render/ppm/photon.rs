@@ -1,9 +1,10 @@
 //! Photon tracing (Jensen 2001; Hachisuka et al. 2008 §3.2; seed report §3.2.2): photons leave
-//! the lights in proportion to their power, bounce off mirrors and through glass (Fresnel
-//! chooses reflection or refraction), and at every diffuse surface hand their flux to the
-//! visible points whose search sphere holds them — on the same side of the surface — before
-//! continuing diffusely under Russian roulette with the surface's albedo as the survival
-//! probability. A stratified photon's direction comes from a low-discrepancy sequence over
+//! the lights in proportion to their power, follow a delta lobe of mirrors and glass picked
+//! with its share (Fresnel chooses reflection or refraction), and at every surface with a
+//! smooth BSDF ([`crate::render::bsdf`]) hand their flux to the visible points whose search
+//! sphere holds them — on the same side of the surface — before continuing in a direction
+//! sampled from the BSDF (its Phong lobe included) under Russian roulette with the BSDF's
+//! albedo as the survival probability. A stratified photon's direction comes from a low-discrepancy sequence over
 //! the render's photons ([`crate::render::sequence`]; Keller, Grünschloß & Droske 2012).
 
 use glam::{DVec2, DVec3};
@@ -12,10 +13,9 @@ use rand_pcg::Pcg64Mcg;
 
 use super::guide::EmissionGuide;
 use crate::geometry::Ray;
+use crate::render::bsdf::Bsdf;
 use crate::render::sequence;
-use crate::scene::light::cosine_hemisphere;
-use crate::scene::material::{dielectric, reflect};
-use crate::scene::{MaterialKind, Scene};
+use crate::scene::Scene;
 
 /// Counters of one batch of photons.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -191,37 +191,30 @@ impl<'a> PhotonSource<'a> {
             if scene.objects[hit.object as usize].emission.is_some() {
                 return emitted;
             }
-            let surface = scene.surface(&hit, ray.dir);
-            let (color, front, n) = (surface.color, surface.front, surface.normal);
-            match surface.material.kind {
-                MaterialKind::Diffuse { .. } => {
-                    if !(skip_first && first_interaction) {
-                        gather(hit.point, n, flux, indirect);
-                    }
-                    indirect = true;
-                    // Russian roulette on the albedo, then a cosine-distributed bounce.
-                    let survive = color.max_element();
-                    if survive <= 0.0 || rng.random::<f64>() >= survive {
-                        return emitted;
-                    }
-                    flux *= color / survive;
-                    let dir = cosine_hemisphere(n, DVec2::new(rng.random(), rng.random()));
-                    ray = hit.spawn(dir);
+            let bsdf = Bsdf::at(&scene.surface(&hit, ray.dir));
+            let wo = -ray.dir;
+            if bsdf.has_smooth() {
+                if !(skip_first && first_interaction) {
+                    gather(hit.point, bsdf.normal(), flux, indirect);
                 }
-                MaterialKind::Mirror => {
-                    flux *= color;
-                    ray = hit.spawn(reflect(ray.dir, n));
+                indirect = true;
+                // Russian roulette on the albedo, then a bounce sampled from the BSDF.
+                let survive = bsdf.albedo().max_element();
+                if survive <= 0.0 || rng.random::<f64>() >= survive {
+                    return emitted;
                 }
-                MaterialKind::Glass { ior } => {
-                    let glass = dielectric(ray.dir, n, ior, front);
-                    match glass.refracted {
-                        Some(t) if rng.random::<f64>() >= glass.fresnel => {
-                            flux *= color;
-                            ray = hit.spawn(t);
-                        }
-                        _ => ray = hit.spawn(glass.reflected),
-                    }
-                }
+                let Some(s) = bsdf.sample(wo, rng) else {
+                    return emitted;
+                };
+                flux *= s.weight / survive;
+                ray = hit.spawn(s.wi);
+            } else {
+                let lobes = bsdf.specular_lobes(wo);
+                let Some(lobe) = lobes.choose(|| rng.random()) else {
+                    return emitted;
+                };
+                flux *= lobe.tint;
+                ray = hit.spawn(lobe.wi);
             }
             first_interaction = false;
             if flux.max_element() <= 0.0 {

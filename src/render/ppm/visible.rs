@@ -1,7 +1,10 @@
 //! The eye pass of photon mapping (Hachisuka, Ogaki & Jensen 2008 §3.1; seed report §3.2.1):
-//! trace eye rays through mirrors and glass to the first diffuse surface and record a visible
-//! point there — position, normal, and the weight (path throughput × BRDF) that turns photon
-//! flux arriving there into pixel radiance. Emission seen directly along the way, and optionally
+//! trace eye rays through the delta lobes of mirrors and glass (all of them, or one picked
+//! with its share) to the first surface with a smooth BSDF ([`crate::render::bsdf`]) and
+//! record a visible point there — position, normal, and the weight (path throughput × the
+//! BSDF's diffuse part ρ/π) that turns photon flux arriving there into pixel radiance. A
+//! Phong lobe reaches the image through the photons that bounced off it, not at the visible
+//! point itself, which would need each photon's direction. Emission seen directly along the way, and optionally
 //! direct light from point and spot lights (shadow rays), is returned separately.
 
 use std::f64::consts::PI;
@@ -10,9 +13,10 @@ use glam::{DVec2, DVec3};
 use rand::Rng;
 use rand_pcg::Pcg64Mcg;
 
+use crate::geometry::Hit;
 use crate::geometry::Ray;
-use crate::scene::material::{dielectric, reflect};
-use crate::scene::{Light, MaterialKind, Scene};
+use crate::render::bsdf::Bsdf;
+use crate::scene::{Light, Scene};
 
 /// Where photons are gathered for one pixel (or one branch of one pixel's eye path).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -107,63 +111,57 @@ impl EyeWalk<'_> {
         if scene.objects[hit.object as usize].emission.is_some() || depth >= scene.params.max_depth {
             return;
         }
-        let surface = scene.surface(&hit, ray.dir);
-        let (color, n) = (surface.color, surface.normal);
-        match surface.material.kind {
-            MaterialKind::Diffuse { .. } => {
-                // The Phong lobe is a ray-tracer preview nicety; photon mapping uses the
-                // diffuse part.
-                let weight = throughput * color / PI;
-                if self.direct_light {
-                    for (k, light) in scene
-                        .lights
-                        .iter()
-                        .enumerate()
-                        .filter(|(_, l)| direct_by_shadow_rays(l))
-                    {
-                        let Some(ls) = light.sample(hit.point, DVec2::ZERO) else {
-                            continue;
-                        };
-                        let cos = n.dot(ls.wi);
-                        if cos > 0.0 && !scene.occluded_from_hit(&hit, k, &ls) {
-                            out.direct += weight * ls.incident * cos;
-                        }
-                    }
+        let bsdf = Bsdf::at(&scene.surface(&hit, ray.dir));
+        if bsdf.has_smooth() {
+            self.visible_point(&hit, &bsdf, throughput, out);
+        }
+        let lobes = bsdf.specular_lobes(-ray.dir);
+        match (self.branching, lobes.len()) {
+            (Branching::Split, _) | (_, 1) => {
+                for lobe in lobes.iter() {
+                    let next = hit.spawn(lobe.wi);
+                    self.walk(&next, throughput * lobe.share * lobe.tint, depth + 1, rng, out);
                 }
-                (out.points)(VisiblePoint {
-                    slot: self.slot,
-                    position: hit.point,
-                    normal: n,
-                    weight,
-                    radius2: 0.0,
-                });
             }
-            MaterialKind::Mirror => {
-                let r = hit.spawn(reflect(ray.dir, n));
-                self.walk(&r, throughput * color, depth + 1, rng, out);
-            }
-            MaterialKind::Glass { ior } => {
-                let glass = dielectric(ray.dir, n, ior, surface.front);
-                let fresnel = glass.fresnel;
-                let reflected = hit.spawn(glass.reflected);
-                let refracted = glass.refracted.map(|t| hit.spawn(t));
-                match (self.branching, refracted) {
-                    (_, None) => self.walk(&reflected, throughput, depth + 1, rng, out),
-                    (Branching::Split, Some(t)) => {
-                        self.walk(&reflected, throughput * fresnel, depth + 1, rng, out);
-                        self.walk(&t, throughput * (1.0 - fresnel) * color, depth + 1, rng, out);
-                    }
-                    (Branching::Choose { .. }, Some(t)) => {
-                        let u = out.first_choice.take().unwrap_or_else(|| rng.random());
-                        if u < fresnel {
-                            self.walk(&reflected, throughput, depth + 1, rng, out);
-                        } else {
-                            self.walk(&t, throughput * color, depth + 1, rng, out);
-                        }
-                    }
+            (Branching::Choose { .. }, _) => {
+                let first = &mut out.first_choice;
+                if let Some(lobe) = lobes.choose(|| first.take().unwrap_or_else(|| rng.random())) {
+                    self.walk(&hit.spawn(lobe.wi), throughput * lobe.tint, depth + 1, rng, out);
                 }
             }
         }
+    }
+
+    /// A visible point where the walk meets a smooth surface, with the direct light of the
+    /// point and spot lights when asked. Photon mapping gathers with the BSDF's diffuse part
+    /// (`ρ/π`) here.
+    fn visible_point(&self, hit: &Hit, bsdf: &Bsdf, throughput: DVec3, out: &mut EyeOut) {
+        let scene = self.scene;
+        let n = bsdf.normal();
+        let weight = throughput * bsdf.diffuse_reflectance() / PI;
+        if self.direct_light {
+            for (k, light) in scene
+                .lights
+                .iter()
+                .enumerate()
+                .filter(|(_, l)| direct_by_shadow_rays(l))
+            {
+                let Some(ls) = light.sample(hit.point, DVec2::ZERO) else {
+                    continue;
+                };
+                let cos = n.dot(ls.wi);
+                if cos > 0.0 && !scene.occluded_from_hit(hit, k, &ls) {
+                    out.direct += weight * ls.incident * cos;
+                }
+            }
+        }
+        (out.points)(VisiblePoint {
+            slot: self.slot,
+            position: hit.point,
+            normal: n,
+            weight,
+            radius2: 0.0,
+        });
     }
 }
 
