@@ -297,6 +297,66 @@ fn no_native_dialog(_: &caustic::app::file_dialog::FileRequest) -> Option<PathBu
     None
 }
 
+/// The window's own dialog takes the keyboard from the start: typing replaces the proposed
+/// name's stem (the extension stays), Enter saves, Tab completes from the listing, and Escape
+/// cancels; the mouse is never used after "Save frame...".
+#[test]
+fn the_window_s_own_dialog_is_driven_by_the_keyboard_alone() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = harness(ball(), true);
+    for f in fixed_frames() {
+        viewer_mut(&mut h).show_frame(f);
+    }
+    viewer_mut(&mut h).set_native_dialog(no_native_dialog);
+    viewer_mut(&mut h).settings.last_directory = Some(dir.path().to_path_buf());
+    h.step();
+    h.get_by_role_and_label(Role::Button, "Save frame...").click();
+    step_until(&mut h, "the in-window dialog", Viewer::file_dialog_in_window);
+    h.run_steps(2);
+    h.event(egui::Event::Text("keyboard".into()));
+    h.step();
+    h.key_press(egui::Key::Enter);
+    let status = wait_saved(&mut h);
+    assert!(
+        matches!(&status, Status::Info(t) if t.contains("keyboard.png")),
+        "{status:?}"
+    );
+    assert!(dir.path().join("keyboard.png").is_file());
+
+    // Select all, type the start of the name, Tab completes it, Enter takes it, and the
+    // replace question answers Enter too.
+    h.get_by_role_and_label(Role::Button, "Save frame...").click();
+    step_until(&mut h, "the dialog again", Viewer::file_dialog_in_window);
+    h.run_steps(2);
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    h.event(egui::Event::Text("keyb".into()));
+    h.step();
+    h.key_press(egui::Key::Tab);
+    h.step();
+    h.key_press(egui::Key::Enter);
+    step_until(&mut h, "the replace question", |v| {
+        v.confirming_overwrite().is_some()
+    });
+    assert_eq!(
+        viewer(&h).confirming_overwrite(),
+        Some(dir.path().join("keyboard.png").as_path())
+    );
+    h.key_press(egui::Key::Enter);
+    let status = wait_saved(&mut h);
+    assert!(
+        matches!(&status, Status::Info(t) if t.contains("keyboard.png")),
+        "{status:?}"
+    );
+
+    // Escape cancels.
+    h.get_by_role_and_label(Role::Button, "Save frame...").click();
+    step_until(&mut h, "the dialog a third time", Viewer::file_dialog_in_window);
+    h.run_steps(2);
+    h.key_press(egui::Key::Escape);
+    step_until(&mut h, "the dialog to close", |v| !v.busy());
+    assert!(matches!(viewer(&h).status(), Some(Status::Info(s)) if s == "Save cancelled"));
+}
+
 #[test]
 fn without_a_native_dialog_the_frame_saves_through_the_window_s_own() {
     let dir = tempfile::tempdir().expect("temp dir");

@@ -187,6 +187,8 @@ struct InWindow {
     message: Option<String>,
     /// Set once the person chose (`Some(path)`) or cancelled (`None`).
     answer: Option<Option<PathBuf>>,
+    /// Whether the name field has been given the keyboard (on the first frame).
+    focused: bool,
 }
 
 impl InWindow {
@@ -205,6 +207,7 @@ impl InWindow {
             entries: Vec::new(),
             message: None,
             answer: None,
+            focused: false,
         };
         window.enter(folder);
         window
@@ -321,11 +324,14 @@ impl InWindow {
     }
 
     fn contents_ui(&mut self, ui: &mut egui::Ui) {
+        let enter = ui.input(|i| i.key_pressed(egui::Key::Enter));
+        let mut enter_taken = false;
         ui.horizontal(|ui| {
             let label = ui.label("Folder:");
             let field = ui.add(egui::TextEdit::singleline(&mut self.folder_text).desired_width(360.0));
             let field = field.labelled_by(label.id);
-            if field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter)) {
+            if field.lost_focus() && enter {
+                enter_taken = true;
                 self.enter(PathBuf::from(self.folder_text.clone()));
             }
             if ui.button("Up").on_hover_text("The folder above").clicked() {
@@ -373,14 +379,32 @@ impl InWindow {
             {
                 self.complete();
             }
-            let field = ui.add(
-                egui::TextEdit::singleline(&mut self.name)
-                    .id(id)
-                    .desired_width(340.0),
-            );
-            let field = field.labelled_by(label.id);
-            confirm |= field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
+            let mut output = egui::TextEdit::singleline(&mut self.name)
+                .id(id)
+                .desired_width(340.0)
+                .show(ui);
+            if !self.focused {
+                // The dialog opens with the keyboard in the name field and the name's stem
+                // selected, so typing replaces the stem and keeps the extension.
+                self.focused = true;
+                let stem = match self.name.rfind('.') {
+                    Some(dot) if dot > 0 => self.name[..dot].chars().count(),
+                    _ => self.name.chars().count(),
+                };
+                let range = egui::text_selection::CCursorRange::two(
+                    egui::text::CCursor::new(0),
+                    egui::text::CCursor::new(stem),
+                );
+                output.state.cursor.set_char_range(Some(range));
+                output.state.store(ui.ctx(), id);
+                output.response.request_focus();
+            }
+            let field = output.response.response.clone().labelled_by(label.id);
+            enter_taken |= field.lost_focus() && enter;
+            confirm |= field.lost_focus() && enter;
         });
+        // Enter takes the name wherever the keyboard is, unless a field used it.
+        confirm |= enter && !enter_taken && ui.memory(|m| m.focused().is_none());
         if let Some(message) = &self.message {
             ui.colored_label(ui.visuals().warn_fg_color, message);
         }
