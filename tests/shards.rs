@@ -520,6 +520,17 @@ fn a_watched_folder_follows_the_render_most_parts_belong_to_or_the_one_chosen() 
     );
     // Told once.
     assert_eq!(folder.scan(dir.path()).expect("scans"), Default::default());
+    // A part that arrives after the render is complete adds nothing, and says so, once.
+    std::fs::copy(dir.path().join("p0.exr"), dir.path().join("p9_late.exr")).expect("copy");
+    let report = folder.scan(dir.path()).expect("scans");
+    assert!(!report.changed, "{report:?}");
+    assert_eq!(
+        report.skipped,
+        ["p9_late.exr: adds nothing: its passes are merged already (the render is complete)"]
+    );
+    assert_eq!(folder.scan(dir.path()).expect("scans"), Default::default());
+    std::fs::remove_file(dir.path().join("p9_late.exr")).expect("remove");
+    folder.scan(dir.path()).expect("scans");
     // The renders in the folder, most parts first; choosing the other shows it.
     let renders = folder.renders();
     assert_eq!(

@@ -410,6 +410,23 @@ fn without_a_native_dialog_the_frame_saves_through_the_window_s_own() {
     assert!(matches!(viewer(&h).status(), Some(Status::Info(s)) if s == "Save cancelled"));
 }
 
+/// A scene that fails at launch: the window says the built-in scene is shown instead (there
+/// was no scene before it to keep rendering).
+#[test]
+fn a_scene_that_fails_at_launch_says_the_built_in_scene_is_shown() {
+    let mut h = harness(Scene::builtin(), true);
+    viewer_mut(&mut h).report_launch_failure("missing.toml: no such file".into());
+    h.run_steps(2);
+    assert!(h.query_by_label("Could not open scene").is_some());
+    assert!(h.query_by_label("missing.toml: no such file").is_some());
+    assert!(h.query_by_label("The built-in scene is shown instead.").is_some());
+    assert!(h.query_by_label("ball.toml is still rendering.").is_none());
+    assert_eq!(
+        viewer(&h).scene_error_instead(),
+        Some("The built-in scene is shown instead.")
+    );
+}
+
 #[test]
 fn bad_scene_shows_its_error_and_the_old_scene_keeps_rendering() {
     let dir = tempfile::tempdir().expect("temp dir");
@@ -426,6 +443,7 @@ fn bad_scene_shows_its_error_and_the_old_scene_keeps_rendering() {
         h.query_by_label("Could not open scene").is_some(),
         "no error window"
     );
+    assert!(h.query_by_label("ball.toml is still rendering.").is_some());
     assert_eq!(viewer(&h).scene().source, PathBuf::from("ball.toml"));
     let pass = viewer(&h).frame().map_or(0, |f| f.pass);
     step_until(&mut h, "more passes of the old scene", |v| {
@@ -640,8 +658,12 @@ fn opening_a_reference_shows_the_true_error_curve_and_the_difference_view() {
     assert!(points[0][1] > points[3][1], "the error falls: {points:?}");
     h.get_by_label_contains("against the reference: RMSE 5.000e-2");
 
-    // The signed difference view shows its legend; A/B shows the reference.
+    // The radius view has a legend: the layer's name and the ends of its log scale.
     h.key_press(egui::Key::D);
+    h.run_steps(2);
+    assert_eq!(viewer(&h).settings.display, DisplayMode::Layer(0));
+    h.get_by_label("radius (log scale; black: none)");
+    // The signed difference view shows its legend; A/B shows the reference.
     h.key_press(egui::Key::D);
     h.key_press(egui::Key::D);
     h.run_steps(2);

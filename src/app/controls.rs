@@ -360,8 +360,8 @@ pub fn dialogs_ui(viewer: &ViewerState, ctx: &egui::Context, out: &mut Vec<Actio
         egui::Window::new("Could not open scene")
             .open(&mut open)
             .show(ctx, |ui| {
-                ui.colored_label(Color32::from_rgb(255, 110, 90), error);
-                ui.label("The previous scene is still rendering.");
+                ui.colored_label(Color32::from_rgb(255, 110, 90), &error.message);
+                ui.label(&error.instead);
                 ok = ui.button("OK").clicked();
             });
         if !open || ok {

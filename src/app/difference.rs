@@ -4,7 +4,7 @@
 //! sequential ramp). Values are the mean over the colour channels; each view's scale is the
 //! 99th percentile of its magnitudes, so a few fireflies do not wash the picture out.
 
-use egui::{Color32, Rect, RichText, Vec2};
+use egui::Rect;
 
 use super::false_colour::false_colour;
 
@@ -86,51 +86,26 @@ pub fn difference_bytes(
 
 /// Draws the legend in the lower left corner of `view`: a colour bar and its values.
 pub fn legend_ui(ui: &mut egui::Ui, view: Rect, legend: Legend) {
-    let (title, low, high) = match legend.kind {
-        DifferenceKind::Signed => (
+    match legend.kind {
+        DifferenceKind::Signed => super::false_colour::colour_bar_ui(
+            ui,
+            view,
             "render − reference",
-            format!("−{:.3e}", legend.scale),
-            format!("+{:.3e}", legend.scale),
+            &[
+                format!("−{:.3e}", legend.scale),
+                "0".to_owned(),
+                format!("+{:.3e}", legend.scale),
+            ],
+            |t| diverging(2.0 * t - 1.0),
         ),
-        DifferenceKind::Relative => (
+        DifferenceKind::Relative => super::false_colour::colour_bar_ui(
+            ui,
+            view,
             "|render − reference| / (reference + 0.01)",
-            "0".to_owned(),
-            format!("{:.3e}", legend.scale),
+            &["0".to_owned(), format!("{:.3e}", legend.scale)],
+            false_colour,
         ),
-    };
-    let area = egui::Area::new(egui::Id::unique("caustic-difference-legend"))
-        .fixed_pos(view.left_bottom() + Vec2::new(12.0, -78.0))
-        .order(egui::Order::Foreground);
-    area.show(ui.ctx(), |ui| {
-        egui::Frame::popup(ui.style()).show(ui, |ui| {
-            ui.label(RichText::new(title).small());
-            let (bar, _) = ui.allocate_exact_size(Vec2::new(220.0, 12.0), egui::Sense::hover());
-            let steps = 64;
-            for k in 0..steps {
-                let t = (k as f32 + 0.5) / steps as f32;
-                let rgb = match legend.kind {
-                    DifferenceKind::Signed => diverging(2.0 * t - 1.0),
-                    DifferenceKind::Relative => false_colour(t),
-                };
-                let x0 = bar.left() + bar.width() * k as f32 / steps as f32;
-                let x1 = bar.left() + bar.width() * (k + 1) as f32 / steps as f32;
-                let cell = Rect::from_x_y_ranges(x0..=x1, bar.y_range());
-                ui.painter()
-                    .rect_filled(cell, 0.0, Color32::from_rgb(rgb[0], rgb[1], rgb[2]));
-            }
-            ui.horizontal(|ui| {
-                ui.label(RichText::new(low).small().monospace());
-                if legend.kind == DifferenceKind::Signed {
-                    ui.add_space(50.0);
-                    ui.label(RichText::new("0").small().monospace());
-                    ui.add_space(50.0);
-                } else {
-                    ui.add_space(130.0);
-                }
-                ui.label(RichText::new(high).small().monospace());
-            });
-        });
-    });
+    }
 }
 
 #[cfg(test)]

@@ -22,8 +22,8 @@ pub struct ImageView {
     pan: Vec2,
     /// Set when the texture must be rebuilt (new frame, exposure or display mode changed).
     dirty: bool,
-    /// The legend of the difference view shown, if one is.
-    pub legend: Option<Legend>,
+    /// The legend of the false-colour view shown (a difference or a layer), if one is.
+    pub legend: Option<ViewLegend>,
 }
 
 /// What [`ImageView::ui`] did this frame.
@@ -60,6 +60,39 @@ impl Default for ImageView {
     }
 }
 
+/// What the colours of a false-colour view mean.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ViewLegend {
+    /// A difference against the reference.
+    Difference(Legend),
+    /// A per-pixel layer (search radius, photon count) on a log scale: its label and the
+    /// values at the two ends.
+    Layer {
+        /// The layer's label.
+        label: &'static str,
+        /// The smallest positive value (the dark end).
+        low: f32,
+        /// The largest value (the bright end).
+        high: f32,
+    },
+}
+
+impl ViewLegend {
+    /// Draws it in the lower left corner of `view`.
+    pub fn ui(self, ui: &mut egui::Ui, view: egui::Rect) {
+        match self {
+            ViewLegend::Difference(legend) => super::difference::legend_ui(ui, view, legend),
+            ViewLegend::Layer { label, low, high } => super::false_colour::colour_bar_ui(
+                ui,
+                view,
+                &format!("{label} (log scale; black: none)"),
+                &[format!("{low:.3e}"), format!("{high:.3e}")],
+                super::false_colour::false_colour,
+            ),
+        }
+    }
+}
+
 /// What the image view shows besides the frame's own channels.
 #[derive(Clone, Copy, Default)]
 pub struct Comparison<'a> {
@@ -69,14 +102,14 @@ pub struct Comparison<'a> {
     pub show_reference: bool,
 }
 
-/// The 8-bit RGB picture of a frame in a display mode, and the legend of a difference view.
+/// The 8-bit RGB picture of a frame in a display mode, and the legend of a false-colour view.
 /// A difference mode without a (matching) reference shows the radiance.
 pub fn display_bytes(
     frame: &Frame,
     mode: DisplayMode,
     exposure_stops: f32,
     comparison: Comparison,
-) -> (Vec<u8>, Option<Legend>) {
+) -> (Vec<u8>, Option<ViewLegend>) {
     let reference = comparison.reference.filter(|r| r.len() == frame.radiance.len());
     if let (Some(r), true) = (reference, comparison.show_reference) {
         return (srgb8(r, exposure_stops), None);
@@ -88,17 +121,24 @@ pub fn display_bytes(
     };
     if let (Some(kind), Some(r)) = (kind, reference) {
         let (bytes, legend) = difference_bytes(&frame.radiance, r, kind);
-        return (bytes, Some(legend));
+        return (bytes, Some(ViewLegend::Difference(legend)));
     }
     let layer = match mode {
         DisplayMode::Layer(k) => frame.layers.get(k as usize),
         _ => None,
     };
-    let bytes = match layer {
-        Some(layer) => false_colour_image(&layer.values),
-        None => srgb8(&frame.radiance, exposure_stops),
-    };
-    (bytes, None)
+    match layer {
+        Some(layer) => {
+            let (bytes, range) = false_colour_image(&layer.values);
+            let legend = range.map(|(low, high)| ViewLegend::Layer {
+                label: layer.label,
+                low,
+                high,
+            });
+            (bytes, legend)
+        }
+        None => (srgb8(&frame.radiance, exposure_stops), None),
+    }
 }
 
 /// The frame's radiance as an [`Image`] (for display and saving).

@@ -142,7 +142,7 @@ pub fn run(scene_path: Option<PathBuf>, mut launch: LaunchOptions) -> anyhow::Re
                 viewer.install_overlay(render_state, None);
             }
             if let Some(e) = error {
-                viewer.scene_error = Some(e);
+                viewer.report_launch_failure(e);
             }
             if let Some(r) = reference {
                 viewer.set_reference(r);

@@ -31,6 +31,15 @@ pub enum Status {
     Error(String),
 }
 
+/// A scene that could not be opened, as its window tells it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneError {
+    /// Why, naming the file and field.
+    pub message: String,
+    /// What the viewer shows instead ("ball.toml is still rendering.").
+    pub instead: String,
+}
+
 /// What the viewer's widgets read.
 pub struct ViewerState {
     /// Persisted preferences.
@@ -50,8 +59,8 @@ pub struct ViewerState {
     /// Seconds from the last restart-type change to its first image.
     pub(super) restart_latency_secs: Option<f64>,
     pub(super) save: SaveFlow,
-    /// A scene that failed to open, with its error (shown in a window).
-    pub(super) scene_error: Option<String>,
+    /// A scene that failed to open: its error, and what is shown instead (in a window).
+    pub(super) scene_error: Option<SceneError>,
     /// The render thread's panic message.
     pub(super) render_failure: Option<String>,
     pub(super) status: Option<Status>,
@@ -156,7 +165,25 @@ impl ViewerState {
 
     /// The error of the last scene that failed to open, if it is still shown.
     pub fn scene_error(&self) -> Option<&str> {
-        self.scene_error.as_deref()
+        self.scene_error.as_ref().map(|e| e.message.as_str())
+    }
+
+    /// What the scene-error window says is shown instead of the scene that failed.
+    pub fn scene_error_instead(&self) -> Option<&str> {
+        self.scene_error.as_ref().map(|e| e.instead.as_str())
+    }
+
+    /// The error of a scene that failed to open while this one renders on.
+    pub(super) fn scene_failed(&mut self, message: String) {
+        let scene = self.document.scene();
+        // Built-in scenes are named "<built-in ...>".
+        let instead = match scene.source.file_name() {
+            Some(name) if !scene.source.to_string_lossy().starts_with('<') => {
+                format!("{} is still rendering.", name.to_string_lossy())
+            }
+            _ => "The built-in scene is still rendering.".to_owned(),
+        };
+        self.scene_error = Some(SceneError { message, instead });
     }
 
     /// The render thread's failure, if it failed.

@@ -138,6 +138,15 @@ impl Viewer {
         self.overlay_installed = true;
     }
 
+    /// Shows why the scene asked for at launch could not be opened: the viewer has opened
+    /// the built-in scene instead, and says so.
+    pub fn report_launch_failure(&mut self, message: String) {
+        self.scene_error = Some(super::state::SceneError {
+            message,
+            instead: "The built-in scene is shown instead.".to_owned(),
+        });
+    }
+
     /// Commands sent to the render session, oldest first (the last 256).
     pub fn recent_commands(&self) -> impl Iterator<Item = &Command> {
         self.recent_commands.iter()

@@ -52,7 +52,7 @@ impl Viewer {
                     }
                     Err(e) => {
                         self.status = Some(Status::Error(format!("Could not open {}", path.display())));
-                        self.scene_error = Some(e);
+                        self.scene_failed(e);
                     }
                 }
             }
@@ -215,7 +215,7 @@ impl Viewer {
         }
         self.projection = Some(projection);
         if let Some(legend) = self.image_view.legend {
-            super::difference::legend_ui(ui, shown.view, legend);
+            legend.ui(ui, shown.view);
         }
     }
 }

@@ -245,14 +245,37 @@ impl FolderMerge {
                 (fate, _) => fate.clone(),
             };
             let changed = entry_fate(&self.files, &path) != Some(&fate);
-            if let (Fate::Skipped(why), true) = (&fate, changed) {
-                report.skipped.push(why.clone());
+            match (&fate, changed) {
+                (Fate::Skipped(why), true) => report.skipped.push(why.clone()),
+                (Fate::Redundant, true) => report.skipped.extend(self.redundant(&path)),
+                _ => {}
             }
             report.changed |= changed && fate == Fate::Merged;
             if let Some(e) = self.files.get_mut(&path) {
                 e.fate = fate;
             }
         }
+    }
+
+    /// Why the part at `path` added nothing: every one of its passes was merged already
+    /// (from other parts), and whether the render was complete before it came. `None` for a
+    /// file that holds the whole render (the farm's own merge beside its parts), which is
+    /// expected there.
+    fn redundant(&self, path: &Path) -> Option<String> {
+        let header = self.files.get(path)?.header.as_ref().ok()?;
+        if header.passes.len() as u64 == u64::from(header.total_passes) {
+            return None;
+        }
+        let complete = self.merged.as_ref().is_some_and(|(_, _, m)| m.is_complete());
+        let when = if complete {
+            "the render is complete"
+        } else {
+            "other parts hold them"
+        };
+        Some(format!(
+            "{}: adds nothing: its passes are merged already ({when})",
+            name_of(path)
+        ))
     }
 
     /// Reads `path` (of the render shown) and merges it.
