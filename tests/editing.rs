@@ -862,3 +862,36 @@ fn lights_are_dragged_like_points_undone_and_saved_into_the_file() {
     assert!((d2 - d1).length() < 1e-12, "{d2} vs {d1}");
     assert_eq!(back.lights[1], moved);
 }
+
+/// "Frame" with nothing selected frames the lights as well as the patches: a lamp far above
+/// the view comes into it, and a light outside the view is marked on its edge until then.
+#[test]
+fn frame_all_brings_a_far_light_into_view() {
+    use caustic::app::action::Action;
+    use caustic::app::light_markers::edge_markers;
+    let mut h = editing_app();
+    let lamp = light_handle(0, LightPart::Place);
+    let place = viewer(&h).handle_position(lamp).expect("the lamp");
+    // Lift the lamp far above the scene, out of the view.
+    let far = place + DVec3::new(0.0, 0.0, 40.0);
+    let v = h.state_mut().as_mut().expect("viewer");
+    v.apply(Action::SetPoint(lamp, far));
+    h.run_steps(2);
+    let proj = viewer(&h).projection().expect("placed").clone();
+    assert!(
+        proj.to_screen(far).is_none_or(|s| !proj.view.contains(s)),
+        "the lamp left the view"
+    );
+    let markers = edge_markers(&proj, viewer(&h).lights());
+    assert_eq!(markers.len(), 1, "{markers:?}");
+    assert!(proj.view.contains(markers[0].at));
+    h.state_mut()
+        .as_mut()
+        .expect("viewer")
+        .apply(Action::FrameSelection);
+    h.run_steps(2);
+    let proj = viewer(&h).projection().expect("placed").clone();
+    let s = proj.to_screen(far).expect("in front");
+    assert!(proj.view.contains(s), "{s:?} outside {:?}", proj.view);
+    assert!(edge_markers(&proj, viewer(&h).lights()).is_empty());
+}

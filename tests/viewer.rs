@@ -826,6 +826,21 @@ fn watching_a_folder_merges_each_new_part_and_skips_what_does_not_belong() {
         "the merged image is not black"
     );
     h.get_by_label("Render folder");
+    // What does nothing while watching is not shown: the renderer, pause, restart and the
+    // render settings; saving and exposure are.
+    for gone in [
+        "Renderer",
+        "Pause",
+        "Resume",
+        "Restart",
+        "Photon mapping",
+        "Camera",
+        "Alpha",
+    ] {
+        assert!(h.query_by_label(gone).is_none(), "{gone} is shown while watching");
+    }
+    h.get_by_label("Save frame...");
+    assert!(h.query_all_by_label("Exposure").next().is_some());
     // A part of another render (another α) is skipped with a message in the status bar.
     let mut other = ball();
     other.params.alpha = 0.5;
@@ -871,6 +886,8 @@ fn watching_a_folder_merges_each_new_part_and_skips_what_does_not_belong() {
     h.step();
     assert!(viewer(&h).watching().is_none());
     assert!(!viewer(&h).paused(), "rendering again");
+    h.get_by_label("Restart");
+    assert!(h.query_all_by_label("Photon mapping").next().is_some());
 }
 
 #[test]

@@ -209,7 +209,7 @@ pub const COMMANDS: &[Command] = &[
     },
     Command {
         label: "Frame",
-        tooltip: "Frame the selection (or all patches) with the camera",
+        tooltip: "Frame the selection (or all patches and lights) with the camera",
         keys: "C",
         shortcuts: &[(NONE, Key::C)],
         menu: Menu::Edit,

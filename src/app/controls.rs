@@ -122,8 +122,12 @@ pub fn side_panel_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Acti
     let shown = viewer.params();
     let mut p = shown.clone();
     render_section_ui(viewer, &mut p, ui, out);
-    renderer_section_ui(&mut p, viewer.ranges, ui);
-    camera_section_ui(&mut p, viewer.ranges, ui);
+    // A watched folder's image comes from the farm: the renderer and its settings do
+    // nothing there, so they are not shown.
+    if viewer.watching().is_none() {
+        renderer_section_ui(&mut p, viewer.ranges, ui);
+        camera_section_ui(&mut p, viewer.ranges, ui);
+    }
     if p != shown {
         out.push(Action::SetParams(p));
     }
@@ -138,7 +142,24 @@ pub fn side_panel_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Acti
 
 /// The renderer, pause, restart, save and exposure.
 fn render_section_ui(viewer: &ViewerState, p: &mut PanelParams, ui: &mut egui::Ui, out: &mut Vec<Action>) {
+    let watching = viewer.watching().is_some();
     ui.heading("Render");
+    if !watching {
+        renderer_choice_ui(p, ui, out);
+    } else {
+        if ui
+            .button("Save frame...")
+            .on_hover_text("Save the merged image: PNG as displayed, or EXR with linear radiance (Ctrl+S)")
+            .clicked()
+        {
+            out.push(Action::SaveFrame);
+        }
+    }
+    exposure_ui(viewer, ui, out);
+}
+
+/// The renderer, pause, restart and save.
+fn renderer_choice_ui(p: &mut PanelParams, ui: &mut egui::Ui, out: &mut Vec<Action>) {
     ui.horizontal(|ui| {
         ui.label("Renderer");
         // Progressive renderers first (the viewer's own), then single-frame ones.
@@ -173,7 +194,10 @@ fn render_section_ui(viewer: &ViewerState, p: &mut PanelParams, ui: &mut egui::U
             out.push(Action::SaveFrame);
         }
     });
+}
 
+/// The display's exposure.
+fn exposure_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Action>) {
     let mut exposure = viewer.settings.exposure_stops;
     if ui
         .add(

@@ -435,10 +435,11 @@ impl Editor {
             .collect()
     }
 
-    /// Centre and radius of the selection (all patches when nothing is selected).
+    /// Centre and radius of the selection (all patches and lights when nothing is selected).
     pub fn selection_sphere(&self, doc: &Document) -> (DVec3, f64) {
         let points: Vec<DVec3> = if self.selection.is_empty() {
-            doc.patches().flat_map(|p| p.points).collect()
+            let lights = doc.lights().iter().map(light_place);
+            doc.patches().flat_map(|p| p.points).chain(lights).collect()
         } else {
             self.selection.iter().map(|r| self.point(doc, *r)).collect()
         };

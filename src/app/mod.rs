@@ -12,7 +12,8 @@
 //! - [`controls`], [`edit_panel`]: menu, side panel, status bar, dialog windows.
 //! - [`overlay`], [`editor`], [`view_input`], [`navigate`]: the control-net overlay's
 //!   projection and geometry, the editing state and undo history, the mouse over the image,
-//!   and camera moves (drawn by [`crate::gpu::wireframe`]).
+//!   and camera moves (drawn by [`crate::gpu::wireframe`]); [`light_markers`]: where the
+//!   lights outside the view are.
 //! - [`image_view`]: texture, fit / 1:1 / zoom / pan, probe.
 //! - [`params`]: what the side panel edits (the document's parameters and lens, pause); [`setting_ui`]:
 //!   each render setting's control, from the table of settings.
@@ -42,6 +43,7 @@ pub mod handle;
 pub mod image_view;
 pub mod job;
 pub mod keys;
+pub mod light_markers;
 pub mod navigate;
 pub mod overlay;
 pub mod params;

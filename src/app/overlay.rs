@@ -195,8 +195,7 @@ pub fn overlay_geometry<'a>(
         }
         for (index, q) in p.points.iter().enumerate() {
             let r = Handle::Control(PointRef { patch: k, index });
-            g.markers
-                .push(handle_marker(*q, r, (POINT, 5.0), hovered, selection));
+            push_handle_marker(&mut g.markers, *q, r, (POINT, 5.0), hovered, selection);
         }
     }
     for (k, (light, aim)) in lights.iter().enumerate() {
@@ -205,26 +204,40 @@ pub fn overlay_geometry<'a>(
     g
 }
 
-/// A handle's marker: hovered and selected ones larger and in their colours.
-fn handle_marker(
+/// The dark rim around a hovered or selected handle's marker (points each side), so that it
+/// stands out on any background: a bright floor as well as a dark wall.
+const HALO: f32 = 2.0;
+const HALO_COLOR: [f32; 4] = [0.0, 0.0, 0.0, 0.85];
+
+/// Pushes a handle's marker: hovered and selected ones larger, in their colours, over a dark
+/// halo.
+fn push_handle_marker(
+    markers: &mut Vec<Marker>,
     q: DVec3,
     h: Handle,
     (color, size): ([f32; 4], f32),
     hovered: Option<Handle>,
     selection: &BTreeSet<Handle>,
-) -> Marker {
-    let (color, size) = if selection.contains(&h) {
-        (POINT_SELECTED, size + 4.0)
+) {
+    let (color, size, halo) = if selection.contains(&h) {
+        (POINT_SELECTED, size + 4.0, true)
     } else if hovered == Some(h) {
-        (POINT_HOVERED, size + 5.0)
+        (POINT_HOVERED, size + 5.0, true)
     } else {
-        (color, size)
+        (color, size, false)
     };
-    Marker {
+    if halo {
+        markers.push(Marker {
+            position: f32x3(q),
+            color: HALO_COLOR,
+            size: size + 2.0 * HALO,
+        });
+    }
+    markers.push(Marker {
         position: f32x3(q),
         color,
         size,
-    }
+    });
 }
 
 /// Light `k`'s gizmo: a marker at its place (position or centre), and its shape: a spot's
@@ -277,21 +290,23 @@ fn light_gizmos(
             }
         }
     }
-    g.markers.push(handle_marker(
+    push_handle_marker(
+        &mut g.markers,
         place,
         handle(LightPart::Place),
         (LIGHT, 9.0),
         hovered,
         selection,
-    ));
+    );
     if matches!(light, Light::Spot { .. }) {
-        g.markers.push(handle_marker(
+        push_handle_marker(
+            &mut g.markers,
             aim,
             handle(LightPart::Aim),
             (LIGHT, 6.0),
             hovered,
             selection,
-        ));
+        );
     }
 }
 
@@ -325,6 +340,40 @@ mod tests {
                     assert!((back - q).length() < 1e-3, "{back} vs {q}");
                 }
             }
+        }
+    }
+
+    #[test]
+    fn selected_and_hovered_handles_sit_on_a_dark_halo() {
+        let scene = crate::scene::Scene::builtin();
+        let patches: Vec<BezierPatch> = scene.geometry.patches().iter().map(|(p, _)| *p).collect();
+        let lights: Vec<(Light, DVec3)> = scene.lights.iter().map(|l| (*l, DVec3::ZERO)).collect();
+        let light = Handle::Light(LightRef {
+            light: 0,
+            part: LightPart::Place,
+        });
+        let point = Handle::Control(PointRef { patch: 0, index: 5 });
+        let plain = overlay_geometry(&patches, &lights, None, &BTreeSet::new());
+        let chosen = overlay_geometry(&patches, &lights, Some(point), &BTreeSet::from([light]));
+        assert_eq!(chosen.markers.len(), plain.markers.len() + 2);
+        for (marker, colour) in [
+            (patches[0].points[5], POINT_HOVERED),
+            (
+                super::super::handle::light_place(&scene.lights[0]),
+                POINT_SELECTED,
+            ),
+        ] {
+            let at = chosen
+                .markers
+                .iter()
+                .position(|m| m.position == f32x3(marker) && m.color == colour)
+                .expect("the marker");
+            let halo = &chosen.markers[at - 1];
+            assert_eq!(
+                (halo.position, halo.color),
+                (chosen.markers[at].position, HALO_COLOR)
+            );
+            assert_eq!(halo.size, chosen.markers[at].size + 2.0 * HALO);
         }
     }
 }

@@ -206,6 +206,10 @@ impl Viewer {
                     shown.view, callback,
                 ));
         }
+        if self.editing() {
+            let markers = super::light_markers::edge_markers(&projection, self.lights());
+            super::light_markers::paint(&ui.painter_at(shown.view), &markers, shown.view);
+        }
         if let Some((from, to)) = self.editor.rubber_band {
             let band = egui::Rect::from_two_pos(from, to);
             let stroke = egui::Stroke::new(1.0, ui.visuals().selection.stroke.color);
