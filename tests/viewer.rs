@@ -925,3 +925,48 @@ fn the_probe_never_reads_past_a_frame_that_shrank() {
             || viewer(&h).probe().is_some_and(|(x, y)| x < 32 && y < 24)
     );
 }
+
+/// At the window's default size (1180×760) the side panel shows, without scrolling, what a
+/// person watches: the renderer, pause and restart, exposure, the key statistics, the error
+/// plot, and the first of the current renderer's settings.
+#[test]
+fn the_side_panel_fits_what_matters_at_the_default_size() {
+    let mut h = Harness::builder()
+        .with_size(egui::Vec2::new(1180.0, 760.0))
+        .build_ui_state(
+            |ui, viewer: &mut Option<Viewer>| {
+                if let Some(v) = viewer {
+                    v.ui(ui);
+                }
+            },
+            None,
+        );
+    let mut v = Viewer::with_pause(&h.ctx, Scene::builtin(), ViewerSettings::default(), true);
+    for f in fixed_frames() {
+        v.show_frame(f);
+    }
+    *h.state_mut() = Some(v);
+    h.run_steps(3);
+    let status_top = h.get_by_label_contains("Hover over the image").rect().top();
+    for label in [
+        "Photon mapping",
+        "Resume",
+        "Restart",
+        "Pass",
+        "Photons/s",
+        "Elapsed",
+        "Estimated error",
+        "Photons per pass",
+        "Alpha",
+    ] {
+        let rect = h
+            .query_all_by_label(label)
+            .map(|n| n.rect())
+            .fold(egui::Rect::NOTHING, |a, b| a.union(b));
+        assert!(rect.is_positive(), "{label} is not drawn");
+        assert!(
+            rect.bottom() <= status_top,
+            "{label} is below the fold: {rect:?} (the status bar starts at {status_top})"
+        );
+    }
+}

@@ -119,25 +119,40 @@ pub fn side_panel_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Acti
         watching_ui(w, ui, out);
         ui.separator();
     }
+    // What a person watches first — the renderer, pause and restart, exposure, the key
+    // statistics and the error plot — comes first; the settings follow in sections that fold
+    // (egui remembers which are open, with the window's other state).
     let shown = viewer.params();
     let mut p = shown.clone();
     render_section_ui(viewer, &mut p, ui, out);
+    ui.separator();
+    statistics_ui(viewer, ui);
     // A watched folder's image comes from the farm: the renderer and its settings do
     // nothing there, so they are not shown.
     if viewer.watching().is_none() {
         renderer_section_ui(&mut p, viewer.ranges, ui);
-        camera_section_ui(&mut p, viewer.ranges, ui);
+        ui.separator();
+        section(ui, "Camera", true, |ui| {
+            camera_section_ui(&mut p, viewer.ranges, ui)
+        });
     }
     if p != shown {
         out.push(Action::SetParams(p));
     }
-
     if !(viewer.patches().len() == 0 && viewer.lights().is_empty()) {
         ui.separator();
-        super::edit_panel::edit_panel_ui(viewer, ui, out);
+        section(ui, "Edit", true, |ui| {
+            super::edit_panel::edit_panel_ui(viewer, ui, out)
+        });
     }
-    ui.separator();
-    statistics_ui(viewer, ui);
+}
+
+/// A section of the side panel under a heading that folds it (open at first if `open`).
+fn section(ui: &mut egui::Ui, title: &str, open: bool, body: impl FnOnce(&mut egui::Ui)) {
+    egui::CollapsingHeader::new(RichText::new(title).heading())
+        .id_salt(("caustic-section", title))
+        .default_open(open)
+        .show(ui, body);
 }
 
 /// The renderer, pause, restart, save and exposure.
@@ -221,14 +236,13 @@ fn renderer_section_ui(p: &mut PanelParams, ranges: Ranges, ui: &mut egui::Ui) {
         RendererKind::Path => return,
     };
     ui.separator();
-    ui.heading(heading);
-    setting_ui::settings_ui(p, ranges, ui, setting_ui::only(kind));
+    section(ui, heading, true, |ui| {
+        setting_ui::settings_ui(p, ranges, ui, setting_ui::only(kind));
+    });
 }
 
 /// The lens and the depth of paths.
 fn camera_section_ui(p: &mut PanelParams, ranges: Ranges, ui: &mut egui::Ui) {
-    ui.separator();
-    ui.heading("Camera");
     ui.add(
         egui::Slider::new(&mut p.aperture, 0.0..=ranges.aperture_max)
             .text("Aperture")
@@ -302,11 +316,16 @@ fn statistics_ui(viewer: &ViewerState, ui: &mut egui::Ui) {
         });
     let skipped = &frame.stats.skipped;
     if !skipped.is_empty() {
-        ui.label("Skipped work:")
+        egui::CollapsingHeader::new(format!("Skipped work ({})", skipped.len()))
+            .id_salt("caustic-skipped-work")
+            .default_open(false)
+            .show(ui, |ui| {
+                for s in skipped {
+                    ui.label(RichText::new(format!("- {s}")).small());
+                }
+            })
+            .header_response
             .on_hover_text("Work this scene does not need, left out");
-        for s in skipped {
-            ui.label(RichText::new(format!("- {s}")).small());
-        }
     }
     if frame.stats.renderer().progressive() {
         convergence_plot_ui(viewer, ui);

@@ -25,10 +25,9 @@ fn coordinates_ui(ui: &mut egui::Ui, position: glam::DVec3, speed: f64) -> Optio
     (p != position && p.is_finite()).then_some(p)
 }
 
-/// The side panel's editing section.
+/// The side panel's editing section (under its heading, drawn by the panel).
 pub fn edit_panel_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Action>) {
     let editor = &viewer.editor;
-    ui.heading("Edit");
     let mut nets = viewer.settings.show_wireframe;
     if ui
         .checkbox(&mut nets, "Show control nets and lights")

@@ -58,6 +58,8 @@ pub struct Viewer {
     pub(super) watch_scene_from: Option<PathBuf>,
     /// Added to watched images' epochs, so they follow the session's frames.
     pub(super) watch_epoch_base: u64,
+    /// Whether the side panel has been drawn (its first frame starts at the top).
+    pub(super) side_panel_shown: bool,
 }
 
 impl std::ops::Deref for Viewer {
@@ -124,6 +126,7 @@ impl Viewer {
             watch_picking: None,
             watch_scene_from: None,
             watch_epoch_base: 0,
+            side_panel_shown: false,
         }
     }
 

@@ -114,12 +114,18 @@ impl Viewer {
         egui::Panel::top("caustic-menu").show(ui, |ui| controls::menu_ui(self, ui, &mut actions));
         egui::Panel::bottom("caustic-status").show(ui, |ui| controls::status_ui(self, ui));
         if self.settings.show_side_panel {
+            // The panel opens scrolled to its top: egui keeps a scroll position from the last
+            // run, which would open the next with "Render" half hidden.
+            let first = !std::mem::replace(&mut self.side_panel_shown, true);
             egui::Panel::right("caustic-controls")
                 .resizable(true)
                 .default_size(290.0)
                 .show(ui, |ui| {
-                    egui::ScrollArea::vertical()
-                        .show(ui, |ui| controls::side_panel_ui(self, ui, &mut actions));
+                    let mut area = egui::ScrollArea::vertical().id_salt("caustic-side-panel");
+                    if first {
+                        area = area.vertical_scroll_offset(0.0);
+                    }
+                    area.show(ui, |ui| controls::side_panel_ui(self, ui, &mut actions));
                 });
         }
         egui::CentralPanel::no_frame().show(ui, |ui| self.central_ui(ui, &mut actions));
