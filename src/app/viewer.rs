@@ -78,6 +78,7 @@ impl std::ops::DerefMut for Viewer {
 fn session_options(start_paused: bool) -> SessionOptions {
     SessionOptions {
         start_paused,
+        background: true,
         ..SessionOptions::interactive()
     }
 }

@@ -35,8 +35,13 @@ pub struct SessionOptions {
     /// needs each pass); by default a frame not yet taken is replaced and the renderer never
     /// waits.
     pub every_frame: bool,
-    /// Render in a pool of this many threads (`None`: rayon's global pool).
+    /// Render in a pool of this many threads (`None`: rayon's global pool, or with
+    /// `background` a pool of one thread per core).
     pub threads: Option<usize>,
+    /// Render in threads of lower priority (niceness 5 on Linux), so that a window's UI
+    /// thread, which also rasterises in software where there is no GPU, is not kept waiting
+    /// behind them: the viewer's sessions.
+    pub background: bool,
 }
 
 /// Photons between two looks at the command channel in an interactive session: 4 chunks,
@@ -62,6 +67,7 @@ impl Default for SessionOptions {
             time_limit: None,
             every_frame: false,
             threads: None,
+            background: false,
         }
     }
 }

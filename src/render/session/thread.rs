@@ -60,10 +60,26 @@ impl RenderSession {
                         let channel = (frame_tx, stale);
                         run(scene, options, command_rx, (&channel, &waker), interrupt_flag)
                     };
-                    match options
-                        .threads
-                        .map(|n| rayon::ThreadPoolBuilder::new().num_threads(n).build())
-                    {
+                    if options.background {
+                        lower_priority();
+                    }
+                    let cores = || std::thread::available_parallelism().map_or(1, |n| n.get());
+                    let pool_size = match (options.threads, options.background) {
+                        (Some(n), _) => Some(n),
+                        (None, true) => Some(cores()),
+                        (None, false) => None,
+                    };
+                    let background = options.background;
+                    match pool_size.map(|n| {
+                        rayon::ThreadPoolBuilder::new()
+                            .num_threads(n)
+                            .start_handler(move |_| {
+                                if background {
+                                    lower_priority();
+                                }
+                            })
+                            .build()
+                    }) {
                         Some(Ok(pool)) => pool.install(render),
                         Some(Err(e)) => panic!("cannot start {:?} render threads: {e}", options.threads),
                         None => render(),
@@ -258,5 +274,18 @@ fn run(
         if let Some(frame) = frame {
             offer(frame, output, options.every_frame);
         }
+    }
+}
+
+/// Lowers the calling thread's scheduling priority (a render thread of the viewer): niceness
+/// 5 on Linux (the crate maps 35 of 0..=99 to it), a weight a third of the UI thread's, so
+/// the UI keeps its frame rate while a change's first image still comes soon; the lowest
+/// priority (19) starved the render of the cores the UI's software rasteriser takes. Where
+/// the system refuses, the thread keeps its priority: the image is the same either way.
+fn lower_priority() {
+    if let Ok(value) = thread_priority::ThreadPriorityValue::try_from(35u8) {
+        let _ = thread_priority::set_current_thread_priority(thread_priority::ThreadPriority::Crossplatform(
+            value,
+        ));
     }
 }
