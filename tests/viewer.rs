@@ -297,22 +297,29 @@ fn no_native_dialog(_: &caustic::app::file_dialog::FileRequest) -> Option<PathBu
     None
 }
 
+/// A paused viewer with fixed frames and no native file dialog, whose "Save frame..." has
+/// opened the window's own dialog in `dir`.
+fn saving_without_a_native_dialog<'a>(dir: &Path) -> App<'a> {
+    let mut h = harness(ball(), true);
+    for f in fixed_frames() {
+        viewer_mut(&mut h).show_frame(f);
+    }
+    viewer_mut(&mut h).set_native_dialog(no_native_dialog);
+    viewer_mut(&mut h).settings.last_directory = Some(dir.to_path_buf());
+    h.step();
+    h.get_by_role_and_label(Role::Button, "Save frame...").click();
+    step_until(&mut h, "the in-window dialog", Viewer::file_dialog_in_window);
+    h.run_steps(2);
+    h
+}
+
 /// The window's own dialog takes the keyboard from the start: typing replaces the proposed
 /// name's stem (the extension stays), Enter saves, Tab completes from the listing, and Escape
 /// cancels; the mouse is never used after "Save frame...".
 #[test]
 fn the_window_s_own_dialog_is_driven_by_the_keyboard_alone() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let mut h = harness(ball(), true);
-    for f in fixed_frames() {
-        viewer_mut(&mut h).show_frame(f);
-    }
-    viewer_mut(&mut h).set_native_dialog(no_native_dialog);
-    viewer_mut(&mut h).settings.last_directory = Some(dir.path().to_path_buf());
-    h.step();
-    h.get_by_role_and_label(Role::Button, "Save frame...").click();
-    step_until(&mut h, "the in-window dialog", Viewer::file_dialog_in_window);
-    h.run_steps(2);
+    let mut h = saving_without_a_native_dialog(dir.path());
     h.event(egui::Event::Text("keyboard".into()));
     h.step();
     h.key_press(egui::Key::Enter);
@@ -360,16 +367,7 @@ fn the_window_s_own_dialog_is_driven_by_the_keyboard_alone() {
 #[test]
 fn without_a_native_dialog_the_frame_saves_through_the_window_s_own() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let mut h = harness(ball(), true);
-    for f in fixed_frames() {
-        viewer_mut(&mut h).show_frame(f);
-    }
-    viewer_mut(&mut h).set_native_dialog(no_native_dialog);
-    viewer_mut(&mut h).settings.last_directory = Some(dir.path().to_path_buf());
-    h.step();
-    h.get_by_role_and_label(Role::Button, "Save frame...").click();
-    step_until(&mut h, "the in-window dialog", Viewer::file_dialog_in_window);
-    h.run_steps(2);
+    let mut h = saving_without_a_native_dialog(dir.path());
     // It never reports a cancel for the dialog that did not open.
     assert!(
         !matches!(viewer(&h).status(), Some(Status::Info(s)) if s.contains("cancelled")),
