@@ -84,17 +84,20 @@ fn ball() -> Scene {
 
 type App<'a> = Harness<'a, Option<Viewer>>;
 
+/// A window of `size` points that draws the viewer it holds (none yet).
+fn window<'a>(size: egui::Vec2) -> App<'a> {
+    Harness::builder().with_size(size).build_ui_state(
+        |ui, viewer: &mut Option<Viewer>| {
+            if let Some(v) = viewer {
+                v.ui(ui);
+            }
+        },
+        None,
+    )
+}
+
 fn harness<'a>(scene: Scene, paused: bool) -> App<'a> {
-    let mut h = Harness::builder()
-        .with_size(egui::Vec2::new(1100.0, 720.0))
-        .build_ui_state(
-            |ui, viewer: &mut Option<Viewer>| {
-                if let Some(v) = viewer {
-                    v.ui(ui);
-                }
-            },
-            None,
-        );
+    let mut h = window(egui::Vec2::new(1100.0, 720.0));
     let viewer = Viewer::with_pause(&h.ctx, scene, ViewerSettings::default(), paused);
     *h.state_mut() = Some(viewer);
     h.step();
@@ -929,16 +932,7 @@ fn the_probe_never_reads_past_a_frame_that_shrank() {
 /// plot, and the first of the current renderer's settings.
 #[test]
 fn the_side_panel_fits_what_matters_at_the_default_size() {
-    let mut h = Harness::builder()
-        .with_size(egui::Vec2::new(1180.0, 760.0))
-        .build_ui_state(
-            |ui, viewer: &mut Option<Viewer>| {
-                if let Some(v) = viewer {
-                    v.ui(ui);
-                }
-            },
-            None,
-        );
+    let mut h = window(egui::Vec2::new(1180.0, 760.0));
     let mut v = Viewer::with_pause(&h.ctx, Scene::builtin(), ViewerSettings::default(), true);
     for f in fixed_frames() {
         v.show_frame(f);

@@ -323,15 +323,15 @@ impl InWindow {
         }
     }
 
-    fn contents_ui(&mut self, ui: &mut egui::Ui) {
-        let enter = ui.input(|i| i.key_pressed(egui::Key::Enter));
-        let mut enter_taken = false;
+    /// The folder field and "Up"; whether the field took this frame's Enter (to go there).
+    fn folder_row_ui(&mut self, ui: &mut egui::Ui, enter: bool) -> bool {
+        let mut took = false;
         ui.horizontal(|ui| {
             let label = ui.label("Folder:");
             let field = ui.add(egui::TextEdit::singleline(&mut self.folder_text).desired_width(360.0));
             let field = field.labelled_by(label.id);
             if field.lost_focus() && enter {
-                enter_taken = true;
+                took = true;
                 self.enter(PathBuf::from(self.folder_text.clone()));
             }
             if ui.button("Up").on_hover_text("The folder above").clicked() {
@@ -340,36 +340,13 @@ impl InWindow {
                 }
             }
         });
-        let mut chosen: Option<Entry> = None;
-        egui::ScrollArea::vertical().max_height(220.0).show(ui, |ui| {
-            ui.set_min_width(440.0);
-            for entry in &self.entries {
-                let text = if entry.folder {
-                    format!("{}/", entry.name)
-                } else {
-                    entry.name.clone()
-                };
-                if ui.selectable_label(entry.name == self.name, text).clicked() {
-                    chosen = Some(entry.clone());
-                }
-            }
-            if self.entries.is_empty() {
-                ui.weak("(no folders or matching files here)");
-            }
-        });
-        match chosen {
-            Some(e) if e.folder => self.enter(self.folder.join(&e.name)),
-            Some(e) => self.name = e.name,
-            None => {}
-        }
-        let types: Vec<String> = self
-            .request
-            .filters
-            .iter()
-            .map(|(name, exts)| format!("{name} (.{})", exts.join(", .")))
-            .collect();
-        ui.weak(format!("Types: {}", types.join("; ")));
-        let mut confirm = false;
+        took
+    }
+
+    /// The file name field: Tab completes it; on the first frame it takes the keyboard with
+    /// the name's stem selected. Whether Enter confirmed the name in it.
+    fn name_row_ui(&mut self, ui: &mut egui::Ui, enter: bool) -> bool {
+        let mut confirmed = false;
         ui.horizontal(|ui| {
             let label = ui.label("File name:");
             let id = egui::Id::unique("caustic-file-dialog-name");
@@ -400,11 +377,46 @@ impl InWindow {
                 output.response.request_focus();
             }
             let field = output.response.response.clone().labelled_by(label.id);
-            enter_taken |= field.lost_focus() && enter;
-            confirm |= field.lost_focus() && enter;
+            confirmed = field.lost_focus() && enter;
         });
-        // Enter takes the name wherever the keyboard is, unless a field used it.
-        confirm |= enter && !enter_taken && ui.memory(|m| m.focused().is_none());
+        confirmed
+    }
+
+    fn contents_ui(&mut self, ui: &mut egui::Ui) {
+        let enter = ui.input(|i| i.key_pressed(egui::Key::Enter));
+        let folder_took_enter = self.folder_row_ui(ui, enter);
+        let mut chosen: Option<Entry> = None;
+        egui::ScrollArea::vertical().max_height(220.0).show(ui, |ui| {
+            ui.set_min_width(440.0);
+            for entry in &self.entries {
+                let text = if entry.folder {
+                    format!("{}/", entry.name)
+                } else {
+                    entry.name.clone()
+                };
+                if ui.selectable_label(entry.name == self.name, text).clicked() {
+                    chosen = Some(entry.clone());
+                }
+            }
+            if self.entries.is_empty() {
+                ui.weak("(no folders or matching files here)");
+            }
+        });
+        match chosen {
+            Some(e) if e.folder => self.enter(self.folder.join(&e.name)),
+            Some(e) => self.name = e.name,
+            None => {}
+        }
+        let types: Vec<String> = self
+            .request
+            .filters
+            .iter()
+            .map(|(name, exts)| format!("{name} (.{})", exts.join(", .")))
+            .collect();
+        ui.weak(format!("Types: {}", types.join("; ")));
+        let named = self.name_row_ui(ui, enter);
+        // Enter takes the name wherever the keyboard is, unless the folder field used it.
+        let mut confirm = named || (enter && !folder_took_enter && ui.memory(|m| m.focused().is_none()));
         if let Some(message) = &self.message {
             ui.colored_label(ui.visuals().warn_fg_color, message);
         }

@@ -2,7 +2,7 @@
 //! seen still says where it is, so that a person knows which way to turn or dolly to reach
 //! it. Drawn with egui's painter over the image while the overlay is shown.
 
-use egui::{Color32, Pos2, Rect, Shape, Stroke, Vec2};
+use egui::{Color32, Pos2, Shape, Stroke, Vec2};
 
 use super::handle::light_place;
 use super::overlay::OverlayProjection;
@@ -67,8 +67,8 @@ pub fn edge_markers(proj: &OverlayProjection, lights: &[Light]) -> Vec<EdgeMarke
 }
 
 /// Paints `markers` (arrowheads in the lights' gizmo colour, outlined so that they show on
-/// any background) clipped to `clip`.
-pub fn paint(painter: &egui::Painter, markers: &[EdgeMarker], clip: Rect) {
+/// any background).
+pub fn paint(painter: &egui::Painter, markers: &[EdgeMarker]) {
     let fill = Color32::from_rgb(255, 217, 89);
     let outline = Stroke::new(1.5, Color32::from_black_alpha(220));
     for m in markers {
@@ -76,15 +76,14 @@ pub fn paint(painter: &egui::Painter, markers: &[EdgeMarker], clip: Rect) {
         let tip = m.at;
         let back = tip - m.toward * 14.0;
         let points = vec![tip, back + side * 7.0, back - side * 7.0];
-        if clip.contains(tip) {
-            painter.add(Shape::convex_polygon(points, fill, outline));
-        }
+        painter.add(Shape::convex_polygon(points, fill, outline));
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use egui::Rect;
     use glam::DVec3;
 
     fn projection() -> OverlayProjection {

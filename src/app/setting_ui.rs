@@ -40,6 +40,21 @@ fn tooltip(s: &Setting) -> String {
     }
 }
 
+/// A slider over `range` (logarithmic, stepped by `step` when positive) labelled `label`;
+/// whether it moved.
+fn slider_ui<N: egui::emath::Numeric>(
+    ui: &mut Ui,
+    value: &mut N,
+    range: std::ops::RangeInclusive<N>,
+    (log, step): (bool, f64),
+    label: &str,
+    tip: &str,
+) -> bool {
+    let slider = egui::Slider::new(value, range).logarithmic(log).text(label);
+    let slider = if step > 0.0 { slider.step_by(step) } else { slider };
+    ui.add(slider).on_hover_text(tip).changed()
+}
+
 /// One setting's control.
 fn setting_ui(p: &mut PanelParams, s: &'static Setting, ranges: Ranges, ui: &mut Ui) {
     let Some(value) = p.render.get(s.key) else {
@@ -53,24 +68,11 @@ fn setting_ui(p: &mut PanelParams, s: &'static Setting, ranges: Ranges, ui: &mut
             .changed()
             .then_some(Value::Bool(on)),
         (Widget::Slider { min, max, log, step }, Value::Int(mut n)) => {
-            let slider = egui::Slider::new(&mut n, min as u64..=max as u64)
-                .logarithmic(log)
-                .text(s.label);
-            let slider = if step > 0.0 { slider.step_by(step) } else { slider };
-            ui.add(slider)
-                .on_hover_text(tip)
-                .changed()
-                .then_some(Value::Int(n))
+            let range = min as u64..=max as u64;
+            slider_ui(ui, &mut n, range, (log, step), s.label, &tip).then_some(Value::Int(n))
         }
         (Widget::Slider { min, max, log, step }, Value::Real(mut x)) => {
-            let slider = egui::Slider::new(&mut x, min..=max)
-                .logarithmic(log)
-                .text(s.label);
-            let slider = if step > 0.0 { slider.step_by(step) } else { slider };
-            ui.add(slider)
-                .on_hover_text(tip)
-                .changed()
-                .then_some(Value::Real(x))
+            slider_ui(ui, &mut x, min..=max, (log, step), s.label, &tip).then_some(Value::Real(x))
         }
         (widget @ Widget::Auto { .. }, Value::Auto(current)) => auto_ui(p, s, widget, current, ranges, ui),
         (Widget::Choice, Value::Choice(current)) => choice_ui(s, current, &tip, ui),

@@ -214,7 +214,7 @@ impl Viewer {
         }
         if self.editing() {
             let markers = super::light_markers::edge_markers(&projection, self.lights());
-            super::light_markers::paint(&ui.painter_at(shown.view), &markers, shown.view);
+            super::light_markers::paint(&ui.painter_at(shown.view), &markers);
         }
         if let Some((from, to)) = self.editor.rubber_band {
             let band = egui::Rect::from_two_pos(from, to);
