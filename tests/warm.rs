@@ -1,6 +1,7 @@
-//! Warm restarts after an edit: the new epoch keeps what is still valid, converges to the
-//! edited scene's image (mean within 1 % of a cold render), is the same for 1 and 2 threads,
-//! and the session starts it without the low-resolution preview.
+//! Warm restarts after an edit (a control point or a light moved): the new epoch keeps what
+//! is still valid, converges to the edited scene's image (mean within 1 % of a cold render),
+//! is the same for 1 and 2 threads, and the session starts it without the low-resolution
+//! preview.
 
 use std::path::Path;
 use std::time::Duration;
@@ -36,6 +37,14 @@ fn edited(scene: &Scene, by: f64) -> (Scene, Command) {
         position: patch.points[5],
     };
     (out, command)
+}
+
+/// The sheet's light moved by `by`.
+fn light_moved(scene: &Scene, by: DVec3) -> (Scene, Command) {
+    let mut out = scene.clone();
+    let value = scene.lights[0].translated(by);
+    assert!(out.set_light(0, value));
+    (out, Command::SetLight { light: 0, value })
 }
 
 fn options() -> PpmOptions {
@@ -113,6 +122,44 @@ fn a_warm_restart_converges_to_the_edited_scene_for_any_thread_count() {
 }
 
 #[test]
+fn a_moved_light_restarts_warm_and_converges_to_its_new_light() {
+    for antialias in [true, false] {
+        let scene = sheet(96, 20_000, antialias);
+        // Far enough that the sheet's caustic and the floor's shading move visibly.
+        let (edit, _) = light_moved(&scene, DVec3::new(0.6, 0.8, 0.3));
+        let mut old = Ppm::new(&scene, options());
+        run(&mut old, &scene, 6);
+        let before = mean(&old.radiance());
+        let mut kept = old.into_warm_start().expect("warm start");
+        kept.light_moved(0);
+        let mut new = Ppm::new(&edit, options());
+        new.inherit(&edit, kept);
+        // The viewer's ramp: a small first pass, so the old light's prior is worth one full
+        // pass (it counts as 8 first passes) and its share falls as 1/(1 + passes).
+        new.photons_per_pass = 2_500;
+        run(&mut new, &edit, 1);
+        new.photons_per_pass = 20_000;
+        run(&mut new, &edit, 39);
+        assert_eq!(
+            new.stats().kept_share,
+            1.0,
+            "antialias {antialias}: a light's move moves no visible point"
+        );
+        let mut cold = Ppm::new(&edit, options());
+        run(&mut cold, &edit, 40);
+        let (w, c) = (mean(&new.radiance()), mean(&cold.radiance()));
+        assert!(
+            (before - c).abs() > 0.03 * c,
+            "antialias {antialias}: the move changes the image ({before} and {c})"
+        );
+        assert!(
+            (w - c).abs() < 0.01 * c,
+            "antialias {antialias}: warm mean {w} against cold {c}"
+        );
+    }
+}
+
+#[test]
 fn the_moved_sheet_takes_nearby_estimates_and_the_rest_is_kept() {
     for antialias in [true, false] {
         let scene = sheet(96, 20_000, antialias);
@@ -165,13 +212,41 @@ fn the_session_restarts_warm_after_an_edit_and_cold_after_a_setting() {
         "a warm epoch opens with a full pass, not a preview"
     );
     assert!(kept > 0.8, "most pixels kept: {kept}");
+    // So does a moved light, and undoing the move.
+    let (moved, command) = light_moved(&scene, DVec3::new(0.2, 0.0, 0.0));
+    for (epoch, command) in [
+        (2, command),
+        (
+            3,
+            Command::SetLight {
+                light: 0,
+                value: scene.lights[0],
+            },
+        ),
+    ] {
+        session.send(command);
+        let first = loop {
+            let f = next_frame(&session);
+            if f.epoch == epoch {
+                break f;
+            }
+        };
+        let kept = first.stats.json["photon_mapping"]["kept_share"]
+            .as_f64()
+            .unwrap_or(0.0);
+        assert!(
+            !first.preview && kept > 0.8,
+            "a light's move is warm: kept {kept}"
+        );
+    }
+    assert_ne!(moved.lights[0], scene.lights[0]);
     // A setting restarts cold: the preview first, nothing kept.
     let mut params = scene.params.clone();
     params.initial_radius = Some(0.05);
     session.send(Command::SetParams(params));
     let first = loop {
         let f = next_frame(&session);
-        if f.epoch == 2 {
+        if f.epoch == 4 {
             break f;
         }
     };

@@ -1,20 +1,24 @@
 //! Scripted runs of the real window: `caustic view --screenshot FILE` saves a picture of the
 //! window (egui's own screenshot) once the render has reached some passes, and
 //! `caustic view --bench` measures launch-to-first-image, UI frame rate while rendering,
-//! slider-to-new-epoch-image latency and, on scenes with patches, a control-point drag made
-//! through the same actions the mouse emits (each step to its new epoch's first image, the
-//! frame rate meanwhile, and the time to re-prepare the edited patch), prints them and exits.
+//! slider-to-new-epoch-image latency, and drags of a control point (on scenes with patches)
+//! and of a light made through the same actions the mouse emits (each step to its new epoch's
+//! first image, the frame rate meanwhile, what is on screen 100 ms after a move, and the time
+//! to re-prepare the edited patch), prints them and exits.
 
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use super::action::Action;
+use super::handle::{Handle, LightPart, LightRef};
 use super::overlay::PointRef;
 use super::viewer::Viewer;
 use crate::bench::convergence::reference;
 use crate::bench::edit_run::{EditPlan, WarmCold, ON_SCREEN_AFTER};
 use crate::bench::output::BenchOutput;
+use crate::render::session::Command;
+use crate::scene::Scene;
 
 /// What to do besides showing the window.
 #[derive(Clone, Debug)]
@@ -55,10 +59,15 @@ const TIMEOUT: Duration = Duration::from_secs(300);
 const FPS_WINDOW: Duration = Duration::from_secs(5);
 /// Restarts measured.
 const LATENCY_ROUNDS: usize = 6;
-/// Steps of the control-point drag measured.
+/// Steps of each drag measured.
 const DRAG_ROUNDS: usize = 12;
-/// The control point the drag stage moves: patch 0, an inner point of its net.
+/// The control point the first drag stage moves: patch 0, an inner point of its net.
 const DRAG_POINT: PointRef = PointRef { patch: 0, index: 5 };
+/// The light the second drag stage moves, by its place.
+const DRAG_LIGHT: LightRef = LightRef {
+    light: 0,
+    part: LightPart::Place,
+};
 
 enum Stage {
     WaitFirstImage,
@@ -74,7 +83,7 @@ enum Stage {
         round: usize,
         sent: Option<Instant>,
     },
-    Drag(DragStage),
+    Drag(Box<DragStage>),
     Screenshot {
         requested: bool,
     },
@@ -95,37 +104,92 @@ impl Stage {
     }
 }
 
-/// The drag stage of `--bench`: a control point dragged step by step through the same
-/// actions the mouse emits, each step timed to its new epoch's first image.
+/// A drag stage of `--bench`: a handle (a control point, then a light) dragged step by step
+/// through the same actions the mouse emits, each step timed to its new epoch's first image.
 struct DragStage {
+    grab: Handle,
     round: usize,
     /// When the current step was made.
     sent: Option<Instant>,
-    /// Where the drag pressed (the point's place on screen).
+    /// Where the drag pressed (the handle's place on screen).
     press: Option<egui::Pos2>,
+    /// The scene before the first step (what the drag preview's error is measured from).
+    before: Option<Scene>,
     start: Instant,
     frames: u32,
+    /// Each step's move to its new-epoch image (seconds).
+    latencies: Vec<f64>,
+}
+
+/// What a finished drag stage measured.
+struct DragFigures {
+    grab: Handle,
+    /// Each step's move to its new-epoch image (seconds).
+    latencies: Vec<f64>,
+    /// UI frames per second while dragging.
+    fps: f64,
+    /// The scene before the drag and the edit the whole drag made.
+    edit: Option<(Scene, Command)>,
 }
 
 impl DragStage {
-    /// One UI frame of the stage: `Some(Ok(frames per second))` when done, `Some(Err)` when
-    /// the renderer showed nothing for a minute.
-    fn step(
-        &mut self,
-        viewer: &mut Viewer,
-        now: Instant,
-        latencies: &mut Vec<f64>,
-    ) -> Option<Result<f64, String>> {
+    fn new(grab: Handle, now: Instant) -> Self {
+        DragStage {
+            grab,
+            round: 0,
+            sent: None,
+            press: None,
+            before: None,
+            start: now,
+            frames: 0,
+            latencies: Vec::new(),
+        }
+    }
+
+    /// The first drag stage after `after` for `viewer`'s scene: the control point, then the
+    /// light, each where the scene has it.
+    fn next(viewer: &Viewer, after: Option<Handle>, now: Instant) -> Option<Self> {
+        let point = (viewer.patches().len() > 0).then_some(Handle::Control(DRAG_POINT));
+        let light = (!viewer.document.lights().is_empty()).then_some(Handle::Light(DRAG_LIGHT));
+        let order = [point, light];
+        let from = match after {
+            None => 0,
+            Some(h) => order
+                .iter()
+                .position(|o| *o == Some(h))
+                .map_or(order.len(), |k| k + 1),
+        };
+        order[from..]
+            .iter()
+            .flatten()
+            .next()
+            .map(|&h| DragStage::new(h, now))
+    }
+
+    /// One UI frame of the stage: `Some(Ok(figures))` when done (with no steps when the
+    /// handle is behind the camera), `Some(Err)` when the renderer showed nothing for a
+    /// minute.
+    fn step(&mut self, viewer: &mut Viewer, now: Instant) -> Option<Result<DragFigures, String>> {
         self.frames += 1;
         let Some(at) = self.sent else {
             if self.press.is_none() {
-                let point = viewer.document.patch(DRAG_POINT.patch)?.points[DRAG_POINT.index];
+                let point = viewer.editor.point(&viewer.document, self.grab);
                 self.press = viewer.projection().and_then(|p| p.to_screen(point));
+                if self.press.is_none() {
+                    // Behind the camera: there is nothing on screen to grab.
+                    return Some(Ok(DragFigures {
+                        grab: self.grab,
+                        latencies: Vec::new(),
+                        fps: 0.0,
+                        edit: None,
+                    }));
+                }
+                self.before = Some(viewer.scene().clone());
             }
             let screen = self.press?;
             if self.round == 0 {
                 viewer.apply(Action::BeginPointDrag {
-                    grab: DRAG_POINT.into(),
+                    grab: self.grab,
                     press: screen,
                 });
             }
@@ -138,18 +202,51 @@ impl DragStage {
             return None;
         };
         if viewer.restart_latency_secs().is_some() && !viewer.restart_pending() {
-            latencies.push(viewer.restart_latency_secs().unwrap_or(0.0));
+            self.latencies.push(viewer.restart_latency_secs().unwrap_or(0.0));
             self.round += 1;
             self.sent = None;
             if self.round == DRAG_ROUNDS {
                 viewer.apply(Action::EndGesture);
-                return Some(Ok(self.frames as f64 / (now - self.start).as_secs_f64()));
+                let edit = self
+                    .before
+                    .take()
+                    .and_then(|b| whole_edit(b, viewer.scene(), self.grab));
+                return Some(Ok(DragFigures {
+                    grab: self.grab,
+                    latencies: std::mem::take(&mut self.latencies),
+                    fps: self.frames as f64 / (now - self.start).as_secs_f64(),
+                    edit,
+                }));
             }
         } else if now - at > Duration::from_secs(60) {
-            return Some(Err("no image 60 s after a control-point move".into()));
+            return Some(Err(format!("no image 60 s after a move of {}", name(self.grab))));
         }
         None
     }
+}
+
+/// A dragged handle in words.
+fn name(grab: Handle) -> &'static str {
+    match grab {
+        Handle::Control(_) => "control point",
+        Handle::Light(_) => "light",
+    }
+}
+
+/// The edit a whole drag of `grab` made, from `before` to `after`, as one command.
+fn whole_edit(before: Scene, after: &Scene, grab: Handle) -> Option<(Scene, Command)> {
+    let command = match grab {
+        Handle::Control(r) => Command::MoveControlPoint {
+            patch: r.patch,
+            index: r.index,
+            position: after.geometry.patches().get(r.patch)?.0.points[r.index],
+        },
+        Handle::Light(r) => Command::SetLight {
+            light: r.light,
+            value: *after.lights.get(r.light)?,
+        },
+    };
+    Some((before, command))
 }
 
 /// The state of a scripted run.
@@ -163,10 +260,8 @@ pub struct Automation {
     /// The same with the renderer paused.
     fps_paused: Option<(f64, f64, f64)>,
     latencies: Vec<f64>,
-    /// Control-point move to new-epoch image, each drag step (seconds).
-    drag_latencies: Vec<f64>,
-    /// UI frames per second while dragging.
-    drag_fps: Option<f64>,
+    /// What each drag stage measured.
+    drags: Vec<DragFigures>,
     /// Exit status for the process (non-zero when the run failed).
     pub failed: Option<String>,
 }
@@ -182,8 +277,7 @@ impl Automation {
             fps: None,
             fps_paused: None,
             latencies: Vec::new(),
-            drag_latencies: Vec::new(),
-            drag_fps: None,
+            drags: Vec::new(),
             failed: None,
         })
     }
@@ -224,10 +318,14 @@ impl Automation {
             }
             Stage::FrameRate { .. } => self.frame_rate_step(viewer, now, ui_secs),
             Stage::Latency { .. } => self.latency_step(viewer, now),
-            Stage::Drag(drag) => match drag.step(viewer, now, &mut self.drag_latencies) {
-                Some(Ok(fps)) => {
-                    self.drag_fps = Some(fps);
-                    self.stage = Stage::Screenshot { requested: false };
+            Stage::Drag(drag) => match drag.step(viewer, now) {
+                Some(Ok(figures)) => {
+                    let grab = figures.grab;
+                    self.drags.push(figures);
+                    self.stage = DragStage::next(viewer, Some(grab), now)
+                        .map_or(Stage::Screenshot { requested: false }, |d| {
+                            Stage::Drag(Box::new(d))
+                        });
                 }
                 Some(Err(e)) => self.finish(viewer, Some(e)),
                 None => {}
@@ -298,17 +396,10 @@ impl Automation {
                     *round += 1;
                     *sent = None;
                     if *round == LATENCY_ROUNDS {
-                        self.stage = if viewer.patches().len() == 0 {
-                            Stage::Screenshot { requested: false }
-                        } else {
-                            Stage::Drag(DragStage {
-                                round: 0,
-                                sent: None,
-                                press: None,
-                                start: now,
-                                frames: 0,
-                            })
-                        };
+                        self.stage = DragStage::next(viewer, None, now)
+                            .map_or(Stage::Screenshot { requested: false }, |d| {
+                                Stage::Drag(Box::new(d))
+                            });
                     }
                 } else if now - *at > Duration::from_secs(60) {
                     self.finish(viewer, Some("no image 60 s after a restart".into()));
@@ -390,42 +481,8 @@ impl Automation {
                 ms.join(", ")
             );
         }
-        if !self.drag_latencies.is_empty() {
-            let mut l = self.drag_latencies.clone();
-            l.sort_by(f64::total_cmp);
-            let ms: Vec<String> = self
-                .drag_latencies
-                .iter()
-                .map(|s| format!("{:.0}", s * 1e3))
-                .collect();
-            println!(
-                "  control-point drag step to new-epoch image: median {:.0} ms, max {:.0} ms over {} steps  (each: {} ms)",
-                l[l.len() / 2] * 1e3,
-                l[l.len() - 1] * 1e3,
-                l.len(),
-                ms.join(", ")
-            );
-            if let Some(fps) = self.drag_fps {
-                println!("  UI frame rate while dragging:  {fps:.1} fps");
-            }
-            let secs = crate::bench::time_reprepare(
-                &viewer.scene().geometry,
-                DRAG_POINT.patch,
-                DRAG_POINT.index,
-                21,
-            );
-            match drag_preview_error(viewer) {
-                Ok(line) => println!("{line}"),
-                Err(e) => println!("  drag preview error: not measured ({e})"),
-            }
-            if !secs.is_empty() {
-                println!(
-                    "  re-prepare one edited patch (subdivision + BVH update): median {:.2} ms, max {:.2} ms over {} edits",
-                    secs[secs.len() / 2] * 1e3,
-                    secs[secs.len() - 1] * 1e3,
-                    secs.len()
-                );
-            }
+        for drag in &self.drags {
+            report_drag(drag, viewer);
         }
         if let Some(f) = viewer.frame() {
             println!(
@@ -436,44 +493,77 @@ impl Automation {
     }
 }
 
+/// Prints what a drag stage measured: its steps, the frame rate, the drag preview's error
+/// and, for a control point, the time to re-prepare its patch.
+fn report_drag(drag: &DragFigures, viewer: &Viewer) {
+    let what = name(drag.grab);
+    let mut l = drag.latencies.clone();
+    l.sort_by(f64::total_cmp);
+    if l.is_empty() {
+        println!("  {what} drag: not measured (it is behind the camera)");
+        return;
+    }
+    let ms: Vec<String> = drag.latencies.iter().map(|s| format!("{:.0}", s * 1e3)).collect();
+    println!(
+        "  {what} drag step to new-epoch image: median {:.0} ms, max {:.0} ms over {} steps  (each: {} ms)",
+        l[l.len() / 2] * 1e3,
+        l[l.len() - 1] * 1e3,
+        l.len(),
+        ms.join(", ")
+    );
+    println!("  UI frame rate while dragging the {what}:  {:.1} fps", drag.fps);
+    match &drag.edit {
+        Some((before, edit)) => match drag_preview_error(viewer.scene(), before, edit) {
+            Ok(line) => println!("  {what} {line}"),
+            Err(e) => println!("  {what} drag preview error: not measured ({e})"),
+        },
+        None => println!("  {what} drag preview error: not measured (the drag made no edit)"),
+    }
+    if let Handle::Control(r) = drag.grab {
+        let secs = crate::bench::time_reprepare(&viewer.scene().geometry, r.patch, r.index, 21);
+        if !secs.is_empty() {
+            println!(
+                "  re-prepare one edited patch (subdivision + BVH update): median {:.2} ms, max {:.2} ms over {} edits",
+                secs[secs.len() / 2] * 1e3,
+                secs[secs.len() - 1] * 1e3,
+                secs.len()
+            );
+        }
+    }
+}
+
 /// Passes of the reference the drag preview is measured against.
 const PREVIEW_REFERENCE_PASSES: u32 = 100;
 
-/// The drag preview's figure: the RMSE of what is on screen [`ON_SCREEN_AFTER`] a move of the
-/// dragged point (from where it was to where the drag left it), against the reference of the
-/// edited scene that `bench edit` uses (cached), with warm restarts (the viewer's) and with
-/// the cold restart and preview the viewer had before them; medians of 3 runs each (`bench
-/// edit`'s harness, [`WarmCold`]), in the viewer's kind of render session without the window.
-fn drag_preview_error(viewer: &Viewer) -> Result<String, String> {
-    let edited = viewer.scene();
-    let position = edited.geometry.patches()[DRAG_POINT.patch].0.points[DRAG_POINT.index];
-    let mut before = edited.clone();
-    let start = viewer.document.loaded_patches()[DRAG_POINT.patch].points[DRAG_POINT.index];
-    before
-        .geometry
-        .set_control_point(DRAG_POINT.patch, DRAG_POINT.index, start);
+/// The drag preview's figure: the RMSE of what is on screen [`ON_SCREEN_AFTER`] the whole
+/// drag's `edit` of `before` (which made `edited`), against the reference of the edited scene
+/// that `bench edit` uses (cached), with warm restarts (the viewer's) and with the cold
+/// restart and preview the viewer had before them; medians of 3 runs each (`bench edit`'s
+/// harness, [`WarmCold`]), in the viewer's kind of render session without the window.
+fn drag_preview_error(edited: &Scene, before: &Scene, edit: &Command) -> Result<String, String> {
     let mut out = BenchOutput::new(false, "view");
-    let what = format!(
-        "control point {} of patch {} moved to {position:?}",
-        DRAG_POINT.index, DRAG_POINT.patch
-    );
+    let what = match edit {
+        Command::MoveControlPoint {
+            patch,
+            index,
+            position,
+        } => format!("control point {index} of patch {patch} moved to {position:?}"),
+        Command::SetLight { light, value } => format!("light {light} set to {value:?}"),
+        _ => return Err("not an edit".into()),
+    };
     let reference = reference(edited, PREVIEW_REFERENCE_PASSES, None, Some(what), &mut out)
         .map_err(|e| format!("{e:#}"))?;
     let plan = EditPlan {
-        edit: crate::render::session::Command::MoveControlPoint {
-            patch: DRAG_POINT.patch,
-            index: DRAG_POINT.index,
-            position,
-        },
+        edit: edit.clone(),
         before_passes: 8,
         warm: true,
         target: 0.0,
         limit: std::time::Duration::from_secs(3),
     };
-    let m = WarmCold::measure(&before, &plan, 3, &reference, |_, _, _| {})?.medians();
+    let m = WarmCold::measure(before, &plan, 3, &reference, |_, _, _| {})?.medians();
     let ([warm, cold], [(wt, we), (ct, ce)]) = (m.on_screen, m.first);
     Ok(format!(
-        "  drag preview, against a {PREVIEW_REFERENCE_PASSES}-pass reference of the edited scene (medians of 3 moves): the new epoch's first image has RMSE {we:.3e} at {:.0} ms with warm restarts, {ce:.3e} at {:.0} ms with the cold restart's ¼-resolution preview of before ({:.2}x); on screen {} ms after the move: {warm:.3e} and {cold:.3e} ({:.2}x)",
+        "drag preview, against a {PREVIEW_REFERENCE_PASSES}-pass reference of the edited scene (medians of 3 moves): the new epoch's first image has RMSE {we:.3e} at {:.0} ms with warm restarts, {ce:.3e} at {:.0} ms with the cold restart's ¼-resolution preview ({:.2}x); on screen {} ms after the move: {warm:.3e} and {cold:.3e} ({:.2}x)",
         wt * 1e3,
         ct * 1e3,
         we / ce,

@@ -19,7 +19,7 @@ pub struct AllArgs {
     /// The README whose benchmark table is written from the results.
     #[arg(long, default_value = "README.md")]
     readme: PathBuf,
-    /// Run only these benchmarks (by name: intersect, ppm, whitted, convergence, edit,
+    /// Run only these benchmarks (by name: intersect, ppm, whitted, convergence, edit, edit-light,
     /// memory); the others keep their figures in the results file.
     #[arg(long, value_delimiter = ',')]
     only: Vec<String>,
@@ -133,6 +133,24 @@ const BENCHES: &[Bench] = &[
         figures: &[
             Figure {
                 what: "Live editing (inline patch): a moved control point to relative MSE 1e-2, warm restart",
+                pointer: "/warm_secs",
+                unit: "s",
+                decimals: 2,
+            },
+            Figure {
+                what: "… cold restart",
+                pointer: "/cold_secs",
+                unit: "s",
+                decimals: 2,
+            },
+        ],
+    },
+    Bench {
+        name: "edit-light",
+        args: &["edit", "scenes/lens.toml", "--light", "0", "--runs", "3"],
+        figures: &[
+            Figure {
+                what: "Live editing (lens): a moved spot light to relative MSE 1e-2, warm restart",
                 pointer: "/warm_secs",
                 unit: "s",
                 decimals: 2,

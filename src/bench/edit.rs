@@ -1,5 +1,6 @@
 //! `caustic bench edit`: how soon an edit shows converged. One control point is moved by a
-//! few per cent of its patch's size while the viewer's kind of session renders; the time from
+//! few per cent of its patch's size (or, with `--light`, a light by a few per cent of the
+//! scene's size across the view) while the viewer's kind of session renders; the time from
 //! the edit to relative MSE 1e-2 against a (cached) reference of the edited scene is measured
 //! with the new epoch started warm and cold, runs interleaved, medians printed.
 
@@ -27,8 +28,13 @@ pub struct EditArgs {
     /// The control point that moves (4i + j; default an inner one).
     #[arg(long, default_value_t = 5)]
     point: usize,
+    /// Move this light instead of a control point (its index in the scene's `[[lights]]`,
+    /// from 0): along the camera's right, by `--distance` of the scene's bounding-box
+    /// diagonal.
+    #[arg(long, value_name = "K")]
+    light: Option<usize>,
     /// How far it moves, as a share of the patch's bounding-box diagonal, along the surface's
-    /// normal there.
+    /// normal there (with `--light`, of the scene's diagonal, across the view).
     #[arg(long, default_value_t = 0.03)]
     distance: f64,
     /// Passes rendered before the edit (the image a person was looking at).
@@ -54,13 +60,6 @@ pub struct EditArgs {
     pub threads: Threads,
 }
 
-/// The edit a run makes.
-struct Edit {
-    patch: usize,
-    index: usize,
-    position: DVec3,
-}
-
 /// Runs the measurement.
 pub fn bench_edit(args: EditArgs, out: &mut BenchOutput) -> Result<()> {
     if args.runs == 0 || args.before_passes == 0 {
@@ -75,37 +74,30 @@ pub fn bench_edit(args: EditArgs, out: &mut BenchOutput) -> Result<()> {
         "inline_patch",
     )?;
     scene.params.renderer = RendererKind::Ppm;
-    let edit = edit(&scene, &args)?;
+    let (edit, what) = match args.light {
+        Some(k) => light_edit(&scene, k, args.distance)?,
+        None => point_edit(&scene, &args)?,
+    };
     let mut edited = scene.clone();
-    edited
-        .geometry
-        .set_control_point(edit.patch, edit.index, edit.position);
+    crate::render::session::command::apply_to_scene(&mut edited, vec![edit.clone()]);
     let reference = super::convergence::reference(
         &edited,
         args.reference_passes,
         args.reference_dir.as_deref(),
-        Some(format!(
-            "control point {} of patch {} moved to {:?}",
-            edit.index, edit.patch, edit.position
-        )),
+        Some(what.clone()),
         out,
     )?;
     out.say(format!(
-        "Edit of {}: control point {} of patch {} moved by {} % of the patch's size; {} passes before the edit, {}x{}",
+        "Edit of {}: {what} ({} % of the {}'s size); {} passes before the edit, {}x{}",
         scene.source.display(),
-        edit.index,
-        edit.patch,
         100.0 * args.distance,
+        if args.light.is_some() { "scene" } else { "patch" },
         args.before_passes,
         scene.camera.width,
         scene.camera.height
     ));
     let plan = EditPlan {
-        edit: Command::MoveControlPoint {
-            patch: edit.patch,
-            index: edit.index,
-            position: edit.position,
-        },
+        edit,
         before_passes: args.before_passes,
         warm: true,
         target: args.target,
@@ -124,8 +116,9 @@ pub fn bench_edit(args: EditArgs, out: &mut BenchOutput) -> Result<()> {
     Ok(())
 }
 
-/// The moved point: `--distance` of the patch's diagonal along the surface normal at it.
-fn edit(scene: &Scene, args: &EditArgs) -> Result<Edit> {
+/// The moved point: `--distance` of the patch's diagonal along the surface normal at it; the
+/// command and what it did, in words.
+fn point_edit(scene: &Scene, args: &EditArgs) -> Result<(Command, String)> {
     let patches = scene.geometry.patches();
     let Some((patch, _)) = patches.get(args.patch) else {
         bail!(
@@ -145,11 +138,40 @@ fn edit(scene: &Scene, args: &EditArgs) -> Result<Edit> {
     let normal = patch.normal(i as f64 / 3.0, j as f64 / 3.0).unwrap_or(DVec3::Y);
     let bounds = patch.bounds();
     let size = (bounds.max - bounds.min).length();
-    Ok(Edit {
+    let position = patch.points[args.point] + normal * (args.distance * size);
+    let what = format!(
+        "control point {} of patch {} moved to {position:?}",
+        args.point, args.patch
+    );
+    let command = Command::MoveControlPoint {
         patch: args.patch,
         index: args.point,
-        position: patch.points[args.point] + normal * (args.distance * size),
-    })
+        position,
+    };
+    Ok((command, what))
+}
+
+/// Light `k` moved along the camera's right by `distance` of the scene's diagonal; the
+/// command and what it did, in words.
+fn light_edit(scene: &Scene, k: usize, distance: f64) -> Result<(Command, String)> {
+    let Some(light) = scene.lights.get(k) else {
+        bail!(
+            "--light {k}: {} has {} lights",
+            scene.source.display(),
+            scene.lights.len()
+        );
+    };
+    let bounds = scene.geometry.bounds();
+    let size = if bounds.is_empty() {
+        1.0
+    } else {
+        (bounds.max - bounds.min).length()
+    };
+    let cam = &scene.camera;
+    let right = cam.forward.cross(cam.up).normalize_or_zero();
+    let value = light.translated(right * (distance * size));
+    let what = format!("light {k} moved by {:?}", right * (distance * size));
+    Ok((Command::SetLight { light: k, value }, what))
 }
 
 /// Prints the medians: the time to the target, then the first image after the edit and what

@@ -12,6 +12,8 @@ use crate::settings::RendererKind;
 pub struct PhotonMapping {
     ppm: Ppm,
     guided_emission: bool,
+    /// The lights as this render began (a warm restart tells the next which moved).
+    lights: Vec<crate::scene::Light>,
 }
 
 impl PhotonMapping {
@@ -27,6 +29,7 @@ impl PhotonMapping {
         Self {
             ppm,
             guided_emission: scene.params.guided_emission,
+            lights: scene.lights.clone(),
         }
     }
 }
@@ -66,7 +69,9 @@ impl Integrator for PhotonMapping {
 
     fn warm_restart(self: Box<Self>, scene: &Scene, setup: &Setup) -> Box<dyn Integrator> {
         let mut next = PhotonMapping::new(scene, setup);
-        if let Some(kept) = self.ppm.into_warm_start() {
+        if let Some(mut kept) = self.ppm.into_warm_start() {
+            let moved = (0..scene.lights.len()).filter(|&k| self.lights.get(k) != scene.lights.get(k));
+            moved.for_each(|k| kept.light_moved(k));
             next.ppm.inherit(scene, kept);
         }
         Box::new(next)

@@ -29,7 +29,12 @@
 //! - **The radius choices**: the initial radius and the indirect estimate's scale, so cold and
 //!   kept pixels agree.
 //! - **The emission guide's learned densities** as a prior the new epoch keeps learning
-//!   ([`EmissionGuide::as_prior`]); a moved light forgets its own.
+//!   ([`EmissionGuide::as_prior`]); a moved light keeps a smaller share of its own.
+//!
+//! A moved (or turned) light changes the light seen directly at every pixel it reaches, a
+//! term each pass estimates afresh (point lights by shadow ray, area lights by one sample a
+//! pass): its prior is dropped, and only the photons' estimates are kept, which the new
+//! photons take over from as after a moved control point.
 //!
 //! An epoch interrupted before its first pass completed hands on what it inherited, so a drag
 //! that moves faster than a pass still warms each step from the last image that was made.
@@ -64,7 +69,8 @@ pub struct StreamOffset {
     pub photons: u64,
 }
 
-/// What an epoch hands to the next after an edit ([`super::Ppm::into_warm_start`]).
+/// What an epoch hands to the next after an edit ([`super::Ppm::into_warm_start`]): a
+/// control point or a light moved ([`WarmStart::light_moved`]).
 #[derive(Clone, Debug)]
 pub struct WarmStart {
     /// The image size.
@@ -91,7 +97,8 @@ pub struct WarmStart {
 }
 
 impl WarmStart {
-    /// Notes that light `light` moved: its part of the emission guide is forgotten.
+    /// Notes that light `light` moved or turned: its part of the emission guide is forgotten,
+    /// and the light seen directly starts afresh.
     pub fn light_moved(&mut self, light: usize) {
         if !self.moved_lights.contains(&light) {
             self.moved_lights.push(light);
@@ -342,7 +349,9 @@ impl WarmStart {
                 continue;
             };
             let old_range = &old[o].1;
-            light[*pixel as usize] = self.light[*pixel as usize].capped(PRIOR_PASSES, first);
+            if self.moved_lights.is_empty() {
+                light[*pixel as usize] = self.light[*pixel as usize].capped(PRIOR_PASSES, first);
+            }
             for (from, to) in old_range.clone().zip(range.clone()) {
                 let factor = carry(&self.points[from], &now[to], self.slots[from].primary.radius2())
                     .unwrap_or(DVec3::ONE);

@@ -90,7 +90,7 @@ pub(super) fn valid(command: &Command, patches: usize, lights: &[crate::scene::L
 /// the scene, in order. Control-point moves are gathered so that each edited patch is
 /// re-prepared once, however many steps of a drag arrived together (the latest position of
 /// each point wins).
-pub(super) fn apply_to_scene(scene: &mut Scene, commands: Vec<Command>) {
+pub fn apply_to_scene(scene: &mut Scene, commands: Vec<Command>) {
     let mut edited: std::collections::BTreeMap<usize, BezierPatch> = Default::default();
     for command in commands {
         match command {

@@ -126,8 +126,8 @@ pub struct SessionState {
     pending: Vec<Command>,
     /// A restart is waiting.
     restart_due: bool,
-    /// The waiting restart changes more than the scene's geometry (settings, camera, or a
-    /// plain restart): it starts cold.
+    /// The waiting restart changes more than the scene's geometry and lights (settings,
+    /// camera, or a plain restart): it starts cold.
     cold_due: bool,
     pub(super) shutdown: bool,
 }
@@ -170,7 +170,11 @@ impl SessionState {
             return Effect::Ignored;
         }
         let restarts = command.restarts(&self.params);
-        let edit = matches!(command, Command::MoveControlPoint { .. });
+        // An edit of the scene (a control point or a light moved) keeps what is still valid.
+        let edit = matches!(
+            command,
+            Command::MoveControlPoint { .. } | Command::SetLight { .. }
+        );
         match command {
             // The restart takes the newest set: parameters need no replaying.
             Command::SetParams(p) => self.params = p,
