@@ -947,7 +947,7 @@ fn the_side_panel_fits_what_matters_at_the_default_size() {
         "Pass",
         "Photons/s",
         "Elapsed",
-        "Estimated error",
+        "Estimated noise",
         "Photons per pass",
         "Alpha",
     ] {

@@ -332,17 +332,18 @@ fn statistics_ui(viewer: &ViewerState, ui: &mut egui::Ui) {
     }
 }
 
-/// The error against time (log scale): the estimate from successive frames and, with a
-/// reference open, the true RMSE and relative MSE against it.
+/// The error against time (log scale): the noise estimate from the render's own frames
+/// ([`crate::render::error_tracker`]) and, with a reference open, the true RMSE and relative
+/// MSE against it.
 fn convergence_plot_ui(viewer: &ViewerState, ui: &mut egui::Ui) {
     let with_reference = viewer.reference().is_some();
     let title = if with_reference {
         "Error against time"
     } else {
-        "Estimated error"
+        "Estimated noise"
     };
     ui.label(title).on_hover_text(
-        "Log scale against seconds. Estimate: relative RMS noise from successive frames. With a reference: its RMSE and pbrt's relative MSE",
+        "Log scale against seconds. Estimate: the relative RMS noise, from this render's frame and its frame at half the photons. Photon mapping's blur (bias) is not in it: where caustics are sharp it is a part of the true error early on. With a reference: its RMSE and pbrt's relative MSE",
     );
     let log = |v: f64| v.max(1e-12).log10();
     let series = |k: usize| -> Vec<[f64; 2]> {
@@ -367,14 +368,14 @@ fn convergence_plot_ui(viewer: &ViewerState, ui: &mut egui::Ui) {
         plot.y_axis_formatter(|mark, _| percent(10f64.powf(mark.value)))
     };
     plot.show(ui, |plot| {
-        plot.line(Line::new("estimate (relative)", PlotPoints::from(estimate)));
+        plot.line(Line::new("noise estimate (relative)", PlotPoints::from(estimate)));
         if with_reference {
             plot.line(Line::new("RMSE", PlotPoints::from(series(1))));
             plot.line(Line::new("relative MSE", PlotPoints::from(series(2))));
         }
     });
     if let Some(e) = viewer.convergence.latest() {
-        ui.label(format!("now {}", percent(e)));
+        ui.label(format!("now {} (noise; blur not included)", percent(e)));
     }
     if let Some(e) = viewer.reference_errors() {
         ui.label(format!(

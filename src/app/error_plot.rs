@@ -1,23 +1,17 @@
-//! The convergence plot's data: the running error estimate from successive frames alone
-//! ([`crate::render::error::relative_error_estimate`], which explains it) — it falls as the
-//! render converges and is comparable between settings of a scene.
+//! The convergence plot's data: the running error estimate from the epoch's own frames
+//! ([`ErrorTracker`], whose module explains it and what it cannot see) — it falls as the
+//! render converges and is comparable between settings of a scene — and, once a reference is
+//! open, the true error.
 
 use std::sync::Arc;
 
 use crate::render::compare::ReferenceErrors;
-use crate::render::error::relative_error_estimate;
-
-/// One frame as the estimator needs it.
-#[derive(Clone)]
-struct Sample {
-    count: u64,
-    radiance: Arc<[[f32; 3]]>,
-}
+use crate::render::error_tracker::ErrorTracker;
 
 /// Error estimates of one epoch against time.
 #[derive(Clone, Default)]
 pub struct Convergence {
-    previous: Option<Sample>,
+    tracker: ErrorTracker,
     /// `(elapsed seconds, estimated relative RMS error)` per frame after the first.
     pub points: Vec<[f64; 2]>,
     /// `(elapsed seconds, RMSE, relative MSE)` against the reference, per frame since it was
@@ -31,20 +25,12 @@ impl Convergence {
         *self = Self::default();
     }
 
-    /// Takes a frame of the current epoch made from `photons` photons.
-    pub fn add(&mut self, photons: u64, elapsed_secs: f64, radiance: &Arc<[[f32; 3]]>) {
-        if let Some(prev) = &self.previous {
-            if photons <= prev.count {
-                return;
-            }
-            if let Some(e) = relative_error_estimate(prev.count, &prev.radiance, photons, radiance) {
-                self.points.push([elapsed_secs, e]);
-            }
+    /// Takes a frame of the current epoch made from `photons` photons with photon mapping's
+    /// `alpha` (1 for a path tracer's plain means).
+    pub fn add(&mut self, photons: u64, elapsed_secs: f64, radiance: &Arc<[[f32; 3]]>, alpha: f64) {
+        if let Some(e) = self.tracker.add(photons, radiance, alpha) {
+            self.points.push([elapsed_secs, e]);
         }
-        self.previous = Some(Sample {
-            count: photons,
-            radiance: radiance.clone(),
-        });
     }
 
     /// Takes a frame's true error against the reference.

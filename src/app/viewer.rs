@@ -398,8 +398,14 @@ impl Viewer {
             }
         }
         if frame.stats.renderer().progressive() && !frame.preview {
+            // Photon mapping's α shapes how its noise and bias fall; a path tracer's passes
+            // are plain means (α = 1: no bias to fall).
+            let alpha = match frame.stats.renderer() {
+                crate::settings::RendererKind::Ppm => self.document.scene().params.alpha,
+                _ => 1.0,
+            };
             self.convergence
-                .add(frame.photons, frame.elapsed_secs, &frame.radiance);
+                .add(frame.photons, frame.elapsed_secs, &frame.radiance, alpha);
         }
         if let Some(errors) = self
             .reference

@@ -22,6 +22,10 @@ pub enum BenchCommand {
     /// reference of the edited scene (cached), with the new epoch started warm and cold; the
     /// medians of several runs each.
     Edit(super::edit::EditArgs),
+    /// The viewer's error estimate against the truth: scenes rendered as in the viewer, the
+    /// estimate after some passes beside the true relative RMS error against a long
+    /// reference render (cached).
+    Estimate(super::estimate::EstimateArgs),
     /// Photon mapping: resident memory (current and peak) of a long stochastic render (open
     /// aperture), sampled every --every passes.
     Memory(super::memory::MemoryArgs),
@@ -46,6 +50,7 @@ impl BenchCommand {
         match self {
             BenchCommand::Convergence(args) => args.threads.threads,
             BenchCommand::Edit(args) => args.threads.threads,
+            BenchCommand::Estimate(args) => args.threads.threads,
             BenchCommand::Memory(args) => args.threads.threads,
             BenchCommand::Shards(args) => args.threads.threads,
             BenchCommand::Tessellation(args) => args.threads.threads,
@@ -61,6 +66,7 @@ pub fn run(what: BenchCommand, json: bool) -> Result<()> {
         BenchCommand::Ppm(_) => "ppm",
         BenchCommand::Convergence(_) => "convergence",
         BenchCommand::Edit(_) => "edit",
+        BenchCommand::Estimate(_) => "estimate",
         BenchCommand::Memory(_) => "memory",
         BenchCommand::Shards(_) => "shards",
         BenchCommand::Whitted(_) => "whitted",
@@ -78,6 +84,7 @@ pub fn run(what: BenchCommand, json: bool) -> Result<()> {
         BenchCommand::Ppm(args) => super::scaling::bench_ppm(args, &mut out),
         BenchCommand::Convergence(args) => super::convergence::bench_convergence(args, &mut out),
         BenchCommand::Edit(args) => super::edit::bench_edit(args, &mut out),
+        BenchCommand::Estimate(args) => super::estimate::bench_estimate(args, &mut out),
     }?;
     out.finish();
     Ok(())

@@ -16,6 +16,7 @@ pub mod convergence;
 pub mod edit;
 pub mod edit_run;
 pub mod error_curves;
+pub mod estimate;
 pub mod intersect;
 pub mod memory;
 pub mod output;

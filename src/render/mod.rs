@@ -1,13 +1,14 @@
 //! Renderers and what they render into: progressive photon mapping, the Whitted ray tracer,
 //! the film (linear RGB with tonemapping and PNG/EXR output, extra EXR layers), what an image
 //! records of its render ([`provenance`]), error against a reference or estimated
-//! ([`compare`], [`error`]), deterministic random streams and low-discrepancy sequences, and
+//! ([`compare`], [`error`], [`error_tracker`]), deterministic random streams and low-discrepancy sequences, and
 //! independent passes split across processes and merged ([`shard`]).
 
 pub mod bsdf;
 pub mod compare;
 pub mod control;
 pub mod error;
+pub mod error_tracker;
 pub mod film;
 pub mod frame;
 pub mod integrator;

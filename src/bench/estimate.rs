@@ -1,0 +1,168 @@
+//! `caustic bench estimate`: how true the viewer's error estimate is. Each scene renders as
+//! in the viewer (photon mapping, the photon ramp, every frame seen) and, after some passes,
+//! the estimate from its own frames ([`ErrorTracker`], and the consecutive-frame estimate it
+//! replaced) is set beside the true relative RMS error against a long reference render
+//! (cached, as `bench convergence`'s).
+//!
+//! Scenes are rendered smaller than their own size so that a 4000-pass reference takes
+//! minutes; the photons per pass are scaled with the pixels, so that each pixel sees as many
+//! photons a pass as at the scene's own size.
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Result};
+use clap::Parser;
+
+use super::convergence::reference;
+use super::output::BenchOutput;
+use crate::args::Threads;
+use crate::render::error::relative_error_estimate;
+use crate::render::error_tracker::ErrorTracker;
+use crate::render::session::state::INTERACTIVE_FIRST_PASS_PHOTONS;
+use crate::render::session::SessionOptions;
+use crate::run::render_session;
+use crate::scene::{RendererKind, Scene};
+
+/// `caustic bench estimate`.
+#[derive(Parser)]
+pub struct EstimateArgs {
+    /// Scene files (default: scenes/pool.toml, scenes/cornell.toml, scenes/ring.toml).
+    pub scenes: Vec<PathBuf>,
+    /// Image width (the height keeps the scene's aspect).
+    #[arg(long, default_value_t = 160)]
+    width: u32,
+    /// Passes after which the estimate is compared with the truth.
+    #[arg(long, value_delimiter = ',', default_value = "16,64,256")]
+    passes: Vec<u32>,
+    /// Passes of the reference render (cached).
+    #[arg(long, default_value_t = 4000)]
+    reference_passes: u32,
+    /// Where reference renders are cached (default: ~/.cache/caustic/references).
+    #[arg(long, value_name = "DIR")]
+    reference_dir: Option<PathBuf>,
+    /// `--threads`: the worker pool's size.
+    #[command(flatten)]
+    pub threads: Threads,
+}
+
+/// One comparison: after `pass` passes, the true relative RMS error, the estimate and the
+/// consecutive-frame estimate.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EstimateCheck {
+    /// Passes rendered.
+    pub pass: u32,
+    /// `RMS(L − reference) / RMS(reference)`.
+    pub truth: f64,
+    /// [`ErrorTracker`]'s estimate.
+    pub estimate: Option<f64>,
+    /// The previous frame's comparison (one pass apart).
+    pub consecutive: Option<f64>,
+}
+
+/// `scene` at `width`, photon mapping, photons per pass scaled with the pixels.
+pub fn scaled(mut scene: Scene, width: u32) -> Scene {
+    let before = scene.camera.width as f64 * scene.camera.height as f64;
+    scene.camera.resize(Some(width), None);
+    let after = scene.camera.width as f64 * scene.camera.height as f64;
+    let photons = (scene.params.photons_per_pass as f64 * after / before).round() as u64;
+    scene.params.photons_per_pass = photons.max(1000);
+    scene.params.renderer = RendererKind::Ppm;
+    scene
+}
+
+/// Renders `scene` as the viewer does for the largest of `passes`, comparing the estimates
+/// with the truth against `reference` after each of them.
+pub fn check_estimates(scene: Scene, passes: &[u32], reference: &[[f32; 3]]) -> Result<Vec<EstimateCheck>> {
+    let most = passes.iter().copied().max().unwrap_or(0);
+    let options = SessionOptions {
+        max_passes: Some(most),
+        first_pass_photons: Some(INTERACTIVE_FIRST_PASS_PHOTONS),
+        ..Default::default()
+    };
+    let norm = rms(reference.iter().flatten().map(|&v| v as f64));
+    let alpha = scene.params.alpha;
+    let mut tracker = ErrorTracker::default();
+    let mut previous: Option<(u64, std::sync::Arc<[[f32; 3]]>)> = None;
+    let mut out = Vec::new();
+    render_session(scene, options, |f| {
+        let estimate = tracker.add(f.photons, &f.radiance, alpha);
+        let consecutive = previous
+            .as_ref()
+            .and_then(|(n, a)| relative_error_estimate(*n, a, f.photons, &f.radiance));
+        previous = Some((f.photons, f.radiance.clone()));
+        if passes.contains(&f.pass) {
+            let diff = f
+                .radiance
+                .iter()
+                .zip(reference)
+                .flat_map(|(a, b)| (0..3).map(move |c| a[c] as f64 - b[c] as f64));
+            out.push(EstimateCheck {
+                pass: f.pass,
+                truth: rms(diff) / norm,
+                estimate,
+                consecutive,
+            });
+        }
+    })?;
+    Ok(out)
+}
+
+fn rms(values: impl Iterator<Item = f64>) -> f64 {
+    let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v * v, n + 1));
+    (sum / n.max(1) as f64).sqrt()
+}
+
+/// Runs the measurement.
+pub fn bench_estimate(args: EstimateArgs, out: &mut BenchOutput) -> Result<()> {
+    if args.passes.is_empty() || args.passes.contains(&0) || args.width == 0 {
+        bail!("--passes must list passes of at least 1, and --width be at least 1");
+    }
+    let scenes = if args.scenes.is_empty() {
+        ["pool", "cornell", "ring"]
+            .map(|s| PathBuf::from(format!("scenes/{s}.toml")))
+            .to_vec()
+    } else {
+        args.scenes.clone()
+    };
+    out.say("scene  pass  true  estimate (ratio)  consecutive frames (ratio)".to_string());
+    for path in &scenes {
+        let scene = scaled(Scene::load(path)?, args.width);
+        let reference = reference(
+            &scene,
+            args.reference_passes,
+            args.reference_dir.as_deref(),
+            None,
+            out,
+        )?;
+        let checks = check_estimates(scene, &args.passes, &reference)?;
+        for c in checks {
+            let show = |e: Option<f64>| {
+                e.map_or("-".into(), |e| {
+                    format!("{:.2} % ({:.2}x)", 100.0 * e, e / c.truth)
+                })
+            };
+            out.say(format!(
+                "{}  {}  {:.2} %  {}  {}",
+                path.display(),
+                c.pass,
+                100.0 * c.truth,
+                show(c.estimate),
+                show(c.consecutive)
+            ));
+            let name = path
+                .file_stem()
+                .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
+            out.push(
+                "checks",
+                serde_json::json!({
+                    "scene": name,
+                    "pass": c.pass,
+                    "truth": c.truth,
+                    "estimate": c.estimate,
+                    "consecutive": c.consecutive,
+                }),
+            );
+        }
+    }
+    Ok(())
+}
