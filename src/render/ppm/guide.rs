@@ -109,15 +109,6 @@ struct LightGuide {
     density: Option<Density2D>,
 }
 
-/// The share of a warm prior's photons a moved or turned light's guide keeps. A hand-made
-/// move changes where a light's photons go a little, and the guide, which always mixes in
-/// uniform emission, stays unbiased whatever it learned: kept at a share worth the epoch's
-/// first pass (a prior is [`super::warm::PRIOR_PASSES`] of them), what the new epoch learns
-/// outweighs it from its second pass. Measured with `caustic bench edit scenes/ring.toml
-/// --light 0`: a light that forgot its guide emitted uniformly, and the first image after
-/// the move had RMSE 1.16e-1, as a cold restart's preview; with this share, 4.6e-2.
-pub const MOVED_SHARE: f64 = 1.0 / super::warm::PRIOR_PASSES;
-
 impl EmissionGuide {
     /// A uniform guide for the scene's lights (nothing learned yet); `pick` is the chance
     /// that a photon comes from each light.
@@ -175,10 +166,16 @@ impl EmissionGuide {
 
     /// This guide as the prior of a new epoch after an edit of the scene (a warm restart):
     /// each light's counts scaled down to at most `photons` emitted, so that what the new
-    /// epoch learns soon outweighs them, and the densities rebuilt from the scaled counts.
-    /// Lights in `moved` keep a [`MOVED_SHARE`] of that (their photons now go partly
-    /// elsewhere). `None` when the scene's lights are not the guide's (another count).
-    pub fn as_prior(&self, scene: &Scene, photons: u64, moved: &[usize]) -> Option<Self> {
+    /// epoch learns soon outweighs them, and the densities rebuilt from the scaled counts;
+    /// lights in `moved` (their photons now go partly elsewhere) to at most `moved_photons`.
+    /// The guide always mixes in uniform emission, so whatever a light kept, it stays
+    /// unbiased. `None` when the scene's lights are not the guide's (another count).
+    pub fn as_prior(
+        &self,
+        scene: &Scene,
+        (photons, moved_photons): (u64, u64),
+        moved: &[usize],
+    ) -> Option<Self> {
         if scene.lights.len() != self.lights.len() {
             return None;
         }
@@ -186,12 +183,12 @@ impl EmissionGuide {
         for (l, g) in prior.lights.iter_mut().enumerate() {
             let total: u64 = g.emitted.iter().sum();
             let cap = if moved.contains(&l) {
-                photons as f64 * MOVED_SHARE
+                moved_photons
             } else {
-                photons as f64
+                photons
             };
-            let keep = if total as f64 > cap {
-                cap / total as f64
+            let keep = if total > cap {
+                cap as f64 / total as f64
             } else {
                 1.0
             };

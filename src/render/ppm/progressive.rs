@@ -537,8 +537,10 @@ impl Ppm {
         self.radius.initial_radius = Some(warm.initial_radius2.sqrt());
         self.radius.indirect_scale = warm.indirect_scale;
         if let (Some(guide), true) = (&warm.guide, self.guide.is_some()) {
+            // A moved light keeps one first pass's worth (see `warm`'s module doc).
             let cap = (PRIOR_PASSES * self.photons_per_pass as f64) as u64;
-            if let Some(prior) = guide.as_prior(scene, cap, &warm.moved_lights) {
+            let caps = (cap, self.photons_per_pass);
+            if let Some(prior) = guide.as_prior(scene, caps, &warm.moved_lights) {
                 self.guide = Some(prior);
             }
         }

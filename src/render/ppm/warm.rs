@@ -29,7 +29,12 @@
 //! - **The radius choices**: the initial radius and the indirect estimate's scale, so cold and
 //!   kept pixels agree.
 //! - **The emission guide's learned densities** as a prior the new epoch keeps learning
-//!   ([`EmissionGuide::as_prior`]); a moved light keeps a smaller share of its own.
+//!   ([`EmissionGuide::as_prior`]). A moved or turned light keeps one first pass's worth of
+//!   its own, an eighth of the others': a move made by hand changes where its photons go a
+//!   little, and from the epoch's second pass what it learns anew outweighs what it kept. A
+//!   light that forgot its guide emitted uniformly, and the first image after a move was as
+//!   noisy as a cold restart's preview (`caustic bench edit scenes/ring.toml --light 0`:
+//!   RMSE 1.16e-1 forgotten, 4.6e-2 kept).
 //!
 //! A moved (or turned) light changes the light seen directly at every pixel it reaches, a
 //! term each pass estimates afresh (point lights by shadow ray, area lights by one sample a
@@ -97,8 +102,8 @@ pub struct WarmStart {
 }
 
 impl WarmStart {
-    /// Notes that light `light` moved or turned: its part of the emission guide is forgotten,
-    /// and the light seen directly starts afresh.
+    /// Notes that light `light` moved or turned: its part of the emission guide is kept at
+    /// one first pass's worth, and the light seen directly starts afresh.
     pub fn light_moved(&mut self, light: usize) {
         if !self.moved_lights.contains(&light) {
             self.moved_lights.push(light);
