@@ -9,6 +9,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 use caustic::bench::estimate::scaled;
+use caustic::render::error::mean_squares;
 use caustic::render::error_tracker::ErrorTracker;
 use caustic::render::session::state::INTERACTIVE_FIRST_PASS_PHOTONS;
 use caustic::render::session::SessionOptions;
@@ -41,11 +42,6 @@ fn frames(mut scene: Scene, seed: u64) -> Vec<Estimated> {
     out
 }
 
-fn rms(values: impl Iterator<Item = f64>) -> f64 {
-    let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v * v, n + 1));
-    (sum / n.max(1) as f64).sqrt()
-}
-
 #[test]
 fn the_noise_estimate_is_within_1_5_times_the_measured_noise() {
     for name in ["pool", "cornell", "ring"] {
@@ -54,11 +50,9 @@ fn the_noise_estimate_is_within_1_5_times_the_measured_noise() {
         let a = frames(scene.clone(), 11);
         let b = frames(scene, 12);
         for (pass, ((fa, estimate), (fb, _))) in PASSES.iter().zip(a.iter().zip(&b)) {
-            let diff = fa
-                .iter()
-                .zip(fb.iter())
-                .flat_map(|(p, q)| (0..3).map(move |c| p[c] as f64 - q[c] as f64));
-            let noise = rms(diff) / 2f64.sqrt() / rms(fa.iter().flatten().map(|&v| v as f64));
+            // Two seeds' frames differ by √2 times one frame's noise.
+            let (diff2, norm2) = mean_squares(fb, fa);
+            let noise = (diff2 / 2.0 / norm2).sqrt();
             let estimate = estimate.expect("estimated");
             let ratio = estimate / noise;
             assert!(

@@ -16,7 +16,7 @@ use clap::Parser;
 use super::convergence::reference;
 use super::output::BenchOutput;
 use crate::args::Threads;
-use crate::render::error::relative_error_estimate;
+use crate::render::error::{mean_squares, relative_error_estimate};
 use crate::render::error_tracker::ErrorTracker;
 use crate::render::session::state::INTERACTIVE_FIRST_PASS_PHOTONS;
 use crate::render::session::SessionOptions;
@@ -79,7 +79,6 @@ pub fn check_estimates(scene: Scene, passes: &[u32], reference: &[[f32; 3]]) -> 
         first_pass_photons: Some(INTERACTIVE_FIRST_PASS_PHOTONS),
         ..Default::default()
     };
-    let norm = rms(reference.iter().flatten().map(|&v| v as f64));
     let alpha = scene.params.alpha;
     let mut tracker = ErrorTracker::default();
     let mut previous: Option<(u64, std::sync::Arc<[[f32; 3]]>)> = None;
@@ -91,25 +90,16 @@ pub fn check_estimates(scene: Scene, passes: &[u32], reference: &[[f32; 3]]) -> 
             .and_then(|(n, a)| relative_error_estimate(*n, a, f.photons, &f.radiance));
         previous = Some((f.photons, f.radiance.clone()));
         if passes.contains(&f.pass) {
-            let diff = f
-                .radiance
-                .iter()
-                .zip(reference)
-                .flat_map(|(a, b)| (0..3).map(move |c| a[c] as f64 - b[c] as f64));
+            let (diff2, norm2) = mean_squares(&f.radiance, reference);
             out.push(EstimateCheck {
                 pass: f.pass,
-                truth: rms(diff) / norm,
+                truth: (diff2 / norm2).sqrt(),
                 estimate,
                 consecutive,
             });
         }
     })?;
     Ok(out)
-}
-
-fn rms(values: impl Iterator<Item = f64>) -> f64 {
-    let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v * v, n + 1));
-    (sum / n.max(1) as f64).sqrt()
 }
 
 /// Runs the measurement.

@@ -33,6 +33,17 @@ pub fn relative_error_estimate(n_a: u64, a: &[[f32; 3]], n_b: u64, b: &[[f32; 3]
     if n_a == 0 || n_b <= n_a || a.len() != b.len() || a.is_empty() {
         return None;
     }
+    let (diff2, norm2) = mean_squares(a, b);
+    if norm2 <= 0.0 || !diff2.is_finite() || !norm2.is_finite() {
+        return None;
+    }
+    let ratio = n_b as f64 / n_a as f64 - 1.0;
+    Some((diff2 / ratio).sqrt() / norm2.sqrt())
+}
+
+/// The mean squares of `b − a` and of `b`, over every channel of equally long images: a
+/// relative RMS difference is `√(first / second)`.
+pub fn mean_squares(a: &[[f32; 3]], b: &[[f32; 3]]) -> (f64, f64) {
     let (mut diff2, mut norm2) = (0.0f64, 0.0f64);
     for (pa, pb) in a.iter().zip(b) {
         for c in 0..3 {
@@ -41,11 +52,8 @@ pub fn relative_error_estimate(n_a: u64, a: &[[f32; 3]], n_b: u64, b: &[[f32; 3]
             norm2 += pb[c] as f64 * pb[c] as f64;
         }
     }
-    if norm2 <= 0.0 || !diff2.is_finite() || !norm2.is_finite() {
-        return None;
-    }
-    let ratio = n_b as f64 / n_a as f64 - 1.0;
-    Some((diff2 / ratio).sqrt() / norm2.sqrt())
+    let n = (3 * b.len().max(1)) as f64;
+    (diff2 / n, norm2 / n)
 }
 
 /// Per pixel, the estimated standard error of `b` (mean over the colour channels, radiance

@@ -27,6 +27,8 @@
 
 use std::sync::Arc;
 
+use super::error::mean_squares;
+
 /// Kept frames' photon counts grow at least this much from one to the next.
 pub const KEEP_RATIO: f64 = 1.25;
 
@@ -48,20 +50,6 @@ pub struct ErrorTracker {
 /// shrinking radii).
 pub fn noise_factor(rho: f64, alpha: f64) -> f64 {
     1.0 - rho.powf(2.0 - alpha) + (1.0 - rho).powi(2) * rho.powf(-alpha)
-}
-
-/// Mean squares of `b − a` and of `b`, over every channel.
-fn mean_squares(a: &[[f32; 3]], b: &[[f32; 3]]) -> (f64, f64) {
-    let (mut diff2, mut norm2) = (0.0f64, 0.0f64);
-    for (pa, pb) in a.iter().zip(b) {
-        for c in 0..3 {
-            let d = pb[c] as f64 - pa[c] as f64;
-            diff2 += d * d;
-            norm2 += pb[c] as f64 * pb[c] as f64;
-        }
-    }
-    let n = (3 * b.len().max(1)) as f64;
-    (diff2 / n, norm2 / n)
 }
 
 impl ErrorTracker {
