@@ -100,10 +100,9 @@ fn every_light_kind_over_a_plane_gives_the_closed_form() {
 }
 
 /// The Cornell box (glass and mirror spheres, an area light, a teapot with a Phong lobe): the
-/// path tracer's converged image mean agrees with photon mapping's, channel by channel, with
-/// the lobe and without it. Photon mapping gathers the diffuse part of a `phong` material at
-/// its visible points (the lobe reaches them by photons that bounced off it), so with the lobe
-/// its mean may stay up to 0.5 % below the path tracer's; without it, within 0.4 % either way.
+/// path tracer's converged image mean agrees with photon mapping's, channel by channel, within
+/// 0.4 % either way, with the lobe and without it (photon mapping weighs each photon by the
+/// full BSDF at its visible points).
 #[test]
 fn the_cornell_box_converges_to_photon_mappings_mean() {
     use caustic::scene::MaterialKind;
@@ -118,7 +117,7 @@ fn the_cornell_box_converges_to_photon_mappings_mean() {
         }
     }
     for (name, scene, low, high) in [
-        ("phong", &phong, -0.005, 0.003),
+        ("phong", &phong, -0.004, 0.004),
         ("lambert", &lambert, -0.004, 0.004),
     ] {
         let traced = path_traced(scene, 2048);
@@ -140,6 +139,52 @@ fn the_cornell_box_converges_to_photon_mappings_mean() {
                 (low..=high).contains(&gap),
                 "{name} channel {c}: photon mapped / path traced - 1 = {gap}"
             );
+        }
+    }
+}
+
+/// A glossy plane (ρ = 0.4, 0.3, 0.2 with a Phong lobe of reflectance 0.5 and exponent 20)
+/// seen near the mirror direction of every light kind, whose highlight fills the view:
+/// photon mapping, which weighs each photon at a visible point by the full BSDF for the
+/// photon's direction (and samples area lights through it), converges to the path tracer's
+/// mean within 1 %, with direct light by light sampling and by photons alone (measured: within
+/// 0.62 %). Gathering the diffuse lobe only leaves it about half below (53 % with the point
+/// light).
+#[test]
+fn a_glossy_highlight_converges_to_photon_mappings_mean_for_every_light() {
+    use caustic::scene::MaterialKind;
+    for (kind, light) in LIGHT_KINDS {
+        for direct_light in [true, false] {
+            let mut scene = plane_lit_by(light, direct_light);
+            // The light's mirror image in the plane, through the view's centre, to the eye.
+            scene.camera = caustic::scene::Camera::look_at(
+                glam::DVec3::new(-1.75, 3.0, 0.0),
+                glam::DVec3::new(0.5, 0.0, 0.0),
+                glam::DVec3::Z,
+                40.0,
+                16,
+                12,
+                0.0,
+                None,
+            );
+            scene.params.antialias = true;
+            scene.materials[0].color = glam::DVec3::new(0.4, 0.3, 0.2);
+            scene.materials[0].kind = MaterialKind::Diffuse {
+                specular: 0.5,
+                shininess: 20.0,
+            };
+            let traced = mean_red(&path_traced(&scene, 1024));
+            let mut ppm = Ppm::new(&scene, PpmOptions::default());
+            for _ in 0..64 {
+                ppm.run_pass(&scene, &mut |_| Control::Continue);
+            }
+            let mapped = mean_red(&ppm.radiance());
+            let gap = mapped / traced - 1.0;
+            eprintln!(
+                "{kind}, direct light {direct_light}: path traced {traced:.5}, photon mapped {mapped:.5} ({:+.2} %)",
+                100.0 * gap
+            );
+            assert!(gap.abs() < 0.01, "{kind}, direct light {direct_light}: {gap}");
         }
     }
 }

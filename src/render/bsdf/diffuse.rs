@@ -16,7 +16,8 @@ use std::f64::consts::{PI, TAU};
 use glam::{DVec2, DVec3};
 use rand::Rng;
 
-use super::BsdfSample;
+use super::glossy::phong;
+use super::{BsdfSample, Glossy};
 use crate::scene::light::cosine_hemisphere;
 use crate::scene::material::reflect;
 
@@ -42,8 +43,7 @@ impl Diffuse {
         }
         let mut f = self.color / PI;
         if self.specular > 0.0 {
-            let c = reflect(-wi, self.n).dot(wo).max(0.0);
-            f += DVec3::splat(self.specular * (self.shininess + 2.0) / (2.0 * PI) * c.powf(self.shininess));
+            f += DVec3::splat(phong(self.specular, self.shininess, self.n, wo, wi));
         }
         f
     }
@@ -115,6 +115,14 @@ impl Diffuse {
             wi,
             weight: self.eval(wo, wi) * (cos / pdf),
             pdf,
+        })
+    }
+
+    /// The Phong lobe, compactly; `None` without one.
+    pub fn glossy(&self) -> Option<Glossy> {
+        (self.specular > 0.0).then_some(Glossy::Phong {
+            specular: self.specular as f32,
+            shininess: self.shininess as f32,
         })
     }
 

@@ -21,6 +21,7 @@
 
 mod dielectric;
 mod diffuse;
+mod glossy;
 mod mirror;
 
 use glam::DVec3;
@@ -28,10 +29,11 @@ use rand::Rng;
 
 pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
+pub use glossy::{phong, Glossy};
 pub use mirror::Mirror;
 
-use crate::scene::material::MaterialKind;
-use crate::scene::Surface;
+use crate::scene::material::{Material, MaterialKind};
+use crate::scene::{Scene, Surface};
 
 /// A direction sampled from a BSDF's smooth part.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -140,6 +142,20 @@ impl Bsdf {
         }
     }
 
+    /// Whether a surface of `material` has glossy lobes ([`Bsdf::glossy`]): whether a
+    /// renderer needs room for them. Beside [`Bsdf::at`], and kept in step with it.
+    pub fn has_glossy(material: &Material) -> bool {
+        match material.kind {
+            MaterialKind::Diffuse { specular, .. } => specular > 0.0,
+            MaterialKind::Mirror | MaterialKind::Glass { .. } => false,
+        }
+    }
+
+    /// Whether any of `scene`'s materials has glossy lobes.
+    pub fn scene_has_glossy(scene: &Scene) -> bool {
+        scene.materials.iter().any(Self::has_glossy)
+    }
+
     /// The shading normal on `wo`'s side.
     pub fn normal(&self) -> DVec3 {
         match self {
@@ -165,6 +181,16 @@ impl Bsdf {
         match self {
             Bsdf::Diffuse(b) => b.color,
             Bsdf::Mirror(_) | Bsdf::Dielectric(_) => DVec3::ZERO,
+        }
+    }
+
+    /// The smooth part's glossy lobes (all but its diffuse lobe), compactly, for a visible
+    /// point to weigh each photon by: `eval(wo, wi) = diffuse_reflectance()/π + glossy.eval(n,
+    /// wo, wi)`. `None` when the smooth part is diffuse only.
+    pub fn glossy(&self) -> Option<Glossy> {
+        match self {
+            Bsdf::Diffuse(b) => b.glossy(),
+            Bsdf::Mirror(_) | Bsdf::Dielectric(_) => None,
         }
     }
 

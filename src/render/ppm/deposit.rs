@@ -9,13 +9,14 @@
 //! complex scenes with memory-coherent ray tracing") reorder rays; the points stay where the
 //! grid put them.
 
-use glam::{DVec3, Vec3};
+use glam::{DVec3, Vec2, Vec3};
 use rayon::prelude::*;
 
 use super::gathered::Gathered;
 use super::index::SpatialIndex;
 use super::photon::Emitted;
 use super::points::VisiblePoints;
+use crate::geometry::octahedral;
 use crate::render::control::Control;
 
 /// Deposits one group of hits may hold before they are merged per slot: bounds memory when
@@ -75,8 +76,12 @@ pub(super) struct Hit {
     key: u64,
     /// Where.
     p: DVec3,
-    /// The surface's normal, facing the photon.
-    n: Vec3,
+    /// The surface's normal, facing the photon ([`octahedral::encode_u32`]: it only tells the
+    /// surface's sides apart).
+    n: u32,
+    /// The direction the photon came from, away from the surface ([`octahedral::encode_f32`]:
+    /// a glossy point weighs the photon by it).
+    wi: Vec2,
     /// The photon's flux (a deposit's flux is summed in f32).
     flux: Vec3,
     /// The photon's place in its window (bits 32–62), the hit's place among the photon's
@@ -86,13 +91,13 @@ pub(super) struct Hit {
 }
 
 impl Hit {
-    /// The `nth` hit, at `p` on a surface of normal `n`, of a photon of `flux` that is the
-    /// `photon`th of its window, gathered into the indirect estimate if `indirect`; `key`
-    /// places it.
+    /// The `nth` hit, at `p` on a surface of normal `n`, of a photon of `flux` that came from
+    /// `wi` and is the `photon`th of its window, gathered into the indirect estimate if
+    /// `indirect`; `key` places it.
     pub(super) fn new(
         key: u64,
         p: DVec3,
-        n: DVec3,
+        (n, wi): (DVec3, DVec3),
         flux: DVec3,
         (photon, nth): (u32, u32),
         indirect: bool,
@@ -100,7 +105,8 @@ impl Hit {
         Self {
             key,
             p,
-            n: n.as_vec3(),
+            n: octahedral::encode_u32(n),
+            wi: octahedral::encode_f32(wi),
             flux: flux.as_vec3(),
             order: (photon as u64) << 32 | (nth as u64) << 1 | indirect as u64,
         }
@@ -210,14 +216,17 @@ impl Window {
 
 impl Gather<'_> {
     /// Hands each of `hits` to every visible point on its side of the surface whose search
-    /// sphere of the hit's estimate holds it: the deposits, and the window places of the
-    /// photons that reached a point (repeats possible).
+    /// sphere of the hit's estimate holds it, weighted by the point's BSDF for the photon's
+    /// direction: the deposits, and the window places of the photons that reached a point
+    /// (repeats possible).
     fn hand(&self, hits: &[Hit]) -> Handed {
         let (reach, shade) = (&self.points.reach, &self.points.shade);
+        let glossy = !self.points.glossy.is_empty();
         let mut deposits: Vec<Deposit> = Vec::new();
         let mut reached = Vec::new();
         for h in hits {
-            let (p, n, estimate) = (h.p, h.n.as_dvec3(), h.estimate());
+            let (p, n, estimate) = (h.p, octahedral::decode_u32(h.n), h.estimate());
+            let wi = glossy.then(|| octahedral::decode_f32(h.wi));
             let mut any = false;
             self.index
                 .for_candidates(reach, p, self.radius[estimate], &mut |k| {
@@ -225,9 +234,13 @@ impl Gather<'_> {
                     if (r.position - p).length_squared() <= r.radius2[estimate] as f64 {
                         let s = &shade[k as usize];
                         if s.normal.as_dvec3().dot(n) > 1e-3 {
+                            let weight = match wi {
+                                Some(wi) => self.points.weight(k as usize, wi).as_vec3(),
+                                None => s.weight,
+                            };
                             deposits.push((
                                 Gathered::at(self.estimates, s.slot, estimate),
-                                s.weight * h.flux,
+                                weight * h.flux,
                                 1,
                             ));
                             any = true;
@@ -278,6 +291,7 @@ mod tests {
                     normal,
                     weight: DVec3::new(next(), next(), next()),
                     radius2: 0.0,
+                    glossy: None,
                 }
             })
             .collect();
@@ -334,7 +348,7 @@ mod tests {
             let mut chunk = Vec::new();
             for (k, &(p, normal, flux, photon, indirect)) in hits.iter().enumerate() {
                 let key = index.sort_key(p);
-                chunk.push(Hit::new(key, p, normal, flux, (photon, nth), indirect));
+                chunk.push(Hit::new(key, p, (normal, -normal), flux, (photon, nth), indirect));
                 nth += 1;
                 if hits.get(k + 1).is_none_or(|h| h.3 != photon) {
                     window.push(std::mem::take(&mut chunk), vec![Emitted { light: 0, bin: 0 }]);
@@ -375,6 +389,7 @@ mod tests {
             normal: DVec3::Z,
             weight: DVec3::ONE,
             radius2: 0.0,
+            glossy: None,
         }]
         .into_iter()
         .collect();
@@ -387,7 +402,14 @@ mod tests {
         };
         let mut window = Window::default();
         window.push(
-            vec![Hit::new(0, DVec3::ZERO, DVec3::Z, DVec3::ONE, (0, 0), false)],
+            vec![Hit::new(
+                0,
+                DVec3::ZERO,
+                (DVec3::Z, DVec3::Z),
+                DVec3::ONE,
+                (0, 0),
+                false,
+            )],
             vec![Emitted { light: 0, bin: 0 }],
         );
         let mut out = Gathered::new(1, 1, None);

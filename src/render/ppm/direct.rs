@@ -35,7 +35,7 @@ pub fn has_area_lights(scene: &Scene) -> bool {
 const BLOCK: usize = 1 << 16;
 
 /// Reflected radiance from every area light at each point (one sample each), handed to
-/// `add(k, light)` in point order: `point.weight × L × cos θ / pdf` where the shadow ray is
+/// `add(k, light)` in point order: `point.weight(wi) × L × cos θ / pdf` where the shadow ray is
 /// clear. `key(k)` names point `k` stably across passes (its statistics slot), for the
 /// stratification. Sampled `BLOCK` points at a time, in parallel.
 pub fn area_light_pass(
@@ -104,7 +104,7 @@ impl<'a, K: Fn(usize) -> u64 + Sync> Sampler<'a, K> {
                         continue;
                     }
                     if !scene.occluded_from(position, normal, l as usize, &ls) {
-                        sum += shade.weight.as_dvec3() * ls.incident * cos;
+                        sum += self.points.weight(k, ls.wi) * ls.incident * cos;
                     }
                 }
                 sum
@@ -133,6 +133,7 @@ mod tests {
                 normal: DVec3::Z,
                 weight: DVec3::ONE,
                 radius2: 0.0,
+                glossy: None,
             })
             .collect();
         let key = |k: usize| 7 * k as u64 + 3;

@@ -5,6 +5,7 @@
 use glam::{DVec2, DVec3};
 use rand::Rng;
 use rand_pcg::Pcg64Mcg;
+use rayon::iter::Either;
 use rayon::prelude::*;
 
 use super::config::Config;
@@ -17,6 +18,7 @@ use super::points::{self, Shade, VisiblePoints};
 use super::seen;
 use super::streams;
 use super::visible::{trace_eye, Branching, VisiblePoint};
+use crate::render::bsdf::Bsdf;
 use crate::render::rng::stream_rng;
 use crate::render::sequence;
 use crate::scene::Scene;
@@ -71,7 +73,7 @@ impl EyePass {
         let pixels = (w * h) as usize;
         // New points: the grid over the old ones no longer holds them.
         self.kept_grid = None;
-        self.points.reset(pixels);
+        self.points.reset(pixels, Bsdf::scene_has_glossy(scene));
         let (seen, pass_direct) = light.start_stochastic_pass();
         let rays = scene.camera.eye_rays();
         let subsampler = seen::Subsampler {
@@ -83,13 +85,20 @@ impl EyePass {
             stratified: config.stratified_eye_rays,
             direct_light,
         };
-        let VisiblePoints { reach, shade } = &mut self.points;
+        let VisiblePoints { reach, shade, glossy } = &mut self.points;
+        // Each pixel's glossy lobes go to its place when there is room for them.
+        let glossy = if glossy.is_empty() {
+            Either::Right((0..pixels).into_par_iter().map(|_| None))
+        } else {
+            Either::Left(glossy.par_iter_mut().map(Some))
+        };
         reach
             .par_iter_mut()
             .zip(shade.par_iter_mut())
+            .zip(glossy)
             .zip(pass_direct.par_iter_mut())
             .enumerate()
-            .for_each(|(i, ((reach, shade), direct))| {
+            .for_each(|(i, (((reach, shade), mut glossy), direct))| {
                 if interrupt.is_some_and(|f| f()) {
                     skipped.store(true, std::sync::atomic::Ordering::Relaxed);
                     return;
@@ -102,6 +111,9 @@ impl EyePass {
                 let mut sink = |vp: VisiblePoint| {
                     debug_assert!(shade.slot == Shade::NONE, "a chosen path ends once");
                     (*reach, *shade) = points::split(&vp);
+                    if let Some(g) = glossy.as_mut() {
+                        **g = vp.glossy;
+                    }
                 };
                 // A supersampled pixel's light seen comes from its extra rays alone, so its
                 // own ray needs no shadow rays (they draw no random numbers: the point is the

@@ -223,6 +223,7 @@ mod tests {
             normal: DVec3::Z,
             weight: DVec3::ONE,
             radius2: r * r,
+            glossy: None,
         };
         // A height a few ulps off a cell boundary (the origin is the lowest centre, 0, less r).
         let inv_cell = 1.0 / (CELL_PER_RADIUS * r);
@@ -275,6 +276,7 @@ mod tests {
                 normal: DVec3::Z,
                 weight: DVec3::ONE,
                 radius2: 0.004 * 0.004,
+                glossy: None,
             })
             .collect();
         let (grid, order) = HashGrid::build(&points);
@@ -309,6 +311,7 @@ mod tests {
                     normal: DVec3::Z,
                     weight: DVec3::ONE,
                     radius2: r * r * (1.0 - k as f64 * 1e-3),
+                    glossy: None,
                 })
                 .collect()
         };
@@ -372,6 +375,7 @@ mod tests {
                 normal: DVec3::Z,
                 weight: DVec3::ONE,
                 radius2: (0.05 + 0.3 * next()).powi(2),
+                glossy: None,
             })
             .collect();
         for k in 0..3000u32 {
@@ -383,6 +387,7 @@ mod tests {
                 normal: DVec3::Z,
                 weight: DVec3::ONE,
                 radius2: WALL_RADIUS.powi(2),
+                glossy: None,
             });
         }
         let candidates = grid_slots(&points);

@@ -166,7 +166,8 @@ impl<'a> PhotonSource<'a> {
     /// Traces photon number `n` (counted over the render; it places a stratified photon in
     /// its sequence) with `rng`. At every diffuse hit whose flux should be gathered
     /// (all but direct hits when direct light is computed by light sampling),
-    /// calls `gather(point, normal facing the photon, flux, indirect)`, `indirect` telling
+    /// calls `gather(point, (normal facing the photon, direction it came from), flux,
+    /// indirect)`, `indirect` telling
     /// whether the photon has bounced off a diffuse surface before (indirect light) or came
     /// straight from the light or through mirrors and glass only (direct light, caustics).
     /// Returns where the photon came from.
@@ -175,7 +176,7 @@ impl<'a> PhotonSource<'a> {
         n: u64,
         rng: &mut Pcg64Mcg,
         counts: &mut PhotonCounts,
-        gather: &mut impl FnMut(DVec3, DVec3, DVec3, bool),
+        gather: &mut impl FnMut(DVec3, (DVec3, DVec3), DVec3, bool),
     ) -> Emitted {
         let scene = self.scene;
         let (emitted, mut flux, mut ray) = self.emit(n, rng);
@@ -195,7 +196,7 @@ impl<'a> PhotonSource<'a> {
             let wo = -ray.dir;
             if bsdf.has_smooth() {
                 if !(skip_first && first_interaction) {
-                    gather(hit.point, bsdf.normal(), flux, indirect);
+                    gather(hit.point, (bsdf.normal(), wo), flux, indirect);
                 }
                 indirect = true;
                 // Russian roulette on the albedo, then a bounce sampled from the BSDF.

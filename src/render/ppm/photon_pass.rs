@@ -155,9 +155,9 @@ impl PhotonPass {
             let photon = first + (i - start) as u32;
             let mut nth = 0;
             from.push(
-                source.trace(n, &mut rng, &mut counts, &mut |p, normal, flux, indirect| {
+                source.trace(n, &mut rng, &mut counts, &mut |p, sides, flux, indirect| {
                     let key = job.index.sort_key(p);
-                    hits.push(Hit::new(key, p, normal, flux, (photon, nth), indirect && split));
+                    hits.push(Hit::new(key, p, sides, flux, (photon, nth), indirect && split));
                     nth += 1;
                 }),
             );

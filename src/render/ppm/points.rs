@@ -1,9 +1,11 @@
-//! A pass's visible points as two arrays (structure of arrays): [`Reach`] — position and both
+//! A pass's visible points as arrays (structure of arrays): [`Reach`] — position and both
 //! search radii², all the spatial index and the photon pass's candidate test read, 32 bytes —
 //! and [`Shade`] — slot, normal and weight, read only when a photon is inside, 28 bytes (f32:
 //! a deposit's flux is summed in f32 anyway). One array of [`VisiblePoint`]s (88 bytes) plus
 //! a packed copy of positions and radii for the photon pass (40) held 128 bytes a point: at
-//! 1920×1080 the split saves 140 MiB of a stochastic render's peak.
+//! 1920×1080 the split saves 140 MiB of a stochastic render's peak. A third array, of
+//! [`GlossyPoint`]s, is there only when the scene has glossy materials: a point on a glossy
+//! surface weighs each photon by the BSDF for the photon's direction.
 
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -12,7 +14,7 @@ use rayon::prelude::*;
 use super::estimate::Estimate;
 use super::estimate::Slot;
 use super::sweep::SWEEP_BLOCK;
-use super::visible::VisiblePoint;
+use super::visible::{GlossyPoint, VisiblePoint};
 
 /// A search sphere the spatial indices are built over: a centre and the radius² that reaches
 /// farthest.
@@ -79,13 +81,17 @@ impl Shade {
     };
 }
 
-/// The visible points of a pass: `reach[k]` and `shade[k]` describe point `k`.
+/// The visible points of a pass: `reach[k]`, `shade[k]` and, when the scene has glossy
+/// materials, `glossy[k]` describe point `k`.
 #[derive(Clone, Debug, Default)]
 pub struct VisiblePoints {
     /// Positions and radii.
     pub reach: Vec<Reach>,
     /// Slots, normals and weights.
     pub shade: Vec<Shade>,
+    /// Each point's glossy lobes (`None` on a surface without); empty when no point can have
+    /// any.
+    pub glossy: Vec<Option<GlossyPoint>>,
 }
 
 /// Splits a visible point into its two parts (radii left at 0 until [`VisiblePoints::set_radii`]).
@@ -114,37 +120,74 @@ impl VisiblePoints {
         self.reach.is_empty()
     }
 
-    /// `n` placeholders (no point), keeping the arrays' capacity.
-    pub fn reset(&mut self, n: usize) {
+    /// `n` placeholders (no point), with room for glossy lobes if `glossy`, keeping the
+    /// arrays' capacity.
+    pub fn reset(&mut self, n: usize, glossy: bool) {
         self.reach.clear();
         self.reach.resize(n, Reach::default());
         self.shade.clear();
         self.shade.resize(n, Shade::EMPTY);
+        self.glossy.clear();
+        if glossy {
+            self.glossy.resize(n, None);
+        } else {
+            self.glossy.shrink_to_fit();
+        }
+    }
+
+    /// What point `k` turns flux arriving from `wi` (away from the surface) into: its weight
+    /// (throughput × the diffuse lobe), plus throughput × its glossy lobes for `wi`.
+    #[inline]
+    pub fn weight(&self, k: usize, wi: DVec3) -> DVec3 {
+        let s = &self.shade[k];
+        let diffuse = s.weight.as_dvec3();
+        match self.glossy.get(k) {
+            Some(Some(g)) => diffuse + g.weight(s.normal.as_dvec3(), wi),
+            _ => diffuse,
+        }
     }
 
     /// Removes the placeholders, keeping the points' order.
     pub fn drop_empty(&mut self) {
         let mut kept = 0;
+        let glossy = !self.glossy.is_empty();
         for k in 0..self.shade.len() {
             if self.shade[k].slot != Shade::NONE {
                 self.reach[kept] = self.reach[k];
                 self.shade[kept] = self.shade[k];
+                if glossy {
+                    self.glossy[kept] = self.glossy[k];
+                }
                 kept += 1;
             }
         }
         self.reach.truncate(kept);
         self.shade.truncate(kept);
+        if glossy {
+            self.glossy.truncate(kept);
+        }
     }
 
     /// Puts the points in `order` (place `i` gets point `order[i]`; used up, as the grid's
-    /// build returns it), in place: neither array is copied. The two arrays are permuted at
-    /// once on two threads where there are two (the second with a copy of `order`, 4 bytes a
+    /// build returns it), in place: no array is copied. The arrays are permuted at once on as
+    /// many threads as there are (each but the first with a copy of `order`, 4 bytes a
     /// point), each following the permutation's cycles.
     pub fn permute(&mut self, order: &mut [u32]) {
         let mut copy = order.to_vec();
+        let glossy = &mut self.glossy;
+        let mut glossy_order = (!glossy.is_empty()).then(|| order.to_vec());
         rayon::join(
             || permute_in_place(&mut self.reach, order),
-            || permute_in_place(&mut self.shade, &mut copy),
+            || {
+                rayon::join(
+                    || permute_in_place(&mut self.shade, &mut copy),
+                    || {
+                        if let Some(o) = &mut glossy_order {
+                            permute_in_place(glossy, o);
+                        }
+                    },
+                )
+            },
         );
     }
 
@@ -196,8 +239,14 @@ fn permute_in_place<T: Copy>(items: &mut [T], order: &mut [u32]) {
 
 impl FromIterator<VisiblePoint> for VisiblePoints {
     fn from_iter<I: IntoIterator<Item = VisiblePoint>>(iter: I) -> Self {
-        let (reach, shade) = iter.into_iter().map(|vp| split(&vp)).unzip();
-        Self { reach, shade }
+        let points: Vec<VisiblePoint> = iter.into_iter().collect();
+        let (reach, shade) = points.iter().map(split).unzip();
+        let glossy = if points.iter().any(|p| p.glossy.is_some()) {
+            points.iter().map(|p| p.glossy).collect()
+        } else {
+            Vec::new()
+        };
+        Self { reach, shade, glossy }
     }
 }
 
@@ -213,9 +262,10 @@ mod tests {
             normal: DVec3::Z,
             weight: DVec3::ONE,
             radius2: 0.0,
+            glossy: None,
         };
         let mut points = VisiblePoints::default();
-        points.reset(4);
+        points.reset(4, false);
         for (k, x) in [(1usize, 1.0), (3, 3.0)] {
             (points.reach[k], points.shade[k]) = split(&vp(k as u32, x));
         }
@@ -232,6 +282,54 @@ mod tests {
         assert_eq!(points.reach[0].reach2(), 0.0);
     }
 
+    /// A glossy point's lobes follow it when placeholders are dropped and when points are
+    /// permuted, and its weight for a photon's direction adds the lobe's to the diffuse
+    /// weight; a point without lobes weighs every direction alike.
+    #[test]
+    fn glossy_lobes_follow_their_points() {
+        use crate::render::bsdf::{phong, Glossy};
+        let lobes = Glossy::Phong {
+            specular: 0.5,
+            shininess: 10.0,
+        };
+        let vp = |slot: u32, glossy: bool| VisiblePoint {
+            slot,
+            position: DVec3::new(slot as f64, 0.0, 0.0),
+            normal: DVec3::Z,
+            weight: DVec3::splat(0.1),
+            radius2: 0.0,
+            glossy: glossy.then_some(GlossyPoint {
+                throughput: Vec3::splat(2.0),
+                wo: DVec3::new(0.6, 0.0, 0.8).as_vec3(),
+                lobes,
+            }),
+        };
+        let mut points = VisiblePoints::default();
+        points.reset(6, true);
+        for k in [1usize, 2, 4, 5] {
+            let p = vp(k as u32, k % 2 == 0);
+            (points.reach[k], points.shade[k]) = split(&p);
+            points.glossy[k] = p.glossy;
+        }
+        points.drop_empty();
+        assert_eq!(points.glossy.len(), 4);
+        points.permute(&mut [3, 2, 0, 1]);
+        let slots: Vec<u32> = points.shade.iter().map(|s| s.slot).collect();
+        assert_eq!(slots, [5, 4, 1, 2]);
+        for (k, s) in points.shade.iter().enumerate() {
+            assert_eq!(points.glossy[k].is_some(), s.slot % 2 == 0, "point {k}");
+        }
+        // The mirror direction of wo, and one away from it.
+        let (mirror, off) = (DVec3::new(-0.6, 0.0, 0.8), DVec3::Z);
+        let expected = |wi: DVec3| 0.1 + 2.0 * phong(0.5, 10.0, DVec3::Z, DVec3::new(0.6, 0.0, 0.8), wi);
+        for wi in [mirror, off] {
+            let glossy = points.weight(1, wi);
+            assert!((glossy.x - expected(wi)).abs() < 1e-5, "{glossy} for {wi}");
+            assert!((points.weight(2, wi).x - 0.1).abs() < 1e-7);
+        }
+        assert!(points.weight(1, mirror).x > 2.0 * points.weight(1, off).x);
+    }
+
     /// Putting the points in an order of several cycles moves each point where the order says.
     #[test]
     fn permuting_moves_each_point_where_the_order_says() {
@@ -243,6 +341,7 @@ mod tests {
                 normal: DVec3::Z,
                 weight: DVec3::ONE,
                 radius2: 0.0,
+                glossy: None,
             })
             .collect();
         // Cycles of several lengths: k ↦ 7k mod 1000 on the units, fixed points elsewhere.

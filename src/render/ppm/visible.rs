@@ -2,20 +2,22 @@
 //! trace eye rays through the delta lobes of mirrors and glass (all of them, or one picked
 //! with its share) to the first surface with a smooth BSDF ([`crate::render::bsdf`]) and
 //! record a visible point there — position, normal, and the weight (path throughput × the
-//! BSDF's diffuse part ρ/π) that turns photon flux arriving there into pixel radiance. A
-//! Phong lobe reaches the image through the photons that bounced off it, not at the visible
-//! point itself, which would need each photon's direction. Emission seen directly along the way, and optionally
-//! direct light from point and spot lights (shadow rays), is returned separately.
+//! BSDF's diffuse part ρ/π) that turns photon flux arriving there into pixel radiance. Where
+//! the BSDF has glossy lobes (a Phong lobe), the point keeps them with its throughput and the
+//! direction to the eye ([`GlossyPoint`]), and weighs each photon by them for the photon's own
+//! direction: the full BSDF, as pbrt-v4's SPPM. Emission seen directly along the way, and
+//! optionally direct light from point and spot lights (shadow rays, through the full BSDF), is
+//! returned separately.
 
 use std::f64::consts::PI;
 
-use glam::{DVec2, DVec3};
+use glam::{DVec2, DVec3, Vec3};
 use rand::Rng;
 use rand_pcg::Pcg64Mcg;
 
 use crate::geometry::Hit;
 use crate::geometry::Ray;
-use crate::render::bsdf::Bsdf;
+use crate::render::bsdf::{Bsdf, Glossy};
 use crate::scene::{Light, Scene};
 
 /// Where photons are gathered for one pixel (or one branch of one pixel's eye path).
@@ -31,6 +33,29 @@ pub struct VisiblePoint {
     pub weight: DVec3,
     /// Search radius² (copied from the slot when the index is built).
     pub radius2: f64,
+    /// The BSDF's glossy lobes, where it has any.
+    pub glossy: Option<GlossyPoint>,
+}
+
+/// What a visible point on a glossy surface weighs photons by, beyond its diffuse weight (f32,
+/// 36 bytes with its tag).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GlossyPoint {
+    /// The eye path's throughput to the point.
+    pub throughput: Vec3,
+    /// The direction to the eye (unit).
+    pub wo: Vec3,
+    /// The lobes.
+    pub lobes: Glossy,
+}
+
+impl GlossyPoint {
+    /// Throughput × the lobes' `f(wo, wi)` about the normal `n`: what flux arriving from `wi`
+    /// adds to the point's diffuse weight.
+    #[inline]
+    pub fn weight(&self, n: DVec3, wi: DVec3) -> DVec3 {
+        self.throughput.as_dvec3() * self.lobes.eval(n, self.wo.as_dvec3(), wi)
+    }
 }
 
 /// How the eye pass treats glass.
@@ -113,7 +138,7 @@ impl EyeWalk<'_> {
         }
         let bsdf = Bsdf::at(&scene.surface(&hit, ray.dir));
         if bsdf.has_smooth() {
-            self.visible_point(&hit, &bsdf, throughput, out);
+            self.visible_point(&hit, &bsdf, -ray.dir, throughput, out);
         }
         let lobes = bsdf.specular_lobes(-ray.dir);
         match (self.branching, lobes.len()) {
@@ -132,13 +157,18 @@ impl EyeWalk<'_> {
         }
     }
 
-    /// A visible point where the walk meets a smooth surface, with the direct light of the
-    /// point and spot lights when asked. Photon mapping gathers with the BSDF's diffuse part
-    /// (`ρ/π`) here.
-    fn visible_point(&self, hit: &Hit, bsdf: &Bsdf, throughput: DVec3, out: &mut EyeOut) {
+    /// A visible point where the walk, arriving from `wo`, meets a smooth surface, with the
+    /// direct light of the point and spot lights when asked. Photon mapping gathers with the
+    /// BSDF's diffuse part (`ρ/π`, in the weight) and its glossy lobes here.
+    fn visible_point(&self, hit: &Hit, bsdf: &Bsdf, wo: DVec3, throughput: DVec3, out: &mut EyeOut) {
         let scene = self.scene;
         let n = bsdf.normal();
         let weight = throughput * bsdf.diffuse_reflectance() / PI;
+        let glossy = bsdf.glossy().map(|lobes| GlossyPoint {
+            throughput: throughput.as_vec3(),
+            wo: wo.as_vec3(),
+            lobes,
+        });
         if self.direct_light {
             for (k, light) in scene
                 .lights
@@ -151,7 +181,7 @@ impl EyeWalk<'_> {
                 };
                 let cos = n.dot(ls.wi);
                 if cos > 0.0 && !scene.occluded_from_hit(hit, k, &ls) {
-                    out.direct += weight * ls.incident * cos;
+                    out.direct += throughput * bsdf.eval(wo, ls.wi) * ls.incident * cos;
                 }
             }
         }
@@ -161,6 +191,7 @@ impl EyeWalk<'_> {
             normal: n,
             weight,
             radius2: 0.0,
+            glossy,
         });
     }
 }

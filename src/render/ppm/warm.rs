@@ -111,39 +111,52 @@ impl WarmStart {
     }
 }
 
-/// A slot's visible point, kept compactly (36 bytes) for the next epoch to compare with; all
+/// A slot's visible point, kept compactly (40 bytes) for the next epoch to compare with; all
 /// zero for a slot without one.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PointRecord {
     position: Vec3,
     normal: Vec3,
     weight: Vec3,
+    /// Whether the point has glossy lobes: its estimate then weighs photons by the direction
+    /// to the eye as well, and carries only to the same point.
+    glossy: bool,
+}
+
+impl PointRecord {
+    /// Whether an estimate may carry to or from another pixel's point near it: a point
+    /// without glossy lobes (whose estimate is one of light arriving, scaled by the weight).
+    fn carries_nearby(&self) -> bool {
+        self.weight != Vec3::ZERO && !self.glossy
+    }
 }
 
 /// Each of `slots` slots' visible point among `points` (each point names its slot).
 pub fn records(slots: usize, points: &VisiblePoints) -> Vec<PointRecord> {
     let mut out = vec![PointRecord::default(); slots];
-    for (r, s) in points.reach.iter().zip(&points.shade) {
+    for (k, (r, s)) in points.reach.iter().zip(&points.shade).enumerate() {
         out[s.slot as usize] = PointRecord {
             position: r.position.as_vec3(),
             normal: s.normal,
             weight: s.weight,
+            glossy: matches!(points.glossy.get(k), Some(Some(_))),
         };
     }
     out
 }
 
 /// How a previous slot's estimate carries to a new visible point of the same pixel: `None`
-/// when the point moved by more than [`NEAR`] of the estimate's radius, turned, or its weight
-/// changed more than twofold; else the factor the flux takes for the new weight (1 where
-/// nothing changed).
+/// when the point moved by more than [`NEAR`] of the estimate's radius, turned, its weight
+/// changed more than twofold, or it changed at all on a glossy surface (whose estimate
+/// depends on the direction to the eye, which no factor corrects); else the factor the flux
+/// takes for the new weight (1 where nothing changed).
 fn carry(old: &PointRecord, new: &PointRecord, radius2: f64) -> Option<DVec3> {
     // Equal, or both without a point (a stochastic pixel whose path found no diffuse surface
     // in either pass).
     if old == new {
         return Some(DVec3::ONE);
     }
-    if old.weight == Vec3::ZERO || new.weight == Vec3::ZERO {
+    if old.weight == Vec3::ZERO || new.weight == Vec3::ZERO || old.glossy || new.glossy {
         return None;
     }
     let moved2 = (old.position - new.position).as_dvec3().length_squared();
@@ -389,7 +402,7 @@ impl WarmStart {
         let left = now
             .iter()
             .zip(carried)
-            .filter(|(r, &c)| !c && r.weight != Vec3::ZERO)
+            .filter(|(r, &c)| !c && r.carries_nearby())
             .fold(Aabb::EMPTY, |b, (r, _)| b.grow(r.position.as_dvec3()));
         if left.is_empty() {
             return 0;
@@ -399,13 +412,14 @@ impl WarmStart {
             .points
             .par_iter()
             .enumerate()
-            .filter(|(_, r)| r.weight != Vec3::ZERO && near.contains(r.position.as_dvec3()))
+            .filter(|(_, r)| r.carries_nearby() && near.contains(r.position.as_dvec3()))
             .map(|(k, r)| VisiblePoint {
                 slot: k as u32,
                 position: r.position.as_dvec3(),
                 normal: r.normal.as_dvec3(),
                 weight: r.weight.as_dvec3(),
                 radius2: self.slots[k].primary.radius2(),
+                glossy: None,
             })
             .collect();
         let (grid, order) = HashGrid::build(&old);
@@ -414,7 +428,7 @@ impl WarmStart {
         let found: Vec<(usize, u32, DVec3)> = now
             .par_iter()
             .enumerate()
-            .filter(|(to, new)| !carried[*to] && new.weight != Vec3::ZERO)
+            .filter(|(to, new)| !carried[*to] && new.carries_nearby())
             .filter_map(|(to, new)| {
                 let (p, normal) = (new.position.as_dvec3(), new.normal.as_dvec3());
                 // The nearest; of equally near ones, the first pixel's.
