@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Writes the Bézier-patch example scenes: scenes/pool.toml with assets/pool_water.obj (a
 bicubic B-spline water surface, 7×7 control points, so 4×4 Bézier patches), scenes/ring.toml (a
-mirror ring of 4 patches) and scenes/lens.toml (a biconvex lens of 2 patches).
+mirror ring of 4 patches), scenes/ring_gold.toml (the ring in rough gold) and scenes/lens.toml (a biconvex lens of 2 patches).
 Run from the project folder: python3 assets/make_example_scenes.py"""
 import math
 
@@ -159,11 +159,12 @@ material = "wall"
 """)
 
 ring_text = ",\n".join(patch_toml(p) for p in ring)
-open("scenes/ring.toml", "w").write(HEADER + """# The coffee-cup caustic: a mirror ring (a cylinder of 4 bicubic patches, each a quarter
-# circle) on a table, lit by a point light low and off to one side. Light reflected inside the
-# ring gathers into a cardioid-like cusp on the table. Drag the ring's control points to bend
-# the cusp.
 
+
+def ring_scene(path, about, name, material):
+    """The ring on its table under its lamp, with `about` as its comment and the material
+    table `material` of the ring, named `name`."""
+    open(path, "w").write(HEADER + about + """
 [camera]
 position = [0.0, 4.0, 1.6]
 look_at = [0.0, 0.0, 0.05]
@@ -175,9 +176,8 @@ height = 480
 renderer = "ppm"
 photons_per_pass = 400000
 
-[materials.mirror]
-type = "mirror"
-color = [0.95, 0.9, 0.8]
+[materials.""" + name + """]
+""" + material + """
 
 [materials.table]
 type = "diffuse"
@@ -199,11 +199,25 @@ material = "table"
 [[objects]]
 type = "patches"
 name = "ring"
-material = "mirror"
+material = \"""" + name + """\"
 patches = [
 """ + ring_text + """,
 ]
 """)
+
+
+ring_scene("scenes/ring.toml", """# The coffee-cup caustic: a mirror ring (a cylinder of 4 bicubic patches, each a quarter
+# circle) on a table, lit by a point light low and off to one side. Light reflected inside the
+# ring gathers into a cardioid-like cusp on the table. Drag the ring's control points to bend
+# the cusp.
+""", "mirror", """type = "mirror"
+color = [0.95, 0.9, 0.8]""")
+ring_scene("scenes/ring_gold.toml", """# The coffee-cup caustic from a ring of brushed gold: the same ring as ring.toml, its metal
+# rough (GGX roughness 0.08), so that the cusp it casts is soft and golden and the ring itself
+# glossy.
+""", "gold", """type = "metal"
+conductor = "gold"
+roughness = 0.08""")
 
 open("scenes/lens.toml", "w").write(HEADER + """# A biconvex glass lens (two bicubic patches sharing their square rim) in front of a spot
 # light: the light is focused to a bright point on the wall behind it. Drag the lens's inner

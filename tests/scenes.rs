@@ -37,6 +37,7 @@ fn every_shipped_scene_loads_and_renders() {
         "lens",
         "pool",
         "ring",
+        "ring_gold",
         "scroll",
         "showcase",
         "smallppm",
@@ -177,6 +178,26 @@ fn bad_scene_files_are_reported_clearly() {
         (
             scene_text("").replace("radius = 1\n", ""),
             "objects[0] (sphere): missing 'radius'",
+        ),
+        (
+            scene_text("").replace("type = \"diffuse\"", "type = \"metal\"\nconductor = \"brass\""),
+            "[materials.m] (metal): unknown conductor 'brass' (expected gold, silver, copper, aluminium, or 'eta' and 'k')",
+        ),
+        (
+            scene_text("").replace("type = \"diffuse\"", "type = \"metal\"\neta = [0.2, 0.4, 1.4]"),
+            "[materials.m] (metal): give either 'conductor' (gold, silver, copper, aluminium) or both 'eta' and 'k'",
+        ),
+        (
+            scene_text("").replace("type = \"diffuse\"", "type = \"metal\"\neta = [0, 0.4, 1.4]\nk = [3, 2, 1]"),
+            "'eta' components must be above 0 and at most 100",
+        ),
+        (
+            scene_text("").replace("type = \"diffuse\"", "type = \"mirror\"\nroughness = 1.5"),
+            "[materials.m] (mirror): 'roughness' (GGX α) must be between 0 and 1, got 1.5",
+        ),
+        (
+            scene_text("").replace("type = \"diffuse\"", "type = \"diffuse\"\nroughness = 0.2"),
+            "'roughness' does not apply to type 'diffuse'",
         ),
         (
             scene_text("[[objects]]\ntype = \"mesh\"\nfile = \"nope.obj\"\nmaterial = \"m\"\n"),

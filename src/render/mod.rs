@@ -12,6 +12,7 @@ pub mod error_tracker;
 pub mod film;
 pub mod frame;
 pub mod integrator;
+pub mod mis;
 pub mod ppm;
 pub mod provenance;
 pub mod rng;

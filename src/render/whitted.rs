@@ -118,7 +118,9 @@ impl Tracer<'_> {
             radiance += scene.params.ambient * bsdf.diffuse_reflectance();
             radiance = self.add_direct_light(radiance, &hit, &bsdf, wo, state);
         }
-        for lobe in bsdf.specular_lobes(wo).iter() {
+        // Rough mirrors, metals and glass are followed as polished ones (beside their
+        // highlights): a ray tracer follows delta lobes only.
+        for lobe in bsdf.smooth_lobes(wo).iter() {
             radiance += lobe.share * lobe.tint * self.trace(&hit.spawn(lobe.wi), depth + 1, state);
         }
         radiance

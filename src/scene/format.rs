@@ -158,7 +158,7 @@ pub enum ScaleDesc {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MaterialDesc {
-    /// `"diffuse"`, `"phong"`, `"mirror"` or `"glass"`.
+    /// `"diffuse"`, `"phong"`, `"mirror"`, `"metal"` or `"glass"`.
     #[serde(rename = "type")]
     pub kind: String,
     /// Reflectance (diffuse, phong), tint (mirror, glass); components in [0, 1].
@@ -171,6 +171,14 @@ pub struct MaterialDesc {
     pub shininess: Option<Real>,
     /// Glass index of refraction.
     pub ior: Option<Real>,
+    /// GGX roughness α of mirrors and metals, in [0, 1] (0: smooth).
+    pub roughness: Option<Real>,
+    /// A named metal (`metal`): gold, silver, copper, aluminium.
+    pub conductor: Option<String>,
+    /// A metal's index of refraction per channel, instead of `conductor`.
+    pub eta: Option<Vec3>,
+    /// A metal's extinction coefficient per channel, with `eta`.
+    pub k: Option<Vec3>,
 }
 
 /// `[[lights]]`: one flat table; which keys apply depends on `type`.

@@ -1,5 +1,5 @@
-//! Materials: Lambertian diffuse with an optional Phong lobe, perfect mirrors, and dielectric
-//! glass with exact Fresnel reflectance and total internal reflection.
+//! Materials: Lambertian diffuse with an optional Phong lobe, mirrors and metals (smooth or
+//! rough), and dielectric glass with exact Fresnel reflectance and total internal reflection.
 
 use glam::DVec3;
 
@@ -14,12 +14,30 @@ pub enum MaterialKind {
         /// Phong exponent.
         shininess: f64,
     },
-    /// Perfect specular reflection tinted by the colour.
-    Mirror,
-    /// Smooth dielectric with index of refraction `ior` (relative to the outside, 1).
+    /// Specular reflection tinted by the colour: perfect when `roughness` is 0, else GGX
+    /// microfacets of that α.
+    Mirror {
+        /// GGX roughness α (0: smooth).
+        roughness: f64,
+    },
+    /// A metal of complex index of refraction `eta + i k` per colour channel (named metals
+    /// give theirs), its Fresnel reflectance tinted by the colour; smooth when `roughness` is
+    /// 0, else GGX microfacets of that α.
+    Metal {
+        /// The real part of the index, per channel.
+        eta: DVec3,
+        /// The extinction coefficient, per channel.
+        k: DVec3,
+        /// GGX roughness α (0: smooth).
+        roughness: f64,
+    },
+    /// Dielectric with index of refraction `ior` (relative to the outside, 1): smooth when
+    /// `roughness` is 0, else GGX microfacets of that α (frosted glass).
     Glass {
         /// Index of refraction.
         ior: f64,
+        /// GGX roughness α (0: smooth).
+        roughness: f64,
     },
 }
 

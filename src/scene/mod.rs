@@ -7,6 +7,7 @@ pub mod format;
 pub mod light;
 mod load;
 pub mod material;
+pub mod metals;
 pub mod save;
 pub mod texture;
 

@@ -54,6 +54,15 @@ pub fn alpha(a: f64) -> Result<f64, Invalid> {
     }
 }
 
+/// A microfacet roughness α (the near-specular threshold), in [0, 1].
+pub fn roughness(a: f64) -> Result<f64, Invalid> {
+    if (0.0..=1.0).contains(&a) {
+        Ok(a)
+    } else {
+        Err(format!("must be within 0 and 1, got {a}"))
+    }
+}
+
 /// Photons per pass.
 pub fn photons_per_pass(n: u64) -> Result<u64, Invalid> {
     within(n, PHOTONS_PER_PASS, "")

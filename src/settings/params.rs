@@ -17,6 +17,9 @@ use super::limits;
 use super::setting::{Field, Setting, Value, Widget};
 use super::{IndexKind, RadiusSchedule, RendererKind};
 
+/// The default near-specular threshold (`near_specular`).
+pub const NEAR_SPECULAR: f64 = 0.15;
+
 /// The photon mapper alone.
 const PPM: &[RendererKind] = &[RendererKind::Ppm];
 /// The ray tracer alone.
@@ -178,6 +181,12 @@ render_settings! {
     flag "direct-light", label "Direct light by light sampling", default "true", unit "",
     renderers PPM, live false, widget Widget::Checkbox;
     help "Direct light by light sampling at the visible points (point and spot lights exactly by shadow rays, spheres and quads one stratified sample per pass); photons then count only after their first bounce and carry caustics and indirect light. Off: photons carry all the light (classic PPM).";
+
+    near_specular: f64 = NEAR_SPECULAR;
+    check |a| limits::roughness(*a).map(drop);
+    flag "near-specular", label "Near-specular below", default "0.15", unit "roughness α",
+    renderers PPM, live false, widget Widget::Slider { min: 0.0, max: 1.0, log: false, step: 0.01 };
+    help "Glossy lobes narrower than this microfacet roughness α, times their share of the surface's reflectance (1 for metals and glass; ρs/(ρs + ρ) for a Phong surface), are followed by the eye paths of stochastic photon mapping, as mirrors are, instead of being gathered at the visible point (a Phong exponent n counts as α = √(2/(n+2))). A narrow lobe gathers few photons and blurs what it reflects by the search radius; a wide one seen by a path is noisy, and a followed lobe costs the surface's diffuse light the passes its path takes the lobe. The path finds the lobes' direct light by light sampling; the photons are still stored on the surface and leave through its lobes, so no caustic is lost either way. 0: every glossy lobe is gathered, as classic photon mapping always does (its one eye pass cannot sample them).";
 
     guided_emission: bool = true;
     check any;

@@ -1,10 +1,8 @@
 //! A smooth dielectric interface (glass): reflection with the exact Fresnel reflectance for
 //! unpolarised light and refraction by Snell's law ([`crate::scene::material::dielectric`]),
-//! total internal reflection included. The refracted light is tinted by the colour. Radiance
-//! is not scaled by η² at a crossing (pbrt-v4 does so for radiance, not for importance):
-//! photons carry flux, to which the factor does not apply, and on the paths between a camera
-//! and a light that are both outside the glass the factors of entering and leaving cancel, so
-//! the renderers agree.
+//! total internal reflection included. The refracted light is tinted by the colour. The lobes
+//! transport flux (photons): radiance carried from the eye is scaled by η² at a crossing as
+//! well, which [`super::Bsdf::radiance_scale`] gives.
 
 use glam::DVec3;
 

@@ -11,12 +11,12 @@
 //! direction is the mixture of the two. Without a Phong lobe a sample draws two numbers and
 //! its weight is exactly ρ.
 
-use std::f64::consts::{PI, TAU};
+use std::f64::consts::PI;
 
 use glam::{DVec2, DVec3};
 use rand::Rng;
 
-use super::glossy::phong;
+use super::glossy::{phong, phong_direction, phong_pdf};
 use super::{BsdfSample, Glossy};
 use crate::scene::light::cosine_hemisphere;
 use crate::scene::material::reflect;
@@ -57,12 +57,6 @@ impl Diffuse {
         }
     }
 
-    /// The Phong lobe's sampling density of `wi` around the mirror direction of `wo`.
-    fn lobe_pdf(&self, wo: DVec3, wi: DVec3) -> f64 {
-        let c = reflect(-wo, self.n).dot(wi).max(0.0);
-        (self.shininess + 1.0) / TAU * c.powf(self.shininess)
-    }
-
     /// The density with which [`Diffuse::sample`] picks `wi`.
     pub fn pdf(&self, wo: DVec3, wi: DVec3) -> f64 {
         let cos = self.n.dot(wi);
@@ -71,7 +65,7 @@ impl Diffuse {
         }
         let share = self.lobe_share();
         if share > 0.0 {
-            (1.0 - share) * cos / PI + share * self.lobe_pdf(wo, wi)
+            (1.0 - share) * cos / PI + share * phong_pdf(self.shininess, self.n, wo, wi)
         } else {
             cos / PI
         }
@@ -97,12 +91,7 @@ impl Diffuse {
         let from_lobe = rng.random::<f64>() < share;
         let u = DVec2::new(rng.random(), rng.random());
         let wi = if from_lobe {
-            let axis = reflect(-wo, self.n);
-            let cos_a = u.x.powf(1.0 / (self.shininess + 1.0));
-            let sin_a = (1.0 - cos_a * cos_a).max(0.0).sqrt();
-            let phi = TAU * u.y;
-            let (t, b) = axis.any_orthonormal_pair();
-            (sin_a * phi.cos() * t + sin_a * phi.sin() * b + cos_a * axis).normalize()
+            phong_direction(reflect(-wo, self.n), self.shininess, u)
         } else {
             cosine_hemisphere(self.n, u)
         };

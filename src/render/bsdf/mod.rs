@@ -19,18 +19,23 @@
 //! that the splitting tracers need no case of their own. A new material is its file here plus
 //! one line in [`Bsdf::at`].
 
+mod conductor;
 mod dielectric;
 mod diffuse;
 mod glossy;
+pub mod microfacet;
 mod mirror;
+mod rough_dielectric;
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 use rand::Rng;
 
+pub use conductor::{fresnel_conductor, Conductor, Fresnel};
 pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
 pub use glossy::{phong, Glossy};
 pub use mirror::Mirror;
+pub use rough_dielectric::RoughDielectric;
 
 use crate::scene::material::{Material, MaterialKind};
 use crate::scene::{Scene, Surface};
@@ -116,8 +121,12 @@ pub enum Bsdf {
     Diffuse(Diffuse),
     /// A perfect mirror.
     Mirror(Mirror),
+    /// A metal or a rough mirror (smooth or GGX microfacets).
+    Conductor(Conductor),
     /// A smooth dielectric (glass).
     Dielectric(Dielectric),
+    /// A rough dielectric (frosted glass).
+    RoughDielectric(RoughDielectric),
 }
 
 impl Bsdf {
@@ -132,11 +141,29 @@ impl Bsdf {
                 shininess,
                 n,
             }),
-            MaterialKind::Mirror => Bsdf::Mirror(Mirror { color, n }),
-            MaterialKind::Glass { ior } => Bsdf::Dielectric(Dielectric {
+            MaterialKind::Mirror { roughness } if roughness <= 0.0 => Bsdf::Mirror(Mirror { color, n }),
+            MaterialKind::Mirror { roughness } => Bsdf::Conductor(Conductor {
+                color,
+                fresnel: Fresnel::One,
+                alpha: roughness,
+                n,
+            }),
+            MaterialKind::Metal { eta, k, roughness } => Bsdf::Conductor(Conductor {
+                color,
+                fresnel: Fresnel::Metal { eta, k },
+                alpha: roughness,
+                n,
+            }),
+            MaterialKind::Glass { ior, roughness } if roughness <= 0.0 => Bsdf::Dielectric(Dielectric {
                 color,
                 ior,
                 entering: surface.front,
+                n,
+            }),
+            MaterialKind::Glass { ior, roughness } => Bsdf::RoughDielectric(RoughDielectric {
+                color,
+                eta: if surface.front { ior } else { 1.0 / ior },
+                alpha: roughness,
                 n,
             }),
         }
@@ -147,7 +174,9 @@ impl Bsdf {
     pub fn has_glossy(material: &Material) -> bool {
         match material.kind {
             MaterialKind::Diffuse { specular, .. } => specular > 0.0,
-            MaterialKind::Mirror | MaterialKind::Glass { .. } => false,
+            MaterialKind::Mirror { roughness }
+            | MaterialKind::Metal { roughness, .. }
+            | MaterialKind::Glass { roughness, .. } => roughness > 0.0,
         }
     }
 
@@ -161,7 +190,9 @@ impl Bsdf {
         match self {
             Bsdf::Diffuse(b) => b.n,
             Bsdf::Mirror(b) => b.n,
+            Bsdf::Conductor(b) => b.n,
             Bsdf::Dielectric(b) => b.n,
+            Bsdf::RoughDielectric(b) => b.n,
         }
     }
 
@@ -169,7 +200,8 @@ impl Bsdf {
     /// stored and radiance is estimated.
     pub fn has_smooth(&self) -> bool {
         match self {
-            Bsdf::Diffuse(_) => true,
+            Bsdf::Diffuse(_) | Bsdf::RoughDielectric(_) => true,
+            Bsdf::Conductor(b) => !b.is_smooth(),
             Bsdf::Mirror(_) | Bsdf::Dielectric(_) => false,
         }
     }
@@ -180,16 +212,21 @@ impl Bsdf {
     pub fn diffuse_reflectance(&self) -> DVec3 {
         match self {
             Bsdf::Diffuse(b) => b.color,
-            Bsdf::Mirror(_) | Bsdf::Dielectric(_) => DVec3::ZERO,
+            Bsdf::Mirror(_) | Bsdf::Conductor(_) | Bsdf::Dielectric(_) | Bsdf::RoughDielectric(_) => {
+                DVec3::ZERO
+            }
         }
     }
 
-    /// The smooth part's glossy lobes (all but its diffuse lobe), compactly, for a visible
-    /// point to weigh each photon by: `eval(wo, wi) = diffuse_reflectance()/π + glossy.eval(n,
-    /// wo, wi)`. `None` when the smooth part is diffuse only.
-    pub fn glossy(&self) -> Option<Glossy> {
+    /// The smooth part's glossy lobes (all but its diffuse lobe), compactly, with the tint
+    /// they are multiplied by, for a visible point to weigh each photon by: `eval(wo, wi) =
+    /// diffuse_reflectance()/π + tint × glossy.eval(n, wo, wi)`. `None` when the smooth part
+    /// is diffuse only.
+    pub fn glossy(&self) -> Option<(Glossy, DVec3)> {
         match self {
-            Bsdf::Diffuse(b) => b.glossy(),
+            Bsdf::Diffuse(b) => b.glossy().map(|g| (g, DVec3::ONE)),
+            Bsdf::Conductor(b) => b.glossy().map(|g| (g, b.color)),
+            Bsdf::RoughDielectric(b) => Some((b.glossy(), DVec3::ONE)),
             Bsdf::Mirror(_) | Bsdf::Dielectric(_) => None,
         }
     }
@@ -199,7 +236,9 @@ impl Bsdf {
     pub fn albedo(&self) -> DVec3 {
         match self {
             Bsdf::Diffuse(b) => b.albedo(),
-            Bsdf::Mirror(_) | Bsdf::Dielectric(_) => DVec3::ZERO,
+            Bsdf::Conductor(b) if !b.is_smooth() => b.color,
+            Bsdf::RoughDielectric(b) => b.color.max(DVec3::ONE).min(DVec3::ONE),
+            Bsdf::Mirror(_) | Bsdf::Conductor(_) | Bsdf::Dielectric(_) => DVec3::ZERO,
         }
     }
 
@@ -207,6 +246,8 @@ impl Bsdf {
     pub fn eval(&self, wo: DVec3, wi: DVec3) -> DVec3 {
         match self {
             Bsdf::Diffuse(b) => b.eval(wo, wi),
+            Bsdf::Conductor(b) => b.eval(wo, wi),
+            Bsdf::RoughDielectric(b) => b.eval(wo, wi),
             Bsdf::Mirror(_) | Bsdf::Dielectric(_) => DVec3::ZERO,
         }
     }
@@ -215,17 +256,25 @@ impl Bsdf {
     pub fn pdf(&self, wo: DVec3, wi: DVec3) -> f64 {
         match self {
             Bsdf::Diffuse(b) => b.pdf(wo, wi),
+            Bsdf::Conductor(b) => b.pdf(wo, wi),
+            Bsdf::RoughDielectric(b) => b.pdf(wo, wi),
             Bsdf::Mirror(_) | Bsdf::Dielectric(_) => 0.0,
         }
     }
 
     /// A direction from the smooth part, drawing what numbers it needs from `rng` (a
-    /// Lambertian surface draws two). `None` when the part is empty or the sample falls below
-    /// the surface.
+    /// Lambertian surface and a rough conductor draw two, a rough dielectric three). `None`
+    /// when the part is empty, or the sample falls below the surface (or, refracted, on its
+    /// own side).
     pub fn sample<R: Rng + ?Sized>(&self, wo: DVec3, rng: &mut R) -> Option<BsdfSample> {
         match self {
             Bsdf::Diffuse(b) => b.sample(wo, rng),
-            Bsdf::Mirror(_) | Bsdf::Dielectric(_) => None,
+            Bsdf::Conductor(b) if !b.is_smooth() => b.sample(wo, DVec2::new(rng.random(), rng.random())),
+            Bsdf::RoughDielectric(b) => {
+                let u = DVec2::new(rng.random(), rng.random());
+                b.sample(wo, u, rng.random())
+            }
+            Bsdf::Mirror(_) | Bsdf::Conductor(_) | Bsdf::Dielectric(_) => None,
         }
     }
 
@@ -234,7 +283,48 @@ impl Bsdf {
         match self {
             Bsdf::Diffuse(_) => SpecularLobes::NONE,
             Bsdf::Mirror(b) => b.lobes(wo),
+            Bsdf::Conductor(b) => b.lobes(wo),
             Bsdf::Dielectric(b) => b.lobes(wo),
+            Bsdf::RoughDielectric(_) => SpecularLobes::NONE,
+        }
+    }
+
+    /// What radiance carried from `wi` to `wo` is scaled by beside `f`: `(η_wo / η_wi)²` when
+    /// `wi` is refracted from the far side of a dielectric, else 1. The BSDFs here transport
+    /// flux (photons; pbrt-v4's `TransportMode::Importance`); a tracer carrying radiance from
+    /// the eye multiplies this in at each refraction (pbrt-v4's `TransportMode::Radiance`,
+    /// §9.5.2). On a path that enters and leaves the same glass the factors cancel, which is
+    /// why the path tracer, whose paths start and end in air, may leave them out; photon
+    /// mapping's eye paths may not, since they end at a visible point that can lie in water or
+    /// glass (under `scenes/pool.toml`'s water, without them, photon mapping was 1.47× the path
+    /// tracer).
+    pub fn radiance_scale(&self, wo: DVec3, wi: DVec3) -> f64 {
+        let (n, far) = match self {
+            Bsdf::Dielectric(b) => (b.n, if b.entering { b.ior } else { 1.0 / b.ior }),
+            Bsdf::RoughDielectric(b) => (b.n, b.eta),
+            _ => return 1.0,
+        };
+        if n.dot(wi) < 0.0 && n.dot(wo) > 0.0 {
+            1.0 / (far * far)
+        } else {
+            1.0
+        }
+    }
+
+    /// The delta lobes of the same surface made smooth: a rough mirror, metal or glass as a
+    /// polished one, anything else as it is. What a ray tracer that follows only delta lobes
+    /// (Whitted) shows of a rough surface, beside its highlights.
+    pub fn smooth_lobes(&self, wo: DVec3) -> SpecularLobes {
+        match *self {
+            Bsdf::Conductor(b) => Conductor { alpha: 0.0, ..b }.lobes(wo),
+            Bsdf::RoughDielectric(b) => Dielectric {
+                color: b.color,
+                ior: b.eta,
+                entering: true,
+                n: b.n,
+            }
+            .lobes(wo),
+            _ => self.specular_lobes(wo),
         }
     }
 }

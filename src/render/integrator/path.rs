@@ -33,6 +33,7 @@ use crate::render::provenance;
 use crate::render::rng::stream_rng;
 use crate::render::sequence;
 use crate::render::bsdf::Bsdf;
+use crate::render::mis::power_heuristic;
 use crate::scene::Scene;
 use crate::settings::RendererKind;
 
@@ -81,16 +82,6 @@ impl PathTracer {
     }
 }
 
-/// The power heuristic with exponent 2 for one sample of each strategy (Veach 1997).
-fn power_heuristic(pdf: f64, other: f64) -> f64 {
-    let (a, b) = (pdf * pdf, other * other);
-    if a + b > 0.0 {
-        a / (a + b)
-    } else {
-        0.0
-    }
-}
-
 /// One pixel sample's path: its radiance and how many segments and shadow rays it traced.
 struct Path<'s> {
     scene: &'s Scene,
@@ -113,10 +104,12 @@ impl Path<'_> {
             let Some(ls) = light.sample(hit.point, u) else {
                 continue;
             };
-            let cos = n.dot(ls.wi);
-            if cos <= 0.0 {
+            // Either side of the surface: f is zero where the BSDF takes no light.
+            let f = bsdf.eval(wo, ls.wi);
+            if f == DVec3::ZERO {
                 continue;
             }
+            let cos = n.dot(ls.wi).abs();
             self.shadow_rays += 1;
             if scene.occluded_from_hit(hit, k, &ls) {
                 continue;
@@ -127,7 +120,7 @@ impl Path<'_> {
             } else {
                 1.0
             };
-            sum += bsdf.eval(wo, ls.wi) * ls.incident * cos * weight;
+            sum += f * ls.incident * cos * weight;
         }
         sum
     }

@@ -215,7 +215,8 @@ impl Window {
 }
 
 impl Gather<'_> {
-    /// Hands each of `hits` to every visible point on its side of the surface whose search
+    /// Hands each of `hits` to every visible point on its side of the surface (either side, for
+    /// a point on a rough dielectric) whose search
     /// sphere of the hit's estimate holds it, weighted by the point's BSDF for the photon's
     /// direction: the deposits, and the window places of the photons that reached a point
     /// (repeats possible).
@@ -233,7 +234,9 @@ impl Gather<'_> {
                     let r = &reach[k as usize];
                     if (r.position - p).length_squared() <= r.radius2[estimate] as f64 {
                         let s = &shade[k as usize];
-                        if s.normal.as_dvec3().dot(n) > 1e-3 {
+                        // On the point's side, or through a surface that refracts.
+                        if s.normal.as_dvec3().dot(n) > 1e-3 || (glossy && self.points.two_sided(k as usize))
+                        {
                             let weight = match wi {
                                 Some(wi) => self.points.weight(k as usize, wi).as_vec3(),
                                 None => s.weight,

@@ -99,12 +99,13 @@ impl<'a, K: Fn(usize) -> u64 + Sync> Sampler<'a, K> {
                     let Some(ls) = light.sample(position, u) else {
                         continue;
                     };
-                    let cos = normal.dot(ls.wi);
-                    if cos <= 0.0 {
+                    // Zero below the surface, unless the point refracts.
+                    let weight = self.points.weight(k, ls.wi);
+                    if weight == DVec3::ZERO {
                         continue;
                     }
                     if !scene.occluded_from(position, normal, l as usize, &ls) {
-                        sum += self.points.weight(k, ls.wi) * ls.incident * cos;
+                        sum += weight * ls.incident * normal.dot(ls.wi).abs();
                     }
                 }
                 sum

@@ -17,7 +17,7 @@ use super::light::LightSeen;
 use super::points::{self, Shade, VisiblePoints};
 use super::seen;
 use super::streams;
-use super::visible::{trace_eye, Branching, VisiblePoint};
+use super::visible::{trace_eye, Branching, ShadowRays, VisiblePoint};
 use crate::render::bsdf::Bsdf;
 use crate::render::rng::stream_rng;
 use crate::render::sequence;
@@ -124,7 +124,7 @@ impl EyePass {
                     &rays.ray_with_lens_sample(px, lens),
                     i as u32,
                     Branching::Choose { first },
-                    direct_light && !chosen,
+                    ShadowRays::new(direct_light, !chosen),
                     &mut rng,
                     &mut sink,
                 );
@@ -214,7 +214,7 @@ pub fn trace_classic(job: &EyeJob, scene: &Scene) -> Option<(Vec<DVec3>, Vec<Vis
                     &rays.ray(px, DVec2::ZERO),
                     i as u32,
                     Branching::Split,
-                    direct_light,
+                    ShadowRays::new(direct_light, true),
                     &mut rng,
                     &mut |vp| points.push(vp),
                 ));

@@ -198,7 +198,9 @@ impl<'a> PhotonSource<'a> {
                 if !(skip_first && first_interaction) {
                     gather(hit.point, (bsdf.normal(), wo), flux, indirect);
                 }
-                indirect = true;
+                // Light that has met a diffuse lobe is indirect; a rough mirror, metal or glass
+                // bends it as a smooth one does, into a caustic.
+                indirect |= bsdf.diffuse_reflectance() != DVec3::ZERO;
                 // Russian roulette on the albedo, then a bounce sampled from the BSDF.
                 let survive = bsdf.albedo().max_element();
                 if survive <= 0.0 || rng.random::<f64>() >= survive {

@@ -135,16 +135,29 @@ impl VisiblePoints {
         }
     }
 
-    /// What point `k` turns flux arriving from `wi` (away from the surface) into: its weight
-    /// (throughput × the diffuse lobe), plus throughput × its glossy lobes for `wi`.
+    /// What point `k` turns flux arriving from `wi` (away from the surface; a unit vector)
+    /// into: its weight (throughput × the diffuse lobe) when `wi` is above the surface, plus
+    /// throughput × its glossy lobes for `wi` (which may take light from below).
     #[inline]
     pub fn weight(&self, k: usize, wi: DVec3) -> DVec3 {
         let s = &self.shade[k];
-        let diffuse = s.weight.as_dvec3();
+        let n = s.normal.as_dvec3();
+        let diffuse = if n.dot(wi) > 0.0 {
+            s.weight.as_dvec3()
+        } else {
+            DVec3::ZERO
+        };
         match self.glossy.get(k) {
-            Some(Some(g)) => diffuse + g.weight(s.normal.as_dvec3(), wi),
+            Some(Some(g)) => diffuse + g.weight(n, wi),
             _ => diffuse,
         }
+    }
+
+    /// Whether point `k` gathers light arriving from below its surface too (a rough
+    /// dielectric's refraction).
+    #[inline]
+    pub fn two_sided(&self, k: usize) -> bool {
+        matches!(self.glossy.get(k), Some(Some(g)) if g.lobes.two_sided())
     }
 
     /// Removes the placeholders, keeping the points' order.

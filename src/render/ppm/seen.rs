@@ -51,7 +51,7 @@ use rand::Rng;
 use rayon::prelude::*;
 
 use super::streams;
-use super::visible::{trace_eye, Branching};
+use super::visible::{trace_eye, Branching, ShadowRays};
 use crate::render::rng::stream_rng;
 use crate::render::sequence;
 use crate::scene::camera::EyeRays;
@@ -344,7 +344,7 @@ impl Subsampler<'_> {
                 &self.rays.ray_with_lens_sample(pixel, lens),
                 i as u32,
                 Branching::Choose { first },
-                self.direct_light,
+                ShadowRays::new(self.direct_light, true),
                 &mut rng,
                 &mut |_| {},
             );

@@ -6,6 +6,7 @@ use toml::Spanned;
 use super::diagnostics::{v3, Ctx, Result, Table};
 use crate::scene::format::{MaterialDesc, ScaleDesc, TextureDesc};
 use crate::scene::material::{Material, MaterialKind};
+use crate::scene::metals;
 use crate::scene::texture::{Mapping, Texture, TextureSource};
 
 pub(super) fn material(
@@ -26,7 +27,19 @@ pub(super) fn material(
         ("specular", d.specular.is_some()),
         ("shininess", d.shininess.is_some()),
         ("ior", d.ior.is_some()),
+        ("roughness", d.roughness.is_some()),
+        ("conductor", d.conductor.is_some()),
+        ("eta", d.eta.is_some()),
+        ("k", d.k.is_some()),
     ];
+    let roughness = || -> Result<f64> {
+        let r = d.roughness.map_or(0.0, |r| r.0);
+        if (0.0..=1.0).contains(&r) {
+            Ok(r)
+        } else {
+            Err(t.err(format!("'roughness' (GGX α) must be between 0 and 1, got {r}")))
+        }
+    };
     let color = d
         .color
         .as_ref()
@@ -53,18 +66,30 @@ pub(super) fn material(
             }
         }
         "mirror" => {
-            t.only("mirror", &given, &["color"])?;
-            MaterialKind::Mirror
+            t.only("mirror", &given, &["color", "roughness"])?;
+            MaterialKind::Mirror {
+                roughness: roughness()?,
+            }
+        }
+        "metal" => {
+            t.only("metal", &given, &["color", "roughness", "conductor", "eta", "k"])?;
+            let (eta, k) = metal(&t, d)?;
+            MaterialKind::Metal {
+                eta,
+                k,
+                roughness: roughness()?,
+            }
         }
         "glass" => {
-            t.only("glass", &given, &["color", "ior"])?;
+            t.only("glass", &given, &["color", "ior", "roughness"])?;
             MaterialKind::Glass {
                 ior: t.positive("ior", d.ior.map_or(1.5, |r| r.0))?,
+                roughness: roughness()?,
             }
         }
         other => {
             return Err(t.err(format!(
-                "unknown material type '{other}' (expected diffuse, phong, mirror or glass)"
+                "unknown material type '{other}' (expected diffuse, phong, mirror, metal or glass)"
             )))
         }
     };
@@ -75,12 +100,47 @@ pub(super) fn material(
         }
         None => None,
     };
+    // A metal's colour tints its own reflectance: white unless given.
+    let default_color = if matches!(kind, MaterialKind::Metal { .. }) {
+        DVec3::ONE
+    } else {
+        DVec3::splat(0.75)
+    };
     Ok(Material {
         name: name.to_owned(),
         kind,
-        color: color.unwrap_or(DVec3::splat(0.75)),
+        color: color.unwrap_or(default_color),
         texture,
     })
+}
+
+/// A metal's `(η, k)`: a named `conductor`, or `eta` and `k` both given (each channel finite,
+/// η positive, k not negative, both at most 100).
+fn metal(t: &Table, d: &MaterialDesc) -> Result<(DVec3, DVec3)> {
+    match (&d.conductor, &d.eta, &d.k) {
+        (Some(name), None, None) => metals::named(name).ok_or_else(|| {
+            t.err(format!(
+                "unknown conductor '{name}' (expected {}, or 'eta' and 'k')",
+                metals::names()
+            ))
+        }),
+        (None, Some(eta), Some(k)) => {
+            let (eta, k) = (v3(eta), v3(k));
+            if !(eta.cmpgt(DVec3::ZERO).all() && eta.cmple(DVec3::splat(100.0)).all()) {
+                return Err(t.err(format!(
+                    "'eta' components must be above 0 and at most 100, got {eta}"
+                )));
+            }
+            if !(k.cmpge(DVec3::ZERO).all() && k.cmple(DVec3::splat(100.0)).all()) {
+                return Err(t.err(format!("'k' components must be between 0 and 100, got {k}")));
+            }
+            Ok((eta, k))
+        }
+        _ => Err(t.err(format!(
+            "give either 'conductor' ({}) or both 'eta' and 'k'",
+            metals::names()
+        ))),
+    }
 }
 
 pub(super) fn texture(t: &Table, d: &TextureDesc) -> Result<Texture> {
