@@ -9,7 +9,6 @@ pub mod bspline;
 pub mod bvh;
 pub mod freeform;
 pub mod mesh;
-pub mod octahedral;
 pub mod patch;
 pub mod quad;
 pub mod ray;
