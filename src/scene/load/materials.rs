@@ -21,6 +21,37 @@ pub(super) fn material(
         span: desc.span(),
         name: format!("[materials.{name}] ({})", d.kind),
     };
+    let color = d
+        .color
+        .as_ref()
+        .map(v3)
+        .map(|c| t.reflectance("color", c))
+        .transpose()?;
+    let kind = kind(&t, d)?;
+    let texture = match &d.texture {
+        Some(desc) => {
+            textures.push(texture(&t, desc)?);
+            Some(textures.len() - 1)
+        }
+        None => None,
+    };
+    // A metal's colour tints its own reflectance: white unless given.
+    let default_color = if matches!(kind, MaterialKind::Metal { .. }) {
+        DVec3::ONE
+    } else {
+        DVec3::splat(0.75)
+    };
+    Ok(Material {
+        name: name.to_owned(),
+        kind,
+        color: color.unwrap_or(default_color),
+        texture,
+    })
+}
+
+/// The model a `[materials.NAME]` table's `type` and keys describe, each key checked (and
+/// refused where the type does not take it).
+fn kind(t: &Table, d: &MaterialDesc) -> Result<MaterialKind> {
     let given = [
         ("color", d.color.is_some()),
         ("texture", d.texture.is_some()),
@@ -40,12 +71,6 @@ pub(super) fn material(
             Err(t.err(format!("'roughness' (GGX α) must be between 0 and 1, got {r}")))
         }
     };
-    let color = d
-        .color
-        .as_ref()
-        .map(v3)
-        .map(|c| t.reflectance("color", c))
-        .transpose()?;
     let kind = match d.kind.as_str() {
         "diffuse" => {
             t.only("diffuse", &given, &["color", "texture"])?;
@@ -73,7 +98,7 @@ pub(super) fn material(
         }
         "metal" => {
             t.only("metal", &given, &["color", "roughness", "conductor", "eta", "k"])?;
-            let (eta, k) = metal(&t, d)?;
+            let (eta, k) = metal(t, d)?;
             MaterialKind::Metal {
                 eta,
                 k,
@@ -93,25 +118,7 @@ pub(super) fn material(
             )))
         }
     };
-    let texture = match &d.texture {
-        Some(desc) => {
-            textures.push(texture(&t, desc)?);
-            Some(textures.len() - 1)
-        }
-        None => None,
-    };
-    // A metal's colour tints its own reflectance: white unless given.
-    let default_color = if matches!(kind, MaterialKind::Metal { .. }) {
-        DVec3::ONE
-    } else {
-        DVec3::splat(0.75)
-    };
-    Ok(Material {
-        name: name.to_owned(),
-        kind,
-        color: color.unwrap_or(default_color),
-        texture,
-    })
+    Ok(kind)
 }
 
 /// A metal's `(η, k)`: a named `conductor`, or `eta` and `k` both given (each channel finite,
