@@ -12,7 +12,7 @@ use std::f64::consts::{PI, TAU};
 use glam::{DVec2, DVec3, Vec3};
 
 use super::conductor::{microfacet_pdf, microfacet_reflection, microfacet_sample};
-use super::{BsdfSample, Fresnel, RoughDielectric};
+use super::{Bsdf, BsdfSample, Fresnel, RoughDielectric};
 use crate::scene::material::reflect;
 
 /// The glossy lobes of a BSDF, compactly, without their tint.
@@ -45,27 +45,21 @@ pub enum Glossy {
 }
 
 impl Glossy {
-    /// `f(wo, wi)` of the glossy lobes about the unit shading normal `n` (on `wo`'s side);
-    /// zero when `wi` is below the surface.
+    /// `f(wo, wi)` of the glossy lobes about the unit shading normal `n` (on `wo`'s side),
+    /// for radiance; zero when `wi` is below the surface, unless the lobes refract.
     pub fn eval(&self, n: DVec3, wo: DVec3, wi: DVec3) -> DVec3 {
-        if let Glossy::Dielectric { eta, .. } = *self {
-            let f = self.dielectric(n).eval(wo, wi);
-            return if n.dot(wi) < 0.0 {
-                f / (eta as f64).powi(2)
-            } else {
-                f
-            };
-        }
-        if n.dot(wi) <= 0.0 {
-            return DVec3::ZERO;
-        }
+        let above = n.dot(wi) > 0.0;
         match *self {
-            Glossy::Phong { specular, shininess } => {
+            Glossy::Phong { specular, shininess } if above => {
                 DVec3::splat(phong(specular as f64, shininess as f64, n, wo, wi))
             }
-            Glossy::Conductor { alpha, metal } => microfacet_reflection(alpha as f64, n, wo, wi)
+            Glossy::Conductor { alpha, metal } if above => microfacet_reflection(alpha as f64, n, wo, wi)
                 .map_or(DVec3::ZERO, |(m, f)| fresnel(metal).eval(wo.dot(m)) * f),
-            Glossy::Dielectric { .. } => DVec3::ZERO,
+            Glossy::Dielectric { alpha, eta, tint } => {
+                let b = rough_dielectric(alpha, eta, tint, n);
+                b.eval(wo, wi) * Bsdf::RoughDielectric(b).radiance_scale(wo, wi)
+            }
+            Glossy::Phong { .. } | Glossy::Conductor { .. } => DVec3::ZERO,
         }
     }
 
@@ -73,20 +67,6 @@ impl Glossy {
     /// visible point then gathers photons from both sides.
     pub fn two_sided(&self) -> bool {
         matches!(self, Glossy::Dielectric { .. })
-    }
-
-    /// The rough dielectric these lobes stand for, about `n` (white for any other lobes).
-    fn dielectric(&self, n: DVec3) -> RoughDielectric {
-        let (alpha, eta, tint) = match *self {
-            Glossy::Dielectric { alpha, eta, tint } => (alpha, eta, tint),
-            _ => (1.0, 1.0, Vec3::ONE),
-        };
-        RoughDielectric {
-            color: tint.as_dvec3(),
-            eta: eta as f64,
-            alpha: alpha as f64,
-            n,
-        }
     }
 
     /// The lobes' width as a microfacet roughness α: for a Phong lobe of exponent `n`, the
@@ -110,51 +90,55 @@ impl Glossy {
 
     /// The density with which [`Glossy::sample`] picks `wi`.
     pub fn pdf(&self, n: DVec3, wo: DVec3, wi: DVec3) -> f64 {
-        if let Glossy::Dielectric { .. } = self {
-            return self.dielectric(n).pdf(wo, wi);
-        }
-        if n.dot(wi) <= 0.0 {
-            return 0.0;
-        }
+        let above = n.dot(wi) > 0.0;
         match *self {
-            Glossy::Phong { shininess, .. } => phong_pdf(shininess as f64, n, wo, wi),
-            Glossy::Conductor { alpha, .. } => microfacet_pdf(alpha as f64, n, wo, wi),
-            Glossy::Dielectric { .. } => 0.0,
+            Glossy::Phong { shininess, .. } if above => phong_pdf(shininess as f64, n, wo, wi),
+            Glossy::Conductor { alpha, .. } if above => microfacet_pdf(alpha as f64, n, wo, wi),
+            Glossy::Dielectric { alpha, eta, tint } => rough_dielectric(alpha, eta, tint, n).pdf(wo, wi),
+            Glossy::Phong { .. } | Glossy::Conductor { .. } => 0.0,
         }
     }
 
     /// A direction from the lobes alone, with `u` uniform in [0, 1)³ (a dielectric's third
     /// number chooses reflection or refraction): its weight is `f(wo, wi) |cos θi| / pdf` of
-    /// the lobes. `None` below the surface (for lobes that only reflect).
+    /// the lobes, for radiance. `None` below the surface (for lobes that only reflect).
     pub fn sample(&self, n: DVec3, wo: DVec3, u: DVec3) -> Option<BsdfSample> {
         let (u, choice) = (DVec2::new(u.x, u.y), u.z);
-        let wi = match *self {
-            Glossy::Dielectric { eta, .. } => {
-                let mut s = self.dielectric(n).sample(wo, u, choice)?;
-                if n.dot(s.wi) < 0.0 {
-                    s.weight /= (eta as f64).powi(2);
-                }
-                return Some(s);
+        match *self {
+            Glossy::Phong { shininess, .. } => {
+                let wi = phong_direction(reflect(-wo, n), shininess as f64, u);
+                let (cos, pdf) = (n.dot(wi), self.pdf(n, wo, wi));
+                (cos > 0.0 && pdf > 0.0).then(|| BsdfSample {
+                    wi,
+                    weight: self.eval(n, wo, wi) * (cos / pdf),
+                    pdf,
+                })
             }
-            Glossy::Phong { shininess, .. } => phong_direction(reflect(-wo, n), shininess as f64, u),
             Glossy::Conductor { alpha, metal } => {
                 let (wi, m, weight) = microfacet_sample(alpha as f64, n, wo, u)?;
-                return Some(BsdfSample {
+                Some(BsdfSample {
                     wi,
                     weight: fresnel(metal).eval(wo.dot(m)) * weight,
                     pdf: self.pdf(n, wo, wi),
-                });
+                })
             }
-        };
-        let (cos, pdf) = (n.dot(wi), self.pdf(n, wo, wi));
-        if cos <= 0.0 || pdf <= 0.0 {
-            return None;
+            Glossy::Dielectric { alpha, eta, tint } => {
+                let b = rough_dielectric(alpha, eta, tint, n);
+                let mut s = b.sample(wo, u, choice)?;
+                s.weight *= Bsdf::RoughDielectric(b).radiance_scale(wo, s.wi);
+                Some(s)
+            }
         }
-        Some(BsdfSample {
-            wi,
-            weight: self.eval(n, wo, wi) * (cos / pdf),
-            pdf,
-        })
+    }
+}
+
+/// The rough dielectric of a compact [`Glossy::Dielectric`], about `n`.
+fn rough_dielectric(alpha: f32, eta: f32, tint: Vec3, n: DVec3) -> RoughDielectric {
+    RoughDielectric {
+        color: tint.as_dvec3(),
+        eta: eta as f64,
+        alpha: alpha as f64,
+        n,
     }
 }
 

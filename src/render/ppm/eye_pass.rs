@@ -5,7 +5,6 @@
 use glam::{DVec2, DVec3};
 use rand::Rng;
 use rand_pcg::Pcg64Mcg;
-use rayon::iter::Either;
 use rayon::prelude::*;
 
 use super::config::Config;
@@ -14,7 +13,7 @@ use super::hash_grid::HashGrid;
 use super::index::SpatialIndex;
 use super::kd_tree::KdTree;
 use super::light::LightSeen;
-use super::points::{self, Shade, VisiblePoints};
+use super::points::VisiblePoints;
 use super::seen;
 use super::streams;
 use super::visible::{trace_eye, Branching, ShadowRays, VisiblePoint};
@@ -85,20 +84,11 @@ impl EyePass {
             stratified: config.stratified_eye_rays,
             direct_light,
         };
-        let VisiblePoints { reach, shade, glossy } = &mut self.points;
-        // Each pixel's glossy lobes go to its place when there is room for them.
-        let glossy = if glossy.is_empty() {
-            Either::Right((0..pixels).into_par_iter().map(|_| None))
-        } else {
-            Either::Left(glossy.par_iter_mut().map(Some))
-        };
-        reach
-            .par_iter_mut()
-            .zip(shade.par_iter_mut())
-            .zip(glossy)
+        self.points
+            .places_mut()
             .zip(pass_direct.par_iter_mut())
             .enumerate()
-            .for_each(|(i, (((reach, shade), mut glossy), direct))| {
+            .for_each(|(i, (mut place, direct))| {
                 if interrupt.is_some_and(|f| f()) {
                     skipped.store(true, std::sync::atomic::Ordering::Relaxed);
                     return;
@@ -108,13 +98,7 @@ impl EyePass {
                 let mut rng = stream_rng(seed, streams::EYE, pass * w * h + i);
                 let (jitter, lens, first) = eye_sample(seed, pass, i, sequences, &mut rng);
                 let px = DVec2::new(x as f64, y as f64) + jitter;
-                let mut sink = |vp: VisiblePoint| {
-                    debug_assert!(shade.slot == Shade::NONE, "a chosen path ends once");
-                    (*reach, *shade) = points::split(&vp);
-                    if let Some(g) = glossy.as_mut() {
-                        **g = vp.glossy;
-                    }
-                };
+                let mut sink = |vp: VisiblePoint| place.set(&vp);
                 // A supersampled pixel's light seen comes from its extra rays alone, so its
                 // own ray needs no shadow rays (they draw no random numbers: the point is the
                 // same).

@@ -8,13 +8,14 @@
 //! surface weighs each photon by the BSDF for the photon's direction.
 
 use glam::{DVec3, Vec3};
+use rayon::iter::Either;
 use rayon::prelude::*;
 
 #[cfg(test)]
 use super::estimate::Estimate;
 use super::estimate::Slot;
 use super::sweep::SWEEP_BLOCK;
-use super::visible::{GlossyPoint, VisiblePoint};
+use super::visible::{point_weight, GlossyPoint, VisiblePoint};
 
 /// A search sphere the spatial indices are built over: a centre and the radius² that reaches
 /// farthest.
@@ -94,6 +95,26 @@ pub struct VisiblePoints {
     pub glossy: Vec<Option<GlossyPoint>>,
 }
 
+/// One pixel's place among a stochastic pass's points, which its eye path writes its visible
+/// point into ([`VisiblePoints::places_mut`]).
+pub struct Place<'a> {
+    reach: &'a mut Reach,
+    shade: &'a mut Shade,
+    /// Room for the point's glossy lobes, when the points have any.
+    glossy: Option<&'a mut Option<GlossyPoint>>,
+}
+
+impl Place<'_> {
+    /// Puts `vp` here (once: a chosen path ends at one point).
+    pub fn set(&mut self, vp: &VisiblePoint) {
+        debug_assert!(self.shade.slot == Shade::NONE, "a chosen path ends once");
+        (*self.reach, *self.shade) = split(vp);
+        if let Some(g) = self.glossy.as_deref_mut() {
+            *g = vp.glossy;
+        }
+    }
+}
+
 /// Splits a visible point into its two parts (radii left at 0 until [`VisiblePoints::set_radii`]).
 pub fn split(vp: &VisiblePoint) -> (Reach, Shade) {
     (
@@ -141,16 +162,8 @@ impl VisiblePoints {
     #[inline]
     pub fn weight(&self, k: usize, wi: DVec3) -> DVec3 {
         let s = &self.shade[k];
-        let n = s.normal.as_dvec3();
-        let diffuse = if n.dot(wi) > 0.0 {
-            s.weight.as_dvec3()
-        } else {
-            DVec3::ZERO
-        };
-        match self.glossy.get(k) {
-            Some(Some(g)) => diffuse + g.weight(n, wi),
-            _ => diffuse,
-        }
+        let glossy = self.glossy.get(k).and_then(Option::as_ref);
+        point_weight(s.weight.as_dvec3(), s.normal.as_dvec3(), glossy, wi)
     }
 
     /// Whether point `k` gathers light arriving from below its surface too (a rough
@@ -158,6 +171,21 @@ impl VisiblePoints {
     #[inline]
     pub fn two_sided(&self, k: usize) -> bool {
         matches!(self.glossy.get(k), Some(Some(g)) if g.lobes.two_sided())
+    }
+
+    /// Every place in order, in parallel, for an eye pass to write each pixel's point into
+    /// ([`VisiblePoints::reset`] first).
+    pub fn places_mut(&mut self) -> impl IndexedParallelIterator<Item = Place<'_>> {
+        let glossy = if self.glossy.is_empty() {
+            Either::Right((0..self.reach.len()).into_par_iter().map(|_| None))
+        } else {
+            Either::Left(self.glossy.par_iter_mut().map(Some))
+        };
+        self.reach
+            .par_iter_mut()
+            .zip(self.shade.par_iter_mut())
+            .zip(glossy)
+            .map(|((reach, shade), glossy)| Place { reach, shade, glossy })
     }
 
     /// Removes the placeholders, keeping the points' order.

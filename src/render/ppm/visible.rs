@@ -61,6 +61,19 @@ impl GlossyPoint {
     }
 }
 
+/// What a visible point of normal `n`, diffuse weight `diffuse` and glossy lobes `glossy` turns
+/// flux arriving from `wi` (away from the surface, unit) into: the diffuse weight when `wi` is
+/// above the surface, plus the lobes' weight (which may take light from below). The one rule
+/// for photons, area-light samples and shadow rays alike.
+#[inline]
+pub fn point_weight(diffuse: DVec3, n: DVec3, glossy: Option<&GlossyPoint>, wi: DVec3) -> DVec3 {
+    let diffuse = if n.dot(wi) > 0.0 { diffuse } else { DVec3::ZERO };
+    match glossy {
+        Some(g) => diffuse + g.weight(n, wi),
+        None => diffuse,
+    }
+}
+
 /// How the eye pass treats glass.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Branching {
@@ -172,10 +185,11 @@ impl EyeWalk<'_> {
         };
         let emitted = scene.emission(&hit, ray.dir);
         if emitted != DVec3::ZERO {
-            let light = scene.light_objects.iter().position(|&o| o == Some(hit.object));
-            let weight = match (from, light) {
-                (Some((p, pdf)), Some(k)) => power_heuristic(pdf, scene.lights[k].pdf(p, hit.point)),
-                _ => 1.0,
+            // After a followed lobe, an area light is weighed against its own sample there.
+            let light = || scene.light_objects.iter().position(|&o| o == Some(hit.object));
+            let weight = match from.and_then(|f| Some((f, light()?))) {
+                Some(((p, pdf), k)) => power_heuristic(pdf, scene.lights[k].pdf(p, hit.point)),
+                None => 1.0,
             };
             out.direct += throughput * emitted * weight;
         }
@@ -252,8 +266,8 @@ impl EyeWalk<'_> {
                     continue;
                 };
                 // Either side: a rough dielectric's lobes refract.
-                let cos = n.dot(ls.wi).abs();
-                if lobes.eval(n, wo, ls.wi) == DVec3::ZERO || self.scene.occluded_from_hit(hit, k, &ls) {
+                let f = lobes.eval(n, wo, ls.wi);
+                if f == DVec3::ZERO || self.scene.occluded_from_hit(hit, k, &ls) {
                     continue;
                 }
                 let weight = if light.is_area() {
@@ -262,7 +276,7 @@ impl EyeWalk<'_> {
                 } else {
                     1.0
                 };
-                out.direct += throughput * tint * lobes.eval(n, wo, ls.wi) * ls.incident * cos * weight;
+                out.direct += throughput * tint * f * ls.incident * n.dot(ls.wi).abs() * weight;
             }
         }
         if rng.random::<f64>() < share {
@@ -314,15 +328,9 @@ impl EyeWalk<'_> {
                 let Some(ls) = light.sample(hit.point, DVec2::ZERO) else {
                     continue;
                 };
-                let cos = n.dot(ls.wi);
-                let diffuse = if cos > 0.0 { weight } else { DVec3::ZERO };
-                // Glossy lobes may refract light from below.
-                let f = match glossy {
-                    Some(g) => diffuse + g.weight(n, ls.wi),
-                    None => diffuse,
-                };
+                let f = point_weight(weight, n, glossy.as_ref(), ls.wi);
                 if f != DVec3::ZERO && !scene.occluded_from_hit(hit, k, &ls) {
-                    out.direct += f * ls.incident * cos.abs();
+                    out.direct += f * ls.incident * n.dot(ls.wi).abs();
                 }
             }
         }
