@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Writes the Bézier-patch example scenes: scenes/pool.toml with assets/pool_water.obj (a
 bicubic B-spline water surface, 7×7 control points, so 4×4 Bézier patches), scenes/ring.toml (a
-mirror ring of 4 patches), scenes/ring_gold.toml (the ring in rough gold) and scenes/lens.toml (a biconvex lens of 2 patches).
+mirror ring of 4 patches), scenes/ring_gold.toml (the ring in rough gold) and scenes/lens.toml (a biconvex lens of 2 patches) and scenes/lens_dispersive.toml (the
+lens in SF11 glass), and scenes/prism.toml with assets/prism.obj (a dispersive prism).
 Run from the project folder: python3 assets/make_example_scenes.py"""
 import math
 
@@ -219,10 +220,8 @@ ring_scene("scenes/ring_gold.toml", """# The coffee-cup caustic from a ring of b
 conductor = "gold"
 roughness = 0.08""")
 
-open("scenes/lens.toml", "w").write(HEADER + """# A biconvex glass lens (two bicubic patches sharing their square rim) in front of a spot
-# light: the light is focused to a bright point on the wall behind it. Drag the lens's inner
-# control points to change its power and watch the spot sharpen or blur.
-
+def lens_scene(path, about, glass):
+    open(path, "w").write(HEADER + about + """
 [camera]
 position = [-2.2, 3.0, 5.0]
 look_at = [1.0, 1.3, 0.0]
@@ -237,7 +236,7 @@ max_depth = 10
 
 [materials.glass]
 type = "glass"
-ior = 1.5
+""" + glass + """
 
 [materials.wall]
 type = "diffuse"
@@ -281,4 +280,106 @@ material = "glass"
 patches = [
 """ + patch_toml(front) + ",\n" + patch_toml(back) + """,
 ]
+""")
+
+
+lens_scene("scenes/lens.toml", """# A biconvex glass lens (two bicubic patches sharing their square rim) in front of a spot
+# light: the light is focused to a bright point on the wall behind it. Drag the lens's inner
+# control points to change its power and watch the spot sharpen or blur.
+""", "ior = 1.5")
+lens_scene("scenes/lens_dispersive.toml", """# The lens of lens.toml in dense flint glass (SF11, whose index falls from 1.85 at 400 nm to
+# 1.77 at 700 nm): blue light is bent more and comes to a focus nearer the lens than red, so
+# the spot on the wall is ringed with colour (chromatic aberration).
+""", 'glass = "SF11"')
+
+# --- prism: an equilateral SF11 prism lit by a narrow beam at minimum deviation ---
+SIDE, CENTRE_Y, HALF_LENGTH = 0.9, 3.3, 0.5
+h = SIDE * math.sqrt(3) / 2
+tri = [(-SIDE / 2, CENTRE_Y - h / 3), (SIDE / 2, CENTRE_Y - h / 3), (0.0, CENTRE_Y + 2 * h / 3)]
+verts = [(x, y, z) for z in (HALF_LENGTH, -HALF_LENGTH) for (x, y) in tri]
+# Counter-clockwise seen from outside, so that each face's normal points out of the glass.
+faces = [(1, 2, 3), (4, 6, 5), (1, 4, 5), (1, 5, 2), (2, 5, 6), (2, 6, 3), (3, 6, 4), (3, 4, 1)]
+open("assets/prism.obj", "w").write(
+    "# An equilateral triangular prism (side %g, length %g), apex up; made by make_example_scenes.py\n"
+    % (SIDE, 2 * HALF_LENGTH)
+    + "".join("v %s %s %s\n" % tuple(fmt(c) for c in v) for v in verts)
+    + "".join("f %d %d %d\n" % f for f in faces))
+# SF11's index at 587.56 nm gives the angle of incidence of minimum deviation, the beam
+# inside then running parallel to the base.
+N_D, APEX = 1.78472, math.radians(60)
+incidence = math.asin(N_D * math.sin(APEX / 2))
+# The left face's inward normal points 30° below +x; the beam rises at the incidence less that.
+rise = incidence - APEX / 2
+beam = (math.cos(rise), math.sin(rise), 0.0)
+face_mid = ((tri[0][0] + tri[2][0]) / 2, (tri[0][1] + tri[2][1]) / 2, 0.0)
+spot = tuple(face_mid[k] - 3.0 * beam[k] for k in range(3))
+open("scenes/prism.toml", "w").write(HEADER + """# White light through a glass prism: a narrow beam from a spot light enters an equilateral
+# prism of dense flint glass (SF11) at the angle of least deviation and leaves spread into its
+# colours, violet bent most, which fall on the wall as a spectrum. A dim lamp above shows the
+# room.
+
+[camera]
+position = [0.6, 1.9, 3.8]
+look_at = [1.7, 2.1, 0.0]
+fov = 62
+width = 640
+height = 480
+
+[render]
+renderer = "ppm"
+photons_per_pass = 300000
+max_depth = 10
+
+[materials.prism]
+type = "glass"
+glass = "SF11"
+color = [1, 1, 1]
+
+[materials.wall]
+type = "diffuse"
+color = [0.8, 0.8, 0.8]
+
+[materials.floor]
+type = "diffuse"
+color = [0.45, 0.42, 0.4]
+
+[[lights]]
+type = "spot"
+position = """ + point(spot) + """
+direction = """ + point(beam) + """
+cone_angle = 0.8
+cone_falloff = 0.2
+power = 2.5
+
+[[lights]]
+type = "point"
+position = [-1.0, 5.0, 4.0]
+power = 250
+
+[[objects]]
+type = "plane"
+name = "wall"
+point = [3.5, 0, 0]
+normal = [-1, 0, 0]
+material = "wall"
+
+[[objects]]
+type = "plane"
+name = "back wall"
+point = [0, 0, -3.0]
+normal = [0, 0, 1]
+material = "wall"
+
+[[objects]]
+type = "plane"
+name = "floor"
+point = [0, 0, 0]
+normal = [0, 1, 0]
+material = "floor"
+
+[[objects]]
+type = "mesh"
+name = "prism"
+file = "../assets/prism.obj"
+material = "prism"
 """)

@@ -103,8 +103,8 @@ fn every_light_kind_over_a_plane_gives_the_closed_form() {
 /// path tracer's converged image mean agrees with photon mapping's, channel by channel, within
 /// 0.5 % either way (measured: within 0.42 %), with the lobe and without it (photon mapping weighs each photon by the
 /// full BSDF at its visible points), with the mirror sphere made of rough gold, whose lobe
-/// photon mapping gathers (α 0.2) or follows (α 0.02), and with the glass sphere frosted
-/// (α 0.1 and 0.4).
+/// photon mapping gathers (α 0.2) or follows (α 0.02), with the glass sphere frosted
+/// (α 0.1 and 0.4), and with it made of dispersive flint glass (SF11).
 #[test]
 fn the_cornell_box_converges_to_photon_mappings_mean() {
     use caustic::scene::MaterialKind;
@@ -134,13 +134,29 @@ fn the_cornell_box_converges_to_photon_mappings_mean() {
     let frosted = |roughness| {
         let mut scene = phong.clone();
         for m in &mut scene.materials {
-            if let MaterialKind::Glass { ior, .. } = m.kind {
-                m.kind = MaterialKind::Glass { ior, roughness };
+            if let MaterialKind::Glass { ior, dispersion, .. } = m.kind {
+                m.kind = MaterialKind::Glass {
+                    ior,
+                    roughness,
+                    dispersion,
+                };
             }
         }
         scene
     };
     let (frosted_a, frosted_b) = (frosted(0.1), frosted(0.4));
+    // The glass sphere made of dispersive flint glass (SF11).
+    let mut flint = phong.clone();
+    for m in &mut flint.materials {
+        if let MaterialKind::Glass { .. } = m.kind {
+            let dispersion = caustic::scene::glasses::Dispersion::named("SF11").expect("SF11");
+            m.kind = MaterialKind::Glass {
+                ior: dispersion.ior(0.0, caustic::scene::glasses::D_LINE_NM),
+                roughness: 0.0,
+                dispersion,
+            };
+        }
+    }
     for (name, scene, low, high) in [
         ("phong", &phong, -0.005, 0.005),
         ("lambert", &lambert, -0.005, 0.005),
@@ -148,6 +164,7 @@ fn the_cornell_box_converges_to_photon_mappings_mean() {
         ("rough gold α 0.02", &followed, -0.005, 0.005),
         ("frosted glass α 0.1", &frosted_a, -0.005, 0.005),
         ("frosted glass α 0.4", &frosted_b, -0.005, 0.005),
+        ("dispersive glass (SF11)", &flint, -0.005, 0.005),
     ] {
         let traced = path_traced(scene, 2048);
         let mut ppm = Ppm::new(scene, PpmOptions::default());

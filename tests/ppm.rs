@@ -205,6 +205,14 @@ fn ppm_is_identical_for_one_and_two_threads() {
         assert_eq!(a, b, "aperture {aperture}");
         assert!(a.iter().flatten().all(|c| c.is_finite()) && a.iter().any(|p| p[0] > 0.0));
     }
+    // Photons and eye paths that take a wavelength at a dispersive prism.
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/prism.toml");
+    let mut scene = Scene::load(&path).expect("prism");
+    (scene.camera.width, scene.camera.height) = (48, 36);
+    scene.params.photons_per_pass = 20_000;
+    let a = one.install(|| render_passes(&scene, PpmOptions::default(), 3));
+    let b = two.install(|| render_passes(&scene, PpmOptions::default(), 3));
+    assert_eq!(a, b, "prism");
 }
 
 /// A frame's per-pixel layers, swept in parallel blocks that each find their first slot by a

@@ -35,7 +35,9 @@ fn every_shipped_scene_loads_and_renders() {
         "inline_patch",
         "leaf",
         "lens",
+        "lens_dispersive",
         "pool",
+        "prism",
         "ring",
         "ring_gold",
         "scroll",
@@ -190,6 +192,26 @@ fn bad_scene_files_are_reported_clearly() {
         (
             scene_text("").replace("type = \"diffuse\"", "type = \"metal\"\neta = [0, 0.4, 1.4]\nk = [3, 2, 1]"),
             "'eta' components must be above 0 and at most 100",
+        ),
+        (
+            scene_text("").replace("type = \"diffuse\"", "type = \"glass\"\nglass = \"crown\""),
+            "[materials.m] (glass): unknown glass 'crown' (expected BK7, F2, SF11, fused silica)",
+        ),
+        (
+            scene_text("").replace("type = \"diffuse\"", "type = \"glass\"\nglass = \"BK7\"\nior = 1.5"),
+            "[materials.m] (glass): 'glass = \"BK7\"' gives the index itself: leave out 'ior' and 'abbe'",
+        ),
+        (
+            scene_text("").replace("type = \"diffuse\"", "type = \"glass\"\nabbe = 0.5"),
+            "[materials.m] (glass): 'abbe' must be between 1 and 1000, got 0.5",
+        ),
+        (
+            scene_text("").replace("type = \"diffuse\"", "type = \"glass\"\nior = 0.2\nabbe = 1"),
+            "[materials.m] (glass): 'abbe' 1 with 'ior' 0.2 gives an index of",
+        ),
+        (
+            scene_text("").replace("type = \"diffuse\"", "type = \"diffuse\"\nabbe = 40"),
+            "'abbe' does not apply to type 'diffuse'",
         ),
         (
             scene_text("").replace("type = \"diffuse\"", "type = \"mirror\"\nroughness = 1.5"),
@@ -511,6 +533,12 @@ fn renders_are_identical_for_one_and_two_threads() {
     assert_eq!(a.pixels, b.pixels);
     scene.camera.aperture = 0.2;
     scene.params.dof_samples = 4;
+    let a = one.install(|| render_whitted(&scene, &|_| {}).0);
+    let b = two.install(|| render_whitted(&scene, &|_| {}).0);
+    assert_eq!(a.pixels, b.pixels);
+    // A dispersive lens, which the ray tracer splits into a wavelength per channel.
+    let mut scene = Scene::load(&scenes_dir().join("lens_dispersive.toml")).expect("scene");
+    (scene.camera.width, scene.camera.height) = (64, 48);
     let a = one.install(|| render_whitted(&scene, &|_| {}).0);
     let b = two.install(|| render_whitted(&scene, &|_| {}).0);
     assert_eq!(a.pixels, b.pixels);

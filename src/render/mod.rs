@@ -1,7 +1,8 @@
 //! Renderers and what they render into: progressive photon mapping, the Whitted ray tracer,
 //! the film (linear RGB with tonemapping and PNG/EXR output, extra EXR layers), what an image
 //! records of its render ([`provenance`]), error against a reference or estimated
-//! ([`compare`], [`error`], [`error_tracker`]), deterministic random streams and low-discrepancy sequences, and
+//! ([`compare`], [`error`], [`error_tracker`]), deterministic random streams and low-discrepancy sequences, single
+//! wavelengths for dispersion ([`spectrum`], [`wavelength`]), and
 //! independent passes split across processes and merged ([`shard`]).
 
 pub mod bsdf;
@@ -19,6 +20,8 @@ pub mod rng;
 pub mod sequence;
 pub mod session;
 pub mod shard;
+pub mod spectrum;
+pub mod wavelength;
 pub mod whitted;
 
 pub use film::{Image, Layer, Metadata};

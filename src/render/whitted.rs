@@ -19,9 +19,11 @@ use rayon::prelude::*;
 use super::bsdf::Bsdf;
 use super::film::Image;
 use super::rng::{mix64, stream_rng, streams};
+use super::spectrum::channel_wavelengths;
+use super::wavelength::Wavelength;
 use crate::geometry::{Hit, Ray};
 use crate::scene::camera::{concentric_disk, EyeRays};
-use crate::scene::Scene;
+use crate::scene::{Scene, Surface};
 
 /// What a render did.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
@@ -34,13 +36,24 @@ pub struct WhittedStats {
     pub elapsed_secs: f64,
 }
 
-/// Per-path state: the hash of what the path touched, and the RNG for light samples.
+/// Per-path state: the hash of what the path touched, the RNG for light samples, and the
+/// wavelength the path traces after a dispersive glass split it.
 struct PathState<'r> {
     id: u64,
     rng: &'r mut Pcg64Mcg,
+    wavelength: Wavelength,
 }
 
-impl PathState<'_> {
+impl<'r> PathState<'r> {
+    /// A path of white light, having touched nothing yet.
+    fn new(rng: &'r mut Pcg64Mcg) -> Self {
+        Self {
+            id: 0,
+            rng,
+            wavelength: Wavelength::WHITE,
+        }
+    }
+
     fn touch(&mut self, v: u64) {
         self.id = mix64(self.id ^ v.wrapping_mul(0x9e37_79b9_7f4a_7c15));
     }
@@ -67,13 +80,13 @@ impl Tracer<'_> {
                 let cell = DVec2::new((s % grid) as f64, (s / grid % grid) as f64);
                 let lens = concentric_disk((cell + DVec2::new(rng.random(), rng.random())) / grid as f64);
                 let px = DVec2::new(x as f64 + rng.random::<f64>(), y as f64 + rng.random::<f64>());
-                let mut state = PathState { id: 0, rng: &mut rng };
+                let mut state = PathState::new(&mut rng);
                 sum += self.trace(&eye.ray(px, lens), 0, &mut state);
             }
             rays.fetch_add(n as usize, Ordering::Relaxed);
             (sum / n as f64, 0)
         } else {
-            let mut state = PathState { id: 0, rng: &mut rng };
+            let mut state = PathState::new(&mut rng);
             let px = Scene::pixel_center(x, y);
             let c = self.trace(&eye.ray(px, DVec2::ZERO), 0, &mut state);
             rays.fetch_add(1, Ordering::Relaxed);
@@ -92,7 +105,7 @@ impl Tracer<'_> {
                     x as f64 + (sx as f64 + 0.5) / 4.0,
                     y as f64 + (sy as f64 + 0.5) / 4.0,
                 );
-                let mut state = PathState { id: 0, rng: &mut rng };
+                let mut state = PathState::new(&mut rng);
                 sum += self.trace(&eye.ray(px, DVec2::ZERO), 0, &mut state);
             }
         }
@@ -111,12 +124,31 @@ impl Tracer<'_> {
         if scene.objects[hit.object as usize].emission.is_some() || depth >= scene.params.max_depth {
             return emitted;
         }
-        let bsdf = Bsdf::at(&scene.surface(&hit, ray.dir));
+        let surface = scene.surface(&hit, ray.dir);
+        if surface.material.is_dispersive() && state.wavelength.nm().is_none() {
+            // A dispersive glass splits white light into one wavelength per channel, each
+            // carrying its channel only: chromatic fringes without noise.
+            let mut split = DVec3::ZERO;
+            for (c, nm) in channel_wavelengths().into_iter().enumerate() {
+                state.wavelength = Wavelength::fixed(nm);
+                split[c] = self.shade(&hit, &surface, ray, depth, state)[c];
+            }
+            state.wavelength = Wavelength::WHITE;
+            return emitted + split;
+        }
+        emitted + self.shade(&hit, &surface, ray, depth, state)
+    }
+
+    /// The light a smooth or specular surface at `hit` sends back along `ray` (emission
+    /// aside), after at most `max_depth - depth` more bounces.
+    fn shade(&self, hit: &Hit, surface: &Surface, ray: &Ray, depth: u32, state: &mut PathState) -> DVec3 {
+        let scene = self.scene;
+        let bsdf = Bsdf::at(surface, state.wavelength);
         let wo = -ray.dir;
-        let mut radiance = emitted;
+        let mut radiance = DVec3::ZERO;
         if bsdf.has_smooth() {
             radiance += scene.params.ambient * bsdf.diffuse_reflectance();
-            radiance = self.add_direct_light(radiance, &hit, &bsdf, wo, state);
+            radiance = self.add_direct_light(radiance, hit, &bsdf, wo, state);
         }
         // Rough mirrors, metals and glass are followed as polished ones (beside their
         // highlights): a ray tracer follows delta lobes only.

@@ -169,8 +169,12 @@ pub struct MaterialDesc {
     pub specular: Option<Real>,
     /// Phong exponent.
     pub shininess: Option<Real>,
-    /// Glass index of refraction.
+    /// Glass index of refraction (at 587.56 nm when it varies).
     pub ior: Option<Real>,
+    /// A named glass whose index varies with the wavelength: BK7, F2, SF11, fused silica.
+    pub glass: Option<String>,
+    /// A glass's Abbe number, with `ior`: its index varies with the wavelength.
+    pub abbe: Option<Real>,
     /// GGX roughness α of mirrors and metals, in [0, 1] (0: smooth).
     pub roughness: Option<Real>,
     /// A named metal (`metal`): gold, silver, copper, aluminium.

@@ -1,7 +1,10 @@
 //! Materials: Lambertian diffuse with an optional Phong lobe, mirrors and metals (smooth or
-//! rough), and dielectric glass with exact Fresnel reflectance and total internal reflection.
+//! rough), and dielectric glass with exact Fresnel reflectance and total internal reflection, smooth or
+//! rough, its index constant or varying with the wavelength ([`super::glasses`]).
 
 use glam::DVec3;
+
+use super::glasses::Dispersion;
 
 /// A surface's reflectance model.
 #[derive(Clone, Debug, PartialEq)]
@@ -34,10 +37,12 @@ pub enum MaterialKind {
     /// Dielectric with index of refraction `ior` (relative to the outside, 1): smooth when
     /// `roughness` is 0, else GGX microfacets of that α (frosted glass).
     Glass {
-        /// Index of refraction.
+        /// Index of refraction (at the d line, 587.56 nm, where it varies).
         ior: f64,
         /// GGX roughness α (0: smooth).
         roughness: f64,
+        /// How the index varies with the wavelength.
+        dispersion: Dispersion,
     },
 }
 
@@ -59,6 +64,44 @@ impl Material {
     /// Whether photons stop here and radiance is estimated (diffuse surfaces).
     pub fn is_diffuse(&self) -> bool {
         matches!(self.kind, MaterialKind::Diffuse { .. })
+    }
+
+    /// Whether this material may be replaced by `new` in a live edit: the same name, model
+    /// and texture (colour and the model's numbers may change), every number in the range a
+    /// scene file may give it.
+    pub fn can_become(&self, new: &Material) -> bool {
+        let unit = |x: f64| (0.0..=1.0).contains(&x);
+        let numbers = match new.kind {
+            MaterialKind::Diffuse { specular, shininess } => {
+                unit(specular) && shininess.is_finite() && shininess >= 0.0
+            }
+            MaterialKind::Mirror { roughness } => unit(roughness),
+            MaterialKind::Metal { eta, k, roughness } => {
+                unit(roughness) && eta.is_finite() && k.is_finite() && eta.min_element() > 0.0
+            }
+            MaterialKind::Glass { ior, roughness, .. } => {
+                unit(roughness) && ior.is_finite() && ior > 0.0 && ior <= 100.0
+            }
+        };
+        let same_model = std::mem::discriminant(&self.kind) == std::mem::discriminant(&new.kind)
+            && match (&self.kind, &new.kind) {
+                (MaterialKind::Glass { dispersion: a, .. }, MaterialKind::Glass { dispersion: b, .. }) => {
+                    std::mem::discriminant(a) == std::mem::discriminant(b)
+                }
+                _ => true,
+            };
+        numbers
+            && same_model
+            && self.name == new.name
+            && self.texture == new.texture
+            && new.color.is_finite()
+            && new.color.cmpge(DVec3::ZERO).all()
+            && new.color.cmple(DVec3::ONE).all()
+    }
+
+    /// Whether light is split into its wavelengths here (a glass whose index varies).
+    pub fn is_dispersive(&self) -> bool {
+        matches!(self.kind, MaterialKind::Glass { dispersion, .. } if dispersion.is_dispersive())
     }
 }
 

@@ -4,6 +4,7 @@
 
 pub mod camera;
 pub mod format;
+pub mod glasses;
 pub mod light;
 mod load;
 pub mod material;

@@ -37,6 +37,8 @@ pub use glossy::{phong, Glossy};
 pub use mirror::Mirror;
 pub use rough_dielectric::RoughDielectric;
 
+use super::wavelength::Wavelength;
+use crate::scene::glasses::Dispersion;
 use crate::scene::material::{Material, MaterialKind};
 use crate::scene::{Scene, Surface};
 
@@ -130,10 +132,15 @@ pub enum Bsdf {
 }
 
 impl Bsdf {
-    /// The BSDF of `surface` (its material, colour, side and normal): the one list of
-    /// materials.
-    pub fn at(surface: &Surface) -> Self {
+    /// The BSDF of `surface` (its material, colour, side and normal) for light of
+    /// `wavelength` (which only a dispersive glass asks; white light sees its nominal index):
+    /// the one list of materials.
+    pub fn at(surface: &Surface, wavelength: Wavelength) -> Self {
         let (color, n) = (surface.color, surface.normal);
+        let index = |ior: f64, dispersion: Dispersion| match wavelength.nm() {
+            Some(nm) => dispersion.ior(ior, nm),
+            None => ior,
+        };
         match surface.material.kind {
             MaterialKind::Diffuse { specular, shininess } => Bsdf::Diffuse(Diffuse {
                 color,
@@ -154,15 +161,27 @@ impl Bsdf {
                 alpha: roughness,
                 n,
             }),
-            MaterialKind::Glass { ior, roughness } if roughness <= 0.0 => Bsdf::Dielectric(Dielectric {
-                color,
+            MaterialKind::Glass {
                 ior,
+                roughness,
+                dispersion,
+            } if roughness <= 0.0 => Bsdf::Dielectric(Dielectric {
+                color,
+                ior: index(ior, dispersion),
                 entering: surface.front,
                 n,
             }),
-            MaterialKind::Glass { ior, roughness } => Bsdf::RoughDielectric(RoughDielectric {
+            MaterialKind::Glass {
+                ior,
+                roughness,
+                dispersion,
+            } => Bsdf::RoughDielectric(RoughDielectric {
                 color,
-                eta: if surface.front { ior } else { 1.0 / ior },
+                eta: if surface.front {
+                    index(ior, dispersion)
+                } else {
+                    1.0 / index(ior, dispersion)
+                },
                 alpha: roughness,
                 n,
             }),

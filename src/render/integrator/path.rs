@@ -34,6 +34,7 @@ use crate::render::rng::stream_rng;
 use crate::render::sequence;
 use crate::render::bsdf::Bsdf;
 use crate::render::mis::power_heuristic;
+use crate::render::wavelength::Wavelength;
 use crate::scene::Scene;
 use crate::settings::RendererKind;
 
@@ -130,6 +131,7 @@ impl Path<'_> {
         let scene = self.scene;
         let max_bounces = scene.params.max_depth.max(1) * 4;
         let (mut radiance, mut beta) = (DVec3::ZERO, DVec3::ONE);
+        let mut wavelength = Wavelength::WHITE;
         // The last bounce's origin and BSDF density (None: a specular lobe or the camera).
         let mut last_diffuse: Option<(DVec3, f64)> = None;
         for bounce in 0..=max_bounces {
@@ -150,7 +152,9 @@ impl Path<'_> {
             if scene.objects[hit.object as usize].emission.is_some() || bounce == max_bounces {
                 return radiance;
             }
-            let bsdf = Bsdf::at(&scene.surface(&hit, ray.dir));
+            let surface = scene.surface(&hit, ray.dir);
+            beta *= wavelength.meet(surface.material, || self.rng.random());
+            let bsdf = Bsdf::at(&surface, wavelength);
             let wo = -ray.dir;
             if bsdf.has_smooth() {
                 radiance += beta * self.next_event(&hit, &bsdf, wo);

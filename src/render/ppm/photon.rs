@@ -15,6 +15,7 @@ use super::guide::EmissionGuide;
 use crate::geometry::Ray;
 use crate::render::bsdf::Bsdf;
 use crate::render::sequence;
+use crate::render::wavelength::Wavelength;
 use crate::scene::Scene;
 
 /// Counters of one batch of photons.
@@ -62,6 +63,9 @@ pub struct PhotonSource<'a> {
     /// When photons are stratified: the digital shift of the Sobol points that choose their
     /// lights and directions ([`sequence::sobol_any`]); `None`, every number is random.
     pub stratified: Option<u64>,
+    /// The wavelength every photon starts with: white light ([`Wavelength::WHITE`]), which
+    /// takes one wavelength at the first dispersive glass it meets, or one fixed wavelength.
+    pub wavelength: Wavelength,
 }
 
 /// The chance that a photon comes from each of the scene's lights: in proportion to power.
@@ -101,6 +105,7 @@ impl<'a> PhotonSource<'a> {
             skip_direct: direct_light,
             guide: None,
             stratified: None,
+            wavelength: Wavelength::WHITE,
         }
     }
 
@@ -117,6 +122,12 @@ impl<'a> PhotonSource<'a> {
             stratified: shift,
             ..self
         }
+    }
+
+    /// The same source emitting light of one `wavelength` only (its colour weight is not
+    /// applied: each photon keeps the light's flux).
+    pub fn with_wavelength(self, wavelength: Wavelength) -> Self {
+        Self { wavelength, ..self }
     }
 
     /// The light that `x` in [0, 1) picks (the power share it falls in) and `x` rescaled to
@@ -184,6 +195,7 @@ impl<'a> PhotonSource<'a> {
         counts.paths += 1;
         let mut first_interaction = true;
         let mut indirect = false;
+        let mut wavelength = self.wavelength;
         for _depth in 0..scene.params.max_depth.max(1) * 4 {
             let Some(hit) = scene.geometry.intersect(&ray, f64::INFINITY) else {
                 return emitted;
@@ -192,7 +204,9 @@ impl<'a> PhotonSource<'a> {
             if scene.objects[hit.object as usize].emission.is_some() {
                 return emitted;
             }
-            let bsdf = Bsdf::at(&scene.surface(&hit, ray.dir));
+            let surface = scene.surface(&hit, ray.dir);
+            flux *= wavelength.meet(surface.material, || rng.random());
+            let bsdf = Bsdf::at(&surface, wavelength);
             let wo = -ray.dir;
             if bsdf.has_smooth() {
                 if !(skip_first && first_interaction) {

@@ -21,6 +21,7 @@ use crate::geometry::Hit;
 use crate::geometry::Ray;
 use crate::render::bsdf::{Bsdf, Glossy};
 use crate::render::mis::power_heuristic;
+use crate::render::wavelength::Wavelength;
 use crate::scene::{Light, Scene};
 
 /// Where photons are gathered for one pixel (or one branch of one pixel's eye path).
@@ -150,7 +151,7 @@ pub fn trace_eye(
         branching,
         shadow_rays,
     };
-    walk.walk(ray, DVec3::ONE, 0, rng, &mut out, None);
+    walk.walk(ray, (DVec3::ONE, Wavelength::WHITE), 0, rng, &mut out, None);
     out.direct
 }
 
@@ -169,7 +170,7 @@ impl EyeWalk<'_> {
     fn walk(
         &self,
         ray: &Ray,
-        throughput: DVec3,
+        (throughput, mut wavelength): (DVec3, Wavelength),
         depth: u32,
         rng: &mut Pcg64Mcg,
         out: &mut EyeOut,
@@ -196,11 +197,16 @@ impl EyeWalk<'_> {
         if scene.objects[hit.object as usize].emission.is_some() || depth >= scene.params.max_depth {
             return;
         }
-        let bsdf = Bsdf::at(&scene.surface(&hit, ray.dir));
+        let surface = scene.surface(&hit, ray.dir);
+        let throughput = throughput * wavelength.meet(surface.material, || rng.random());
+        let bsdf = Bsdf::at(&surface, wavelength);
         let wo = -ray.dir;
         if bsdf.has_smooth() {
             match bsdf.glossy().filter(|(g, _)| self.follows(g, &bsdf)) {
-                Some(lobes) => self.near_specular(&hit, &bsdf, lobes, (wo, throughput), depth, rng, out),
+                Some(lobes) => {
+                    let arrival = (wo, throughput, wavelength);
+                    self.near_specular(&hit, &bsdf, lobes, arrival, depth, rng, out)
+                }
                 None => self.visible_point(&hit, &bsdf, (wo, throughput), true, out),
             }
         }
@@ -210,14 +216,21 @@ impl EyeWalk<'_> {
                 for lobe in lobes.iter() {
                     let next = hit.spawn(lobe.wi);
                     let carried = throughput * lobe.share * lobe.tint * bsdf.radiance_scale(wo, lobe.wi);
-                    self.walk(&next, carried, depth + 1, rng, out, None);
+                    self.walk(&next, (carried, wavelength), depth + 1, rng, out, None);
                 }
             }
             (Branching::Choose { .. }, _) => {
                 let first = &mut out.first_choice;
                 if let Some(lobe) = lobes.choose(|| first.take().unwrap_or_else(|| rng.random())) {
                     let carried = throughput * lobe.tint * bsdf.radiance_scale(wo, lobe.wi);
-                    self.walk(&hit.spawn(lobe.wi), carried, depth + 1, rng, out, None);
+                    self.walk(
+                        &hit.spawn(lobe.wi),
+                        (carried, wavelength),
+                        depth + 1,
+                        rng,
+                        out,
+                        None,
+                    );
                 }
             }
         }
@@ -238,7 +251,7 @@ impl EyeWalk<'_> {
             && lobes.roughness() < self.scene.params.near_specular * lobe_share(lobes, bsdf)
     }
 
-    /// At a smooth surface, arriving from `wo` with `throughput`, whose glossy lobes the path
+    /// At a smooth surface, arriving from `wo` with `throughput` and `wavelength`, whose glossy lobes the path
     /// follows: either the lobes (picked with their share of the reflectance: the path goes on
     /// along a direction sampled from them) or a visible point that gathers the diffuse lobe
     /// alone, each weighted by one over its chance. The lobes' direct light is found here,
@@ -252,7 +265,7 @@ impl EyeWalk<'_> {
         hit: &Hit,
         bsdf: &Bsdf,
         (lobes, tint): (Glossy, DVec3),
-        (wo, throughput): (DVec3, DVec3),
+        (wo, throughput, wavelength): (DVec3, DVec3, Wavelength),
         depth: u32,
         rng: &mut Pcg64Mcg,
         out: &mut EyeOut,
@@ -286,7 +299,7 @@ impl EyeWalk<'_> {
                 let from = Some((hit.point, share * s.pdf));
                 self.walk(
                     &next,
-                    throughput * tint * s.weight / share,
+                    (throughput * tint * s.weight / share, wavelength),
                     depth + 1,
                     rng,
                     out,

@@ -5,6 +5,7 @@ use toml::Spanned;
 
 use super::diagnostics::{v3, Ctx, Result, Table};
 use crate::scene::format::{MaterialDesc, ScaleDesc, TextureDesc};
+use crate::scene::glasses::{self, Dispersion};
 use crate::scene::material::{Material, MaterialKind};
 use crate::scene::metals;
 use crate::scene::texture::{Mapping, Texture, TextureSource};
@@ -62,6 +63,8 @@ fn kind(t: &Table, d: &MaterialDesc) -> Result<MaterialKind> {
         ("conductor", d.conductor.is_some()),
         ("eta", d.eta.is_some()),
         ("k", d.k.is_some()),
+        ("glass", d.glass.is_some()),
+        ("abbe", d.abbe.is_some()),
     ];
     let roughness = || -> Result<f64> {
         let r = d.roughness.map_or(0.0, |r| r.0);
@@ -106,10 +109,12 @@ fn kind(t: &Table, d: &MaterialDesc) -> Result<MaterialKind> {
             }
         }
         "glass" => {
-            t.only("glass", &given, &["color", "ior", "roughness"])?;
+            t.only("glass", &given, &["color", "ior", "roughness", "glass", "abbe"])?;
+            let (ior, dispersion) = glass(t, d)?;
             MaterialKind::Glass {
-                ior: t.positive("ior", d.ior.map_or(1.5, |r| r.0))?,
+                ior,
                 roughness: roughness()?,
+                dispersion,
             }
         }
         other => {
@@ -119,6 +124,38 @@ fn kind(t: &Table, d: &MaterialDesc) -> Result<MaterialKind> {
         }
     };
     Ok(kind)
+}
+
+/// A glass's nominal index and its dispersion: a named `glass` (its own index), or `ior`
+/// (default 1.5) with an optional Abbe number `abbe` (at least 1).
+fn glass(t: &Table, d: &MaterialDesc) -> Result<(f64, Dispersion)> {
+    if let Some(name) = &d.glass {
+        if d.ior.is_some() || d.abbe.is_some() {
+            return Err(t.err(format!(
+                "'glass = \"{name}\"' gives the index itself: leave out 'ior' and 'abbe'"
+            )));
+        }
+        let dispersion = Dispersion::named(name)
+            .ok_or_else(|| t.err(format!("unknown glass '{name}' (expected {})", glasses::names())))?;
+        return Ok((dispersion.ior(0.0, glasses::D_LINE_NM), dispersion));
+    }
+    let ior = t.positive("ior", d.ior.map_or(1.5, |r| r.0))?;
+    let Some(abbe) = d.abbe.map(|r| r.0) else {
+        return Ok((ior, Dispersion::None));
+    };
+    if !(1.0..=1000.0).contains(&abbe) {
+        return Err(t.err(format!("'abbe' must be between 1 and 1000, got {abbe}")));
+    }
+    let dispersion = Dispersion::abbe(ior, abbe);
+    // Cauchy's curve for an index below 1 falls with the wavelength and may reach 0.
+    let lowest = [360.0, 830.0].map(|nm| dispersion.ior(ior, nm));
+    if lowest.iter().any(|&n| n <= 0.01) {
+        return Err(t.err(format!(
+            "'abbe' {abbe} with 'ior' {ior} gives an index of {:.3} at the spectrum's end",
+            lowest[0].min(lowest[1])
+        )));
+    }
+    Ok((ior, dispersion))
 }
 
 /// A metal's `(η, k)`: a named `conductor`, or `eta` and `k` both given (each channel finite,
