@@ -895,3 +895,88 @@ fn frame_all_brings_a_far_light_into_view() {
     assert!(proj.view.contains(s), "{s:?} outside {:?}", proj.view);
     assert!(edge_markers(&proj, viewer(&h).lights()).is_empty());
 }
+
+/// The material of the selected point's patch, in the side panel: its roughness changed by a
+/// slider drag (two steps of one drag) is one undo step, a second drag another, the render
+/// session is told, undo and redo restore it, a value out of range is refused, and the saved
+/// scene carries the new roughness and loads back to the edited material.
+#[test]
+fn the_selected_patchs_material_is_edited_undone_and_saved() {
+    use caustic::app::action::Action;
+    use caustic::scene::MaterialKind;
+    let mut h = editing_app();
+    let (r, at) = isolated_point(viewer(&h));
+    pointer(&mut h, at, PointerButton::Primary, true, Modifiers::NONE);
+    pointer(&mut h, at, PointerButton::Primary, false, Modifiers::NONE);
+    h.run_steps(2);
+    let scene = viewer(&h).scene().clone();
+    let index = scene.objects[scene.geometry.patches()[r.patch].1 as usize].material;
+    let before = scene.materials[index].clone();
+    assert!(
+        h.query_by_label_contains(&format!("Material '{}'", before.name))
+            .is_some(),
+        "the panel names the selected patch's material"
+    );
+    let rough = |alpha: f64| {
+        let mut m = before.clone();
+        match &mut m.kind {
+            MaterialKind::Mirror { roughness }
+            | MaterialKind::Metal { roughness, .. }
+            | MaterialKind::Glass { roughness, .. } => *roughness = alpha,
+            other => panic!("the built-in scene's patches are glass or mirror, not {other:?}"),
+        }
+        m
+    };
+    let v = h.state_mut().as_mut().expect("viewer");
+    // Two steps of one drag, then out of range: refused, nothing sent.
+    for (alpha, drag) in [(0.05, Some(7)), (0.1, Some(7)), (2.0, None)] {
+        v.apply(Action::SetMaterial {
+            material: index,
+            value: rough(alpha),
+            drag,
+        });
+    }
+    h.run_steps(2);
+    assert_eq!(viewer(&h).scene().materials[index], rough(0.1));
+    let told: Vec<_> = sent(&h)
+        .into_iter()
+        .filter_map(|c| match c {
+            Command::SetMaterial { material, value } => Some((material, value)),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(told, vec![(index, rough(0.05)), (index, rough(0.1))]);
+    let v = h.state_mut().as_mut().expect("viewer");
+    v.apply(Action::Undo);
+    assert_eq!(
+        v.scene().materials[index],
+        before,
+        "one undo step undoes the drag"
+    );
+    v.apply(Action::Redo);
+    assert_eq!(v.scene().materials[index], rough(0.1));
+    // A second drag is a second step.
+    for alpha in [0.15, 0.2] {
+        v.apply(Action::SetMaterial {
+            material: index,
+            value: rough(alpha),
+            drag: Some(8),
+        });
+    }
+    v.apply(Action::Undo);
+    assert_eq!(
+        v.scene().materials[index],
+        rough(0.1),
+        "the second drag is its own step"
+    );
+    assert!(v.unsaved_edits());
+
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("rough.toml");
+    v.save_scene_to(path.clone());
+    h.step();
+    let text = std::fs::read_to_string(&path).expect("saved");
+    assert!(text.contains("roughness = 0.1"), "{text}");
+    let back = Scene::load(&path).expect("the saved scene loads");
+    assert_eq!(back.materials[index], rough(0.1));
+}

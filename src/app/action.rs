@@ -142,6 +142,16 @@ pub enum Action {
     SetPoint(Handle, DVec3),
     /// Move the selection by a step in screen points (arrow keys).
     Nudge(Vec2),
+    /// Give material `material` new numbers (the panel's material controls); the steps of
+    /// one slider drag (the same `drag` token) are one undo step.
+    SetMaterial {
+        /// Material index in the scene.
+        material: usize,
+        /// The material as it is to be.
+        value: crate::scene::Material,
+        /// The drag it is a step of (a token unique to one press of the mouse), if any.
+        drag: Option<u64>,
+    },
     /// Turn and move the camera to frame the selection (or every patch).
     FrameSelection,
     /// Undo the last edit.

@@ -226,6 +226,25 @@ impl Viewer {
                 let after = (self.scene().camera.clone(), self.editor.pivot);
                 self.record(Edit::Camera { before, after });
             }
+            Action::SetMaterial {
+                material,
+                value,
+                drag,
+            } => {
+                let Some(before) = self.document.scene().materials.get(material).cloned() else {
+                    return;
+                };
+                let Some(change) = self.state.document.set_material(material, value.clone()) else {
+                    return;
+                };
+                self.send_change(change);
+                let edit = Edit::Material {
+                    index: material,
+                    before: Box::new(before),
+                    after: Box::new(value),
+                };
+                self.editor.history.record_in_drag(edit, drag);
+            }
             Action::Undo => {
                 if let Some(edit) = self.editor.history.undo() {
                     self.replay(edit);
@@ -245,6 +264,7 @@ impl Viewer {
         let empty = match &edit {
             Edit::Points(moves) => moves.is_empty(),
             Edit::Camera { before, after } => before == after,
+            Edit::Material { before, after, .. } => before == after,
         };
         if !empty {
             self.editor.history.record(edit);
@@ -278,6 +298,11 @@ impl Viewer {
                 self.move_points(&targets);
             }
             Edit::Camera { after, .. } => self.set_camera(after.0, after.1),
+            Edit::Material { index, after, .. } => {
+                if let Some(change) = self.state.document.set_material(index, *after) {
+                    self.send_change(change);
+                }
+            }
         }
     }
 

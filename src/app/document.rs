@@ -1,6 +1,6 @@
 //! The scene being edited ([`Document`]): the one copy of it in the viewer. The widgets read
-//! it; every edit — render parameters, lens, camera pose, control points, lights — changes it
-//! and answers with the [`Change`]s that bring the render session's own copy along.
+//! it; every edit — render parameters, lens, camera pose, control points, lights, materials —
+//! changes it and answers with the [`Change`]s that bring the render session's own copy along.
 
 use std::path::Path;
 
@@ -9,7 +9,7 @@ use glam::DVec3;
 use super::handle::PointRef;
 use crate::geometry::BezierPatch;
 use crate::render::session::Command;
-use crate::scene::{Camera, Light, Scene};
+use crate::scene::{Camera, Light, Material, Scene};
 use crate::settings::RenderParams;
 
 /// An edit as the render session hears of it.
@@ -68,6 +68,29 @@ impl Document {
     /// The lights as edited (scene order).
     pub fn lights(&self) -> &[Light] {
         &self.scene.lights
+    }
+
+    /// The materials as edited (scene order).
+    pub fn materials(&self) -> &[Material] {
+        &self.scene.materials
+    }
+
+    /// The material of the object patch `k` belongs to (its index in the scene).
+    pub fn patch_material(&self, k: usize) -> Option<usize> {
+        let (_, object) = self.scene.geometry.patches().get(k)?;
+        self.scene.objects.get(*object as usize).map(|o| o.material)
+    }
+
+    /// Replaces material `k` (`None` when it has no such material, nothing changes, or
+    /// `value` is not one it can become: [`Material::can_become`]).
+    pub fn set_material(&mut self, k: usize, value: Material) -> Option<Change> {
+        let current = self.scene.materials.get(k)?;
+        if *current == value || !current.can_become(&value) {
+            return None;
+        }
+        self.scene.materials[k] = value.clone();
+        let command = Command::SetMaterial { material: k, value };
+        Some(Change::new(command, &self.scene.params))
     }
 
     /// The document was written to `path` as `text`: from now on that file is the scene's,

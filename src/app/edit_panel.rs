@@ -1,5 +1,5 @@
 //! The side panel's editing section: the Edit menu's commands as buttons, the selection, exact
-//! coordinates of a selected control point, saving the scene.
+//! coordinates of a selected control point, its patch's material, saving the scene.
 
 use egui::RichText;
 
@@ -8,6 +8,7 @@ use super::commands::{Menu, COMMANDS};
 use super::document::Document;
 use super::editor::Editor;
 use super::handle::{Handle, LightPart};
+use super::material_panel::material_ui;
 use super::state::ViewerState;
 
 /// Three fields for a point's x, y, z; `Some` with the new position when one was changed.
@@ -39,6 +40,7 @@ pub fn edit_panel_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Acti
         out.push(Action::ShowWireframe(nets));
     }
     selection_ui(editor, &viewer.document, ui, out);
+    material_ui(viewer, ui, out);
     // The Edit menu's commands, as buttons.
     ui.horizontal_wrapped(|ui| {
         for c in COMMANDS.iter().filter(|c| c.menu == Menu::Edit) {

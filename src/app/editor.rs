@@ -1,6 +1,6 @@
 //! Shaping patches and placing lights by hand: the selection and hover of their handles
 //! ([`Handle`]), the gesture in progress (dragging handles, or orbiting/panning/dollying the
-//! camera), and the undo history. The control points and lights themselves are the
+//! camera), and the undo history (handles, the camera, materials). The control points and lights themselves are the
 //! document's ([`Document`]): the editor keeps the state of editing and does the geometry of a
 //! gesture; the viewer ([`super::Viewer::apply`]) carries actions out and sends the document's
 //! changes to the render session.
@@ -16,7 +16,7 @@ use super::handle::{light_handles, light_place, Handle, LightPart, LightRef};
 use super::navigate;
 use super::overlay::{control_points, overlay_geometry, OverlayProjection, PICK_RADIUS};
 use crate::gpu::wireframe::WireframeGeometry;
-use crate::scene::{Camera, Light, Scene};
+use crate::scene::{Camera, Light, Material, Scene};
 
 /// Radians of orbit per point dragged.
 const ORBIT_PER_POINT: f64 = 0.008;
@@ -71,6 +71,15 @@ pub enum Edit {
         /// After.
         after: (Camera, DVec3),
     },
+    /// A material's colour or numbers.
+    Material {
+        /// Material index in the scene.
+        index: usize,
+        /// Before.
+        before: Box<Material>,
+        /// After.
+        after: Box<Material>,
+    },
 }
 
 impl Edit {
@@ -79,6 +88,11 @@ impl Edit {
         match self {
             Edit::Points(moves) => Edit::Points(moves.iter().map(|(r, a, b)| (*r, *b, *a)).collect()),
             Edit::Camera { before, after } => Edit::Camera {
+                before: after.clone(),
+                after: before.clone(),
+            },
+            Edit::Material { index, before, after } => Edit::Material {
+                index: *index,
                 before: after.clone(),
                 after: before.clone(),
             },
@@ -91,6 +105,8 @@ impl Edit {
 pub struct History {
     done: Vec<(u64, Edit)>,
     undone: Vec<(u64, Edit)>,
+    /// The material and drag token of the last change made by a drag, if it was.
+    drag: Option<(usize, u64)>,
     next_id: u64,
     saved: u64,
 }
@@ -98,9 +114,41 @@ pub struct History {
 impl History {
     /// Records a new change (clearing what could be redone).
     pub fn record(&mut self, edit: Edit) {
+        self.drag = None;
         self.next_id += 1;
         self.done.push((self.next_id, edit));
         self.undone.clear();
+    }
+
+    /// Records `edit`, a step of the drag `drag` (a token for one press of the mouse) if
+    /// any: the steps of one drag that edit the same material are one change.
+    pub fn record_in_drag(&mut self, edit: Edit, drag: Option<u64>) {
+        let Edit::Material { index, after, .. } = &edit else {
+            return self.record(edit);
+        };
+        let token = drag.map(|d| (*index, d));
+        let same_drag = token.is_some() && token == self.drag && self.undone.is_empty();
+        match self.done.pop() {
+            Some((
+                _,
+                Edit::Material {
+                    index: last, before, ..
+                },
+            )) if same_drag && last == *index => {
+                // A new id: the merged step is not the one a save may have marked.
+                self.record(Edit::Material {
+                    index: last,
+                    before,
+                    after: after.clone(),
+                });
+            }
+            other => {
+                self.done.extend(other);
+                self.record(edit);
+            }
+        }
+        // After the record, which forgets the drag of any other change.
+        self.drag = token;
     }
 
     /// The change to apply to undo the last one.

@@ -9,7 +9,8 @@
 //! - [`viewer`], [`state`]: what runs the viewer and what its widgets read; `window`: the
 //!   frame ([`Viewer::ui`] is what eframe and the tests run).
 //! - [`action`]: every request as an [`action::Action`]; [`Viewer::apply`] carries them out.
-//! - [`controls`], [`edit_panel`]: menu, side panel, status bar, dialog windows.
+//! - [`controls`], [`edit_panel`], [`material_panel`]: menu, side panel, status bar, dialog
+//!   windows.
 //! - [`overlay`], [`editor`], [`view_input`], [`navigate`]: the control-net overlay's
 //!   projection and geometry, the editing state and undo history, the mouse over the image,
 //!   and camera moves (drawn by [`crate::gpu::wireframe`]); [`light_markers`]: where the
@@ -44,6 +45,7 @@ pub mod image_view;
 pub mod job;
 pub mod keys;
 pub mod light_markers;
+pub mod material_panel;
 pub mod navigate;
 pub mod overlay;
 pub mod params;

@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use glam::DVec3;
 use toml_edit::{Array, DocumentMut, Item, Table, Value};
 
-use super::{Camera, Light, RenderParams, Scene};
+use super::{Camera, Light, Material, MaterialKind, RenderParams, Scene};
 use crate::files::{write_atomically, WriteError};
 use crate::geometry::{BezierPatch, Window};
 
@@ -127,6 +127,7 @@ pub fn scene_toml(
     write_patches(&mut doc, scene, loaded);
     if let Some(o) = &original {
         write_changed_lights(&mut doc, scene, &o.lights);
+        write_changed_materials(&mut doc, scene, &o.materials);
     }
     if let (Some(base), Some(out)) = (&scene.base_dir, out_dir) {
         let same = base
@@ -299,6 +300,62 @@ fn write_changed_lights(doc: &mut DocumentMut, scene: &Scene, original: &[Light]
             }
             (Light::Sphere { center: p, .. }, Light::Sphere { center: q, .. }) => set("center", p, q),
             (Light::Quad { corner: p, .. }, Light::Quad { corner: q, .. }) => set("corner", p, q),
+            _ => {}
+        }
+    }
+}
+
+/// Writes the colour and numbers of each material that differs from `original` (the file's)
+/// into its `[materials.NAME]` table; every other key stays as written.
+fn write_changed_materials(doc: &mut DocumentMut, scene: &Scene, original: &[Material]) {
+    let Some(tables) = doc.get_mut("materials").and_then(Item::as_table_like_mut) else {
+        return;
+    };
+    for (m, before) in scene.materials.iter().zip(original) {
+        let Some(t) = tables.get_mut(&m.name).and_then(Item::as_table_like_mut) else {
+            continue;
+        };
+        if m == before {
+            continue;
+        }
+        if m.color != before.color {
+            t.insert("color", toml_edit::value(vec3(m.color)));
+        }
+        let named_glass = t.contains_key("glass");
+        let mut set = |key: &str, now: f64, was: f64| {
+            if now != was {
+                t.insert(key, toml_edit::value(now));
+            }
+        };
+        match (&m.kind, &before.kind) {
+            (
+                MaterialKind::Diffuse { specular, shininess },
+                MaterialKind::Diffuse {
+                    specular: s0,
+                    shininess: n0,
+                },
+            ) => {
+                set("specular", *specular, *s0);
+                set("shininess", *shininess, *n0);
+            }
+            (MaterialKind::Mirror { roughness }, MaterialKind::Mirror { roughness: r0 })
+            | (MaterialKind::Metal { roughness, .. }, MaterialKind::Metal { roughness: r0, .. }) => {
+                set("roughness", *roughness, *r0);
+            }
+            (
+                MaterialKind::Glass { ior, roughness, .. },
+                MaterialKind::Glass {
+                    ior: i0,
+                    roughness: r0,
+                    ..
+                },
+            ) => {
+                set("roughness", *roughness, *r0);
+                // A named glass's index is its own (the file may not give one).
+                if !named_glass {
+                    set("ior", *ior, *i0);
+                }
+            }
             _ => {}
         }
     }

@@ -35,6 +35,14 @@ pub enum Command {
         /// The light as it now is.
         value: crate::scene::Light,
     },
+    /// Replaces material `material` (its colour and model's numbers; the same model, a
+    /// texture kept); restarts, cold: every pixel may change.
+    SetMaterial {
+        /// Material index in the scene.
+        material: usize,
+        /// The material as it now is.
+        value: crate::scene::Material,
+    },
     /// Stop between batches, keeping everything.
     Pause,
     /// Continue after [`Command::Pause`].
@@ -54,6 +62,7 @@ impl Command {
             Command::SetCamera(_)
             | Command::MoveControlPoint { .. }
             | Command::SetLight { .. }
+            | Command::SetMaterial { .. }
             | Command::Restart => true,
             Command::Pause | Command::Resume | Command::Shutdown => false,
         }
@@ -66,8 +75,14 @@ impl Command {
     }
 }
 
-/// Whether a command's values are valid for a scene with `patches` patches and `lights`.
-pub(super) fn valid(command: &Command, patches: usize, lights: &[crate::scene::Light]) -> bool {
+/// Whether a command's values are valid for a scene with `patches` patches, `lights` and
+/// `materials`.
+pub(super) fn valid(
+    command: &Command,
+    patches: usize,
+    lights: &[crate::scene::Light],
+    materials: &[crate::scene::Material],
+) -> bool {
     match command {
         Command::SetParams(p) => p.validate().is_ok(),
         Command::SetCamera(c) => {
@@ -82,11 +97,14 @@ pub(super) fn valid(command: &Command, patches: usize, lights: &[crate::scene::L
             position,
         } => *patch < patches && *index < 16 && position.is_finite(),
         Command::SetLight { light, value } => lights.get(*light).is_some_and(|l| l.can_become(value)),
+        Command::SetMaterial { material, value } => {
+            materials.get(*material).is_some_and(|m| m.can_become(value))
+        }
         Command::Pause | Command::Resume | Command::Restart | Command::Shutdown => true,
     }
 }
 
-/// Applies the camera and control points of the commands that restart the accumulation to
+/// Applies the camera, control points, lights and materials of the commands that restart the accumulation to
 /// the scene, in order. Control-point moves are gathered so that each edited patch is
 /// re-prepared once, however many steps of a drag arrived together (the latest position of
 /// each point wins).
@@ -97,6 +115,11 @@ pub fn apply_to_scene(scene: &mut Scene, commands: Vec<Command>) {
             Command::SetCamera(c) => scene.camera = c,
             Command::SetLight { light, value } => {
                 scene.set_light(light, value);
+            }
+            Command::SetMaterial { material, value } => {
+                if let Some(m) = scene.materials.get_mut(material) {
+                    *m = value;
+                }
             }
             Command::MoveControlPoint {
                 patch,

@@ -119,10 +119,12 @@ pub struct SessionState {
     patches: usize,
     /// The scene's lights (their kinds, for checking [`Command::SetLight`]).
     lights: Vec<crate::scene::Light>,
+    /// The scene's materials (their models, for checking [`Command::SetMaterial`]).
+    materials: Vec<crate::scene::Material>,
     /// Passes completed in this epoch (the ray-traced frame counts as one).
     pub passes: u32,
     pub(super) preview_due: bool,
-    /// Camera and control-point commands for the next epoch.
+    /// Camera, control-point, light and material commands for the next epoch.
     pending: Vec<Command>,
     /// A restart is waiting.
     restart_due: bool,
@@ -155,6 +157,7 @@ impl SessionState {
             params: scene.params.clone(),
             patches: scene.geometry.patches().len(),
             lights: scene.lights.clone(),
+            materials: scene.materials.clone(),
             passes: 0,
             preview_due: options.preview_divisor.is_some(),
             pending: Vec::new(),
@@ -166,7 +169,7 @@ impl SessionState {
 
     /// Takes a command.
     pub fn apply(&mut self, command: Command) -> Effect {
-        if !valid(&command, self.patches, &self.lights) {
+        if !valid(&command, self.patches, &self.lights, &self.materials) {
             return Effect::Ignored;
         }
         let restarts = command.restarts(&self.params);
@@ -187,6 +190,7 @@ impl SessionState {
             Command::SetCamera(_)
             | Command::MoveControlPoint { .. }
             | Command::SetLight { .. }
+            | Command::SetMaterial { .. }
             | Command::Restart => self.pending.push(command),
         }
         if restarts {
