@@ -164,7 +164,8 @@ struct EyeWalk<'s> {
 }
 
 impl EyeWalk<'_> {
-    /// Follows `ray` carrying `throughput` to the diffuse surfaces it reaches; `from` is where
+    /// Follows `ray` carrying `throughput` and its wavelength (white light until a dispersive
+    /// glass fixes one, [`Wavelength::meet`]) to the diffuse surfaces it reaches; `from` is where
     /// and with what density a followed glossy lobe sampled it (an area light it meets is
     /// weighed against the light sampled there), `None` after a delta lobe or the camera.
     fn walk(
