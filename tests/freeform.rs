@@ -15,6 +15,17 @@ use glam::DVec3;
 /// An OBJ file of one bicubic B-spline surface over an `nu` × `nv` grid of points (heights
 /// from a fixed wave), with the given knots and range.
 fn bspline_obj(nu: usize, nv: usize, u_knots: &[f64], v_knots: &[f64], range: [f64; 4]) -> String {
+    surface_obj(("bspline", [3, 3]), (nu, nv), (u_knots, v_knots), range)
+}
+
+/// An OBJ file of one surface of type `kind` and `degrees` over an `nu` × `nv` grid of points
+/// (heights from a fixed wave), with the given `parm` values and range.
+fn surface_obj(
+    (kind, degrees): (&str, [usize; 2]),
+    (nu, nv): (usize, usize),
+    (u_knots, v_knots): (&[f64], &[f64]),
+    range: [f64; 4],
+) -> String {
     let mut text = String::from("# test surface\n");
     for j in 0..nv {
         for i in 0..nu {
@@ -26,7 +37,9 @@ fn bspline_obj(nu: usize, nv: usize, u_knots: &[f64], v_knots: &[f64], range: [f
     let indices: Vec<String> = (1..=nu * nv).map(|k| k.to_string()).collect();
     let join = |k: &[f64]| k.iter().map(f64::to_string).collect::<Vec<_>>().join(" ");
     text += &format!(
-        "cstype bspline\ndeg 3 3\nsurf {} {} {} {} {}\nparm u {}\nparm v {}\nend\n",
+        "cstype {kind}\ndeg {} {}\nsurf {} {} {} {} {}\nparm u {}\nparm v {}\nend\n",
+        degrees[0],
+        degrees[1],
         range[0],
         range[1],
         range[2],
@@ -230,8 +243,16 @@ fn malformed_surfaces_are_errors_naming_the_file_and_line() {
             "surface.obj:19: control point on line 16 has weight 2",
         ),
         (
+            format!("{p}cstype bspline\ndeg 4 3\n{SURF}\nparm u 0 0 0 0 0 1 1 1 1 1\nparm v 0 0 0 0 1 1 1 1\nend\n"),
+            "surface.obj:19: degree 4 along u is not supported ('deg 4 3' on line 18); surfaces of degree 1 to 3 are",
+        ),
+        (
+            format!("{p}cstype bspline\ndeg 3\n{SURF}\nparm u 0 0 0 0 1 1 1 1\nparm v 0 0 0 0 1 1 1 1\nend\n"),
+            "surface.obj:19: 'deg' needs two degrees, along u and v, ('deg 3' on line 18)",
+        ),
+        (
             format!("{p}cstype bspline\ndeg 2 2\n{SURF}\nparm u 0 0 0 1 1 1\nparm v 0 0 0 1 1 1\nend\n"),
-            "surface.obj:19: only bicubic surfaces ('deg 3 3') are supported; 'deg 2 2' is set on line 18",
+            "surface.obj:19: the surface lists 16 control points; its 'parm' lines (lines 20 and 21) need 3 × 3 = 9",
         ),
         (
             format!("{p}cstype bspline\ndeg 3 3\n{SURF}\nparm u 0 0 0 0 1 1 1 1\nend\n"),
@@ -243,7 +264,7 @@ fn malformed_surfaces_are_errors_naming_the_file_and_line() {
         ),
         (
             format!("{p}cstype bspline\ndeg 3 3\nsurf 0 1 0 1 1 2 3 4 5 6 7 8\nparm u 0 0 0 0 1 1 1 1\nparm v 0 0 0 1 1 1\nend\n"),
-            "surface.obj:21: a cubic needs at least 4 control points along v, found 2",
+            "surface.obj:21: a curve of degree 3 needs at least 4 control points along v, found 2",
         ),
         (
             format!("{p}cstype bspline\ndeg 3 3\n{SURF}\nparm u 0 0 0 0 1 1 0.5 1\nparm v 0 0 0 0 1 1 1 1\nend\n"),
@@ -437,4 +458,113 @@ fn inputs_past_the_stated_limits_are_refused_early() {
             .contains("many.bpt:1: the file declares 600000 patches; a scene holds at most 500000"),
         "{err}"
     );
+}
+
+/// The B-spline basis function `N_{i,p}(t)` by the Cox–de Boor recursion (half-open spans; the
+/// domain's last point belongs to the last non-empty span): an evaluation independent of the
+/// reader's knot insertion.
+fn basis(knots: &[f64], i: usize, p: usize, t: f64, last: bool) -> f64 {
+    if p == 0 {
+        let inside = knots[i] <= t && t < knots[i + 1];
+        let at_end = last && t == knots[i + 1] && knots[i] < knots[i + 1];
+        return f64::from(u8::from(inside || at_end));
+    }
+    let mut n = 0.0;
+    if knots[i + p] > knots[i] {
+        n += (t - knots[i]) / (knots[i + p] - knots[i]) * basis(knots, i, p - 1, t, last);
+    }
+    if knots[i + p + 1] > knots[i + 1] {
+        n += (knots[i + p + 1] - t) / (knots[i + p + 1] - knots[i + 1]) * basis(knots, i + 1, p - 1, t, last);
+    }
+    n
+}
+
+/// A surface for the elevation test: type, degrees, points along u and v, `parm` lines, range.
+type Case<'a> = (
+    &'a str,
+    [usize; 2],
+    (usize, usize),
+    (&'a [f64], &'a [f64]),
+    [f64; 4],
+);
+
+/// Surfaces of degree 1 and 2 (B-splines with unclamped and repeated knots, and Bézier
+/// surfaces) equal the bicubic patches they are read as, at 1,000 parameters each, within
+/// 1e-12 (the patch holding each parameter found by its window).
+#[test]
+fn degree_one_and_two_surfaces_equal_their_elevated_bicubic_patches() {
+    let cases: [Case; 4] = [
+        (
+            "bspline",
+            [2, 2],
+            (5, 4),
+            (&[0., 1., 2., 3., 4., 5., 6., 7.], &[0., 0., 0., 1., 2., 2., 2.]),
+            [2.0, 5.0, 0.0, 2.0],
+        ),
+        (
+            "bspline",
+            [1, 2],
+            (4, 5),
+            (&[0., 0., 1., 2.5, 3., 3.], &[0., 0., 0., 1., 1., 2., 2., 2.]),
+            [0.0, 3.0, 0.0, 2.0],
+        ),
+        (
+            "bspline",
+            [2, 1],
+            (6, 3),
+            (&[0., 1., 2., 2., 3., 4., 5., 6., 7.], &[0., 0., 1., 2., 2.]),
+            [2.5, 4.5, 0.0, 2.0],
+        ),
+        (
+            "bezier",
+            [2, 1],
+            (5, 3),
+            (&[0., 1., 3.], &[0., 0.5, 1.]),
+            [0.0, 3.0, 0.0, 1.0],
+        ),
+    ];
+    for (kind, [pu, pv], (nu, nv), (u_parm, v_parm), range) in cases {
+        let text = surface_obj((kind, [pu, pv]), (nu, nv), (u_parm, v_parm), range);
+        let patches = parse(&text).unwrap_or_else(|e| panic!("{kind} {pu}×{pv}: {e}"));
+        let points = vertices(&text);
+        // A Bézier surface's breakpoints as knots: ends p + 1 times, the rest p times.
+        let knots = |parm: &[f64], p: usize| -> Vec<f64> {
+            if kind == "bspline" {
+                return parm.to_vec();
+            }
+            let last = parm.len() - 1;
+            parm.iter()
+                .enumerate()
+                .flat_map(|(k, &b)| std::iter::repeat_n(b, if k == 0 || k == last { p + 1 } else { p }))
+                .collect()
+        };
+        let (uk, vk) = (knots(u_parm, pu), knots(v_parm, pv));
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..1000 {
+            let u = range[0] + next() * (range[1] - range[0]);
+            let v = range[2] + next() * (range[3] - range[2]);
+            let mut expected = DVec3::ZERO;
+            for j in 0..nv {
+                for i in 0..nu {
+                    let w = basis(&uk, i, pu, u, u == range[1]) * basis(&vk, j, pv, v, v == range[3]);
+                    expected += points[i + nu * j] * w;
+                }
+            }
+            let (patch, w) = patches
+                .iter()
+                .find(|(_, w)| (w.u0..=w.u1).contains(&u) && (w.v0..=w.v1).contains(&v))
+                .expect("a patch holds every parameter of the range");
+            let got = patch.eval((u - w.u0) / (w.u1 - w.u0), (v - w.v0) / (w.v1 - w.v0));
+            assert!(
+                (got - expected).length() < 1e-12,
+                "{kind} of degree {pu}×{pv} at ({u}, {v}): patch {got}, surface {expected}"
+            );
+        }
+    }
 }

@@ -1,8 +1,10 @@
-//! Non-rational cubic B-spline surfaces turned into Bézier patches by knot insertion.
+//! Non-rational B-spline surfaces of degree 1 to 3 turned into bicubic Bézier patches by knot
+//! insertion (and, below degree 3, exact degree elevation of each segment:
+//! [`super::elevate`]).
 //!
 //! Boehm's algorithm (W. Boehm, "Inserting new knots into B-spline curves", CAD 12(4), 1980)
 //! inserts a knot without changing the curve. Inserting every distinct knot of the domain until
-//! it has multiplicity 3 (the degree) makes the control polygon of each knot span the Bézier
+//! its multiplicity is the degree makes the control polygon of each knot span the Bézier
 //! control polygon of that span. Done one insertion at a time, each shifting the whole vector,
 //! that costs time quadratic in the knots; instead the range's two ends are inserted (a
 //! constant number of insertions), the curve outside the range dropped, and the clamped curve
@@ -17,30 +19,36 @@
 use glam::DVec3;
 
 use super::bezier::BezierPatch;
+use super::elevate::to_cubic;
 use super::patch::Window;
 
-/// The degree handled here: bicubic.
+/// The degree of the patches made here: bicubic (lower degrees are raised to it).
 pub const DEGREE: usize = 3;
 
 /// Why a B-spline could not be converted. The messages name the knots and counts concerned;
 /// the caller adds the file and line.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum BsplineError {
-    /// The knot vector's length does not match the control points (`points + 4` knots).
-    #[error("{points} control points along {axis} need {} knots, the 'parm {axis}' line gives {knots}", points + DEGREE + 1)]
+    /// The knot vector's length does not match the control points (`points + degree + 1`
+    /// knots).
+    #[error("{points} control points along {axis} need {} knots, the 'parm {axis}' line gives {knots}", points + degree + 1)]
     KnotCount {
         /// `u` or `v`.
         axis: char,
         /// Control points along the axis.
         points: usize,
+        /// The degree along the axis.
+        degree: usize,
         /// Knots given.
         knots: usize,
     },
-    /// Too few control points for a cubic.
-    #[error("a cubic needs at least 4 control points along {axis}, found {points}")]
+    /// Too few control points for the degree.
+    #[error("a curve of degree {degree} needs at least {} control points along {axis}, found {points}", degree + 1)]
     TooFewPoints {
         /// `u` or `v`.
         axis: char,
+        /// The degree along the axis.
+        degree: usize,
         /// Control points along the axis.
         points: usize,
     },
@@ -67,29 +75,47 @@ pub enum BsplineError {
         start: f64,
         /// Range end.
         end: f64,
-        /// The domain's start (knot 4).
+        /// The domain's start (knot `degree + 1`).
         low: f64,
         /// The domain's end (knot `points + 1`).
         high: f64,
     },
 }
 
-/// A cubic B-spline curve's knots along one axis, checked against its control point count.
+/// A B-spline curve's knots along one axis and its degree, checked against its control point
+/// count.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Knots {
     values: Vec<f64>,
+    degree: usize,
 }
 
 impl Knots {
-    /// Checks `values` for `points` control points along `axis` (for messages).
+    /// Checks `values` for a cubic of `points` control points along `axis` (for messages).
     pub fn new(values: Vec<f64>, points: usize, axis: char) -> Result<Knots, BsplineError> {
-        if points < DEGREE + 1 {
-            return Err(BsplineError::TooFewPoints { axis, points });
+        Self::of_degree(values, points, axis, DEGREE)
+    }
+
+    /// Checks `values` for a curve of `degree` (1 to 3) with `points` control points along
+    /// `axis`.
+    pub fn of_degree(
+        values: Vec<f64>,
+        points: usize,
+        axis: char,
+        degree: usize,
+    ) -> Result<Knots, BsplineError> {
+        assert!(
+            (1..=DEGREE).contains(&degree),
+            "degree {degree}: the caller checks 1 to 3"
+        );
+        if points < degree + 1 {
+            return Err(BsplineError::TooFewPoints { axis, degree, points });
         }
-        if values.len() != points + DEGREE + 1 {
+        if values.len() != points + degree + 1 {
             return Err(BsplineError::KnotCount {
                 axis,
                 points,
+                degree,
                 knots: values.len(),
             });
         }
@@ -104,18 +130,18 @@ impl Knots {
                 });
             }
         }
-        Ok(Knots { values })
+        Ok(Knots { values, degree })
     }
 
-    /// The knots of a piecewise cubic Bézier curve with `breakpoints` (each segment's ends):
-    /// every inner breakpoint three times, the ends four times.
-    pub fn from_breakpoints(breakpoints: &[f64]) -> Vec<f64> {
-        let mut values = Vec::with_capacity(3 * breakpoints.len() + 2);
+    /// The knots of a piecewise Bézier curve of `degree` with `breakpoints` (each segment's
+    /// ends): every inner breakpoint `degree` times, the ends once more.
+    pub fn from_breakpoints(breakpoints: &[f64], degree: usize) -> Vec<f64> {
+        let mut values = Vec::with_capacity(degree * breakpoints.len() + 2);
         for (k, b) in breakpoints.iter().enumerate() {
             let copies = if k == 0 || k + 1 == breakpoints.len() {
-                4
+                degree + 1
             } else {
-                3
+                degree
             };
             values.extend(std::iter::repeat_n(*b, copies));
         }
@@ -127,10 +153,15 @@ impl Knots {
         &self.values
     }
 
-    /// The valid parameter domain `[t_3, t_n]` (0-based knots, `n` control points).
+    /// The degree of the curve.
+    pub fn degree(&self) -> usize {
+        self.degree
+    }
+
+    /// The valid parameter domain `[t_p, t_n]` (0-based knots, degree `p`, `n` control points).
     pub fn domain(&self) -> (f64, f64) {
-        let n = self.values.len() - DEGREE - 1;
-        (self.values[DEGREE], self.values[n])
+        let n = self.values.len() - self.degree - 1;
+        (self.values[self.degree], self.values[n])
     }
 
     /// How many Bézier spans the range `[start, end]` holds: one more than its distinct knots
@@ -181,25 +212,21 @@ impl<const N: usize> Lerp for [DVec3; N] {
     }
 }
 
-/// Inserts knot `t` (within the domain) once into `knots` and `points` (Boehm 1980); the curve
-/// is unchanged.
-fn insert_knot<T: Lerp>(knots: &mut Vec<f64>, points: &mut Vec<T>, t: f64) {
-    // The span k in [3, n] with knots[k] <= t <= knots[k + 1] (the last such span for a
+/// Inserts knot `t` (within the domain) once into the curve of degree `p` (`knots`, `points`)
+/// (Boehm 1980); the curve is unchanged.
+fn insert_knot<T: Lerp>(knots: &mut Vec<f64>, points: &mut Vec<T>, t: f64, p: usize) {
+    // The span k in [p, n] with knots[k] <= t <= knots[k + 1] (the last such span for a
     // repeated knot; at the domain's end, the last span).
     let n = points.len() - 1;
-    let k = knots
-        .iter()
-        .rposition(|&u| u <= t)
-        .unwrap_or(DEGREE)
-        .clamp(DEGREE, n);
+    let k = knots.iter().rposition(|&u| u <= t).unwrap_or(p).clamp(p, n);
     let mut out = Vec::with_capacity(points.len() + 1);
     for i in 0..=points.len() {
-        let q = if i + DEGREE <= k {
+        let q = if i + p <= k {
             points[i]
         } else if i > k {
             points[i - 1]
         } else {
-            let span = knots[i + DEGREE] - knots[i];
+            let span = knots[i + p] - knots[i];
             let a = if span > 0.0 { (t - knots[i]) / span } else { 0.0 };
             points[i - 1].lerp_to(points[i], a)
         };
@@ -214,38 +241,43 @@ fn multiplicity(knots: &[f64], t: f64) -> usize {
     knots.iter().filter(|&&u| u == t).count()
 }
 
-/// The curve (`knots`, `points`) over `[start, end]` (within its domain) as a clamped curve:
-/// each end inserted to multiplicity 3 (at most six insertions), then the knots and points
-/// outside the range dropped, the ends given multiplicity 4.
-fn clamped_to<T: Lerp>(knots: &[f64], points: &[T], start: f64, end: f64) -> (Vec<f64>, Vec<T>) {
-    let (mut u, mut p) = (knots.to_vec(), points.to_vec());
+/// The curve of degree `p` (`knots`, `points`) over `[start, end]` (within its domain) as a
+/// clamped curve: each end inserted to multiplicity `p` (at most `2p` insertions), then the
+/// knots and points outside the range dropped, the ends given multiplicity `p + 1`.
+fn clamped_to<T: Lerp>(
+    knots: &[f64],
+    points: &[T],
+    (start, end): (f64, f64),
+    p: usize,
+) -> (Vec<f64>, Vec<T>) {
+    let (mut u, mut q) = (knots.to_vec(), points.to_vec());
     for t in [start, end] {
-        while multiplicity(&u, t) < DEGREE {
-            insert_knot(&mut u, &mut p, t);
+        while multiplicity(&u, t) < p {
+            insert_knot(&mut u, &mut q, t, p);
         }
     }
-    // With `start` at knots first..=last (multiplicity ≥ 3), the curve from `start` on has the
-    // points from last - 3; symmetrically up to `end`.
-    let last_start = u.iter().rposition(|&x| x == start).unwrap_or(DEGREE);
-    let first_end = u.iter().position(|&x| x == end).unwrap_or(u.len() - DEGREE - 1);
-    let first_point = last_start.saturating_sub(DEGREE);
-    let last_point = first_end.saturating_sub(1).min(p.len() - 1);
-    let mut knots = vec![start; DEGREE + 1];
+    // With `start` at knots first..=last (multiplicity ≥ p), the curve from `start` on has the
+    // points from last - p; symmetrically up to `end`.
+    let last_start = u.iter().rposition(|&x| x == start).unwrap_or(p);
+    let first_end = u.iter().position(|&x| x == end).unwrap_or(u.len() - p - 1);
+    let first_point = last_start.saturating_sub(p);
+    let last_point = first_end.saturating_sub(1).min(q.len() - 1);
+    let mut knots = vec![start; p + 1];
     knots.extend_from_slice(&u[last_start + 1..first_end]);
-    knots.extend(std::iter::repeat_n(end, DEGREE + 1));
-    (knots, p[first_point..=last_point].to_vec())
+    knots.extend(std::iter::repeat_n(end, p + 1));
+    (knots, q[first_point..=last_point].to_vec())
 }
 
-/// The Bézier segments of a clamped cubic curve (its first and last four knots equal): Piegl &
-/// Tiller's algorithm A5.6, which raises each interior knot to multiplicity 3 within a
-/// four-point window as it walks the knots once. Interior knots of multiplicity 4 or more (a
-/// break in the curve) start a new segment from the points after them.
-fn decompose<T: Lerp>(u: &[f64], points: &[T]) -> Vec<Segment<T>> {
-    let p = DEGREE;
+/// The Bézier segments of a clamped curve of degree `p` (its first and last `p + 1` knots
+/// equal), each `p + 1` points and its interval: Piegl & Tiller's algorithm A5.6, which raises
+/// each interior knot to multiplicity `p` within a window of `p + 1` points as it walks the
+/// knots once. Interior knots of multiplicity above `p` (a break in the curve) start a new
+/// segment from the points after them.
+fn decompose<T: Lerp>(u: &[f64], points: &[T], p: usize) -> Vec<(Vec<T>, (f64, f64))> {
     let m = u.len() - 1;
     let mut out = Vec::new();
-    let mut q: [T; 4] = std::array::from_fn(|i| points[i]);
-    let mut next: [T; 4] = q;
+    let mut q: Vec<T> = points[..=p].to_vec();
+    let mut next = q.clone();
     let (mut a, mut b) = (p, p + 1);
     while b < m {
         let i = b;
@@ -256,14 +288,8 @@ fn decompose<T: Lerp>(u: &[f64], points: &[T]) -> Vec<Segment<T>> {
         if mult < p {
             // Insert u[b] (p - mult) times into the window q.
             let numer = u[b] - u[a];
-            let alphas: [f64; DEGREE] = std::array::from_fn(|j| {
-                if j < p - mult {
-                    numer / (u[a + mult + 1 + j] - u[a])
-                } else {
-                    0.0
-                }
-            });
             let r = p - mult;
+            let alphas: Vec<f64> = (0..r).map(|j| numer / (u[a + mult + 1 + j] - u[a])).collect();
             for j in 1..=r {
                 let s = mult + j;
                 for k in (s..=p).rev() {
@@ -275,12 +301,12 @@ fn decompose<T: Lerp>(u: &[f64], points: &[T]) -> Vec<Segment<T>> {
                 }
             }
         }
-        out.push((q, (u[a], u[b])));
+        out.push((q.clone(), (u[a], u[b])));
         if b < m {
             for k in (p - mult)..=p {
                 next[k] = points[b - p + k];
             }
-            q = next;
+            q.clone_from(&next);
             a = b;
             b += 1;
         }
@@ -291,47 +317,49 @@ fn decompose<T: Lerp>(u: &[f64], points: &[T]) -> Vec<Segment<T>> {
 /// One Bézier segment of a curve: its four control points and its parameter interval.
 pub type Segment<T> = ([T; 4], (f64, f64));
 
-/// The Bézier segments of the cubic B-spline curve (`points`, `knots`) over `[start, end]`:
-/// each segment's four control points and its parameter interval, in order.
+/// The cubic Bézier segments of the B-spline curve (`points`, `knots`) over `[start, end]`:
+/// each segment's four control points (raised exactly to degree 3 where the curve's degree is
+/// lower) and its parameter interval, in order.
 pub fn bezier_segments<T: Lerp>(
     points: &[T],
     knots: &Knots,
     start: f64,
     end: f64,
 ) -> Vec<([T; 4], (f64, f64))> {
-    let (u, p) = clamped_to(&knots.values, points, start, end);
-    decompose(&u, &p)
+    let p = knots.degree;
+    let (u, q) = clamped_to(&knots.values, points, (start, end), p);
+    decompose(&u, &q, p)
+        .into_iter()
+        .map(|(segment, interval)| (to_cubic(&segment), interval))
+        .collect()
 }
 
-/// A point of the cubic B-spline curve (`points`, `knots`) at `t` in its domain, by de Boor's
+/// A point of the B-spline curve (`points`, `knots`) at `t` in its domain, by de Boor's
 /// algorithm.
 pub fn de_boor(points: &[DVec3], knots: &Knots, t: f64) -> DVec3 {
-    let u = &knots.values;
+    let (u, p) = (&knots.values, knots.degree);
     let n = points.len();
-    // The non-empty span k in [3, n-1] with u[k] <= t (the last span at the domain's end).
-    let k = (DEGREE..n)
-        .rev()
-        .find(|&k| u[k] <= t && u[k] < u[k + 1])
-        .unwrap_or(DEGREE);
-    let mut d: Vec<DVec3> = (0..=DEGREE).map(|j| points[j + k - DEGREE]).collect();
-    for r in 1..=DEGREE {
-        for j in (r..=DEGREE).rev() {
-            let i = j + k - DEGREE;
-            let a = (t - u[i]) / (u[i + DEGREE + 1 - r] - u[i]);
+    // The non-empty span k in [p, n-1] with u[k] <= t (the last span at the domain's end).
+    let k = (p..n).rev().find(|&k| u[k] <= t && u[k] < u[k + 1]).unwrap_or(p);
+    let mut d: Vec<DVec3> = (0..=p).map(|j| points[j + k - p]).collect();
+    for r in 1..=p {
+        for j in (r..=p).rev() {
+            let i = j + k - p;
+            let a = (t - u[i]) / (u[i + p + 1 - r] - u[i]);
             d[j] = d[j - 1].lerp_to(d[j], a);
         }
     }
-    d[DEGREE]
+    d[p]
 }
 
-/// A bicubic B-spline surface: control points `points[i + nu * j]` (`i` along `u` varying
+/// A B-spline surface of degree 1 to 3 along each axis: control points `points[i + nu * j]` (`i` along `u` varying
 /// fastest, as Wavefront OBJ lists them), knots along `u` and `v`, and the parameter range
 /// to convert.
 #[derive(Clone, Debug)]
 pub struct BsplineSurface {
     /// Control points, `u` fastest.
     pub points: Vec<DVec3>,
-    /// Knots along `u` (`nu + 4` values).
+    /// Knots along `u` (`nu + degree + 1` values).
     pub u_knots: Knots,
     /// Knots along `v`.
     pub v_knots: Knots,
@@ -342,7 +370,7 @@ pub struct BsplineSurface {
 impl BsplineSurface {
     /// Control points along `u`.
     pub fn nu(&self) -> usize {
-        self.u_knots.values.len() - DEGREE - 1
+        self.u_knots.values.len() - self.u_knots.degree - 1
     }
 
     /// A point of the surface, by de Boor along `u` on every row, then along `v`.
@@ -355,7 +383,7 @@ impl BsplineSurface {
         de_boor(&column, &self.v_knots, v)
     }
 
-    /// The Bézier patches of the surface over its range, each with its `(u,v)` window in the
+    /// The bicubic Bézier patches of the surface over its range, each with its `(u,v)` window in the
     /// surface's own parameters, ordered by `u` span, then `v` span.
     pub fn to_bezier(&self) -> Vec<(BezierPatch, Window)> {
         let nu = self.nu();

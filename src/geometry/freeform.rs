@@ -1,6 +1,8 @@
-//! Wavefront OBJ free-form surfaces in and out: the bicubic, non-rational `cstype bezier` and
-//! `cstype bspline` surfaces that CAD programs (Rhino, for one) export, read as Bézier patches
-//! with their parameter windows, and patches written back as `cstype bezier` surfaces.
+//! Wavefront OBJ free-form surfaces in and out: the non-rational `cstype bezier` and `cstype
+//! bspline` surfaces of degree 1 to 3 along each axis that CAD programs (Rhino, for one)
+//! export, read as bicubic Bézier patches (lower degrees raised exactly,
+//! [`super::elevate`]) with their parameter windows, and patches written back as `cstype
+//! bezier` surfaces.
 //!
 //! The statements read (Wavefront's *Object Files* appendix B1, "Free-form curve/surface
 //! attributes" and "body statements"): `v x y z [w]`, `cstype [rat] bezier|bspline`,
@@ -47,7 +49,7 @@ pub struct FreeformError {
 /// A Bézier patch and its `(u,v)` window in the parameters of the surface it came from.
 pub type DomainPatch = (BezierPatch, Window);
 
-/// Reads every bicubic free-form surface of an OBJ file as Bézier patches, a line at a time:
+/// Reads every free-form surface (degree 1 to 3) of an OBJ file as bicubic Bézier patches, a line at a time:
 /// what the reader keeps beyond the patches is the `v` points (40 bytes each) and the open
 /// surface's indices, whatever else the file holds.
 pub fn load_freeform_obj(path: &Path) -> Result<Vec<DomainPatch>, FreeformError> {
@@ -247,7 +249,7 @@ impl Reader<'_> {
             "trim" | "hole" | "scrv" | "sp" if self.surface.is_some() => {
                 return Err(self.err(
                     line,
-                    format!("'{keyword}': trimmed surfaces and curves on surfaces are not supported (only whole bicubic surfaces)"),
+                    format!("'{keyword}': trimmed surfaces and curves on surfaces are not supported (only whole surfaces)"),
                 ))
             }
             "end" => {
@@ -339,9 +341,9 @@ impl Reader<'_> {
         Ok(())
     }
 
-    /// Whether the open surface is a Bézier surface (else a B-spline): checks its type,
-    /// degree and weights.
-    fn check_kind(&self, open: &OpenSurface) -> Result<bool, FreeformError> {
+    /// Whether the open surface is a Bézier surface (else a B-spline), and its degrees along
+    /// `u` and `v`: checks its type, degree and weights.
+    fn check_kind(&self, open: &OpenSurface) -> Result<(bool, [usize; 2]), FreeformError> {
         let line = open.line;
         let bezier = match &open.cstype {
             None => return Err(self.err(line, "the surface has no 'cstype' before it".to_owned())),
@@ -349,9 +351,9 @@ impl Reader<'_> {
                 return Err(self.err(
                     line,
                     format!(
-                        "rational surfaces ('cstype rat {}', line {}) are not supported; only non-rational bicubic ones",
-                        c.name, c.line
-                    ),
+                    "rational surfaces ('cstype rat {}', line {}) are not supported; only non-rational ones",
+                    c.name, c.line
+                ),
                 ))
             }
             Some(c) => match c.name.as_str() {
@@ -360,24 +362,23 @@ impl Reader<'_> {
                 other => {
                     return Err(self.err(
                         line,
-                        format!("'cstype {other}' (line {}) is not supported; only 'bezier' and 'bspline'", c.line),
+                        format!(
+                            "'cstype {other}' (line {}) is not supported; only 'bezier' and 'bspline'",
+                            c.line
+                        ),
                     ))
                 }
             },
         };
-        match &open.degree {
-            Some((d, _)) if d == &["3", "3"] => {}
-            Some((d, dline)) => {
+        let degrees = match &open.degree {
+            Some((d, dline)) => self.degrees(d, *dline, line)?,
+            None => {
                 return Err(self.err(
                     line,
-                    format!(
-                        "only bicubic surfaces ('deg 3 3') are supported; 'deg {}' is set on line {dline}",
-                        d.join(" ")
-                    ),
+                    "the surface has no 'deg' line before it (such as 'deg 3 3')".to_owned(),
                 ))
             }
-            None => return Err(self.err(line, "the surface has no 'deg 3 3' before it".to_owned())),
-        }
+        };
         if let Some(v) = open
             .indices
             .iter()
@@ -392,7 +393,33 @@ impl Reader<'_> {
                 ),
             ));
         }
-        Ok(bezier)
+        Ok((bezier, degrees))
+    }
+
+    /// The degrees along `u` and `v` of a `deg` line (`dline`) set for the surface on `line`:
+    /// each 1, 2 or 3.
+    fn degrees(&self, d: &[String], dline: usize, line: usize) -> Result<[usize; 2], FreeformError> {
+        let refuse = |what: String| {
+            self.err(
+                line,
+                format!(
+                    "{what} ('deg {}' on line {dline}); surfaces of degree 1 to 3 are",
+                    d.join(" ")
+                ),
+            )
+        };
+        let [du, dv] = d else {
+            return Err(refuse("'deg' needs two degrees, along u and v,".to_owned()));
+        };
+        let mut out = [0; 2];
+        for (k, (axis, value)) in [('u', du), ('v', dv)].into_iter().enumerate() {
+            out[k] = match value.parse::<usize>() {
+                Ok(n @ 1..=DEGREE) => n,
+                Ok(n) => return Err(refuse(format!("degree {n} along {axis} is not supported"))),
+                Err(_) => return Err(refuse(format!("'{value}' is not a degree along {axis}"))),
+            };
+        }
+        Ok(out)
     }
 
     /// The knot values of one `parm` line (a Bézier surface's breakpoints made knots), with
@@ -400,7 +427,7 @@ impl Reader<'_> {
     fn knot_values(
         &self,
         open: &OpenSurface,
-        axis: char,
+        (axis, degree): (char, usize),
         bezier: bool,
         end_line: usize,
     ) -> Result<(Vec<f64>, usize), FreeformError> {
@@ -420,7 +447,7 @@ impl Reader<'_> {
                 format!("a Bézier surface's 'parm {axis}' needs two or more increasing breakpoints"),
             ));
         }
-        Ok((Knots::from_breakpoints(&values), pline))
+        Ok((Knots::from_breakpoints(&values, degree), pline))
     }
 
     fn close_surface(&mut self, end_line: usize) -> Result<(), FreeformError> {
@@ -428,11 +455,11 @@ impl Reader<'_> {
             return Ok(());
         };
         let line = open.line;
-        let bezier = self.check_kind(&open)?;
-        let (u_values, u_line) = self.knot_values(&open, 'u', bezier, end_line)?;
-        let (v_values, v_line) = self.knot_values(&open, 'v', bezier, end_line)?;
-        let nu = u_values.len().saturating_sub(DEGREE + 1);
-        let nv = v_values.len().saturating_sub(DEGREE + 1);
+        let (bezier, [pu, pv]) = self.check_kind(&open)?;
+        let (u_values, u_line) = self.knot_values(&open, ('u', pu), bezier, end_line)?;
+        let (v_values, v_line) = self.knot_values(&open, ('v', pv), bezier, end_line)?;
+        let nu = u_values.len().saturating_sub(pu + 1);
+        let nv = v_values.len().saturating_sub(pv + 1);
         if nu * nv != open.indices.len() {
             return Err(self.err(
                 line,
@@ -443,8 +470,8 @@ impl Reader<'_> {
                 ),
             ));
         }
-        let u_knots = Knots::new(u_values, nu, 'u').map_err(|e| self.err(u_line, e.to_string()))?;
-        let v_knots = Knots::new(v_values, nv, 'v').map_err(|e| self.err(v_line, e.to_string()))?;
+        let u_knots = Knots::of_degree(u_values, nu, 'u', pu).map_err(|e| self.err(u_line, e.to_string()))?;
+        let v_knots = Knots::of_degree(v_values, nv, 'v', pv).map_err(|e| self.err(v_line, e.to_string()))?;
         let r = open.range;
         u_knots
             .check_range(r.u0, r.u1, 'u')

@@ -7,6 +7,7 @@ pub mod bezier;
 pub mod bpt;
 pub mod bspline;
 pub mod bvh;
+pub mod elevate;
 pub mod freeform;
 pub mod mesh;
 pub mod patch;

@@ -1,0 +1,58 @@
+//! Exact degree elevation of a Bézier segment to a cubic: a curve of degree `n` is one of
+//! degree `n + 1` whose points are `Q_i = i/(n+1) · P_{i−1} + (1 − i/(n+1)) · P_i` (Forrest
+//! 1972; Piegl & Tiller, *The NURBS Book*, §5.5, eq. 5.36), applied until the degree is 3. So a
+//! surface of degree 1 or 2 along an axis becomes bicubic patches that are the same surface,
+//! parameter for parameter.
+
+use super::bspline::Lerp;
+
+/// The four points of the cubic equal to the Bézier segment `q` of degree `q.len() − 1`
+/// (1 to 3).
+pub fn to_cubic<T: Lerp>(q: &[T]) -> [T; 4] {
+    match *q {
+        [a, b] => [a, a.lerp_to(b, 1.0 / 3.0), a.lerp_to(b, 2.0 / 3.0), b],
+        [a, b, c] => [a, a.lerp_to(b, 2.0 / 3.0), b.lerp_to(c, 1.0 / 3.0), c],
+        [a, b, c, d] => [a, b, c, d],
+        _ => panic!(
+            "a Bézier segment of degree 1 to 3 has 2 to 4 points, not {}",
+            q.len()
+        ),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    /// Bernstein evaluation of a segment of any degree (de Casteljau).
+    fn eval(points: &[DVec3], t: f64) -> DVec3 {
+        let mut d = points.to_vec();
+        for r in 1..d.len() {
+            for j in 0..d.len() - r {
+                d[j] = d[j].lerp(d[j + 1], t);
+            }
+        }
+        d[0]
+    }
+
+    #[test]
+    fn elevated_segments_are_the_same_curve() {
+        let p = [
+            DVec3::new(0.3, -1.0, 2.0),
+            DVec3::new(1.7, 0.4, -0.5),
+            DVec3::new(-0.2, 2.5, 1.1),
+        ];
+        for n in [2, 3] {
+            let cubic = to_cubic(&p[..n]);
+            for k in 0..=100 {
+                let t = k as f64 / 100.0;
+                assert!(
+                    (eval(&cubic, t) - eval(&p[..n], t)).length() < 1e-14,
+                    "degree {} at {t}",
+                    n - 1
+                );
+            }
+        }
+    }
+}
