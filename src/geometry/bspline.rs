@@ -20,6 +20,7 @@ use glam::DVec3;
 
 use super::bezier::BezierPatch;
 use super::elevate::to_cubic;
+pub use super::elevate::Lerp;
 use super::patch::Window;
 
 /// The degree of the patches made here: bicubic (lower degrees are raised to it).
@@ -191,24 +192,6 @@ impl Knots {
                 high,
             })
         }
-    }
-}
-
-/// What knot insertion blends: a point, or a row of points converted together.
-pub trait Lerp: Copy {
-    /// `self · (1 − a) + other · a`.
-    fn lerp_to(self, other: Self, a: f64) -> Self;
-}
-
-impl Lerp for DVec3 {
-    fn lerp_to(self, other: Self, a: f64) -> Self {
-        self * (1.0 - a) + other * a
-    }
-}
-
-impl<const N: usize> Lerp for [DVec3; N] {
-    fn lerp_to(self, other: Self, a: f64) -> Self {
-        std::array::from_fn(|k| self[k].lerp_to(other[k], a))
     }
 }
 

@@ -4,7 +4,25 @@
 //! surface of degree 1 or 2 along an axis becomes bicubic patches that are the same surface,
 //! parameter for parameter.
 
-use super::bspline::Lerp;
+use glam::DVec3;
+
+/// What knot insertion and elevation blend: a point, or a row of points converted together.
+pub trait Lerp: Copy {
+    /// `self · (1 − a) + other · a`.
+    fn lerp_to(self, other: Self, a: f64) -> Self;
+}
+
+impl Lerp for DVec3 {
+    fn lerp_to(self, other: Self, a: f64) -> Self {
+        self * (1.0 - a) + other * a
+    }
+}
+
+impl<const N: usize> Lerp for [DVec3; N] {
+    fn lerp_to(self, other: Self, a: f64) -> Self {
+        std::array::from_fn(|k| self[k].lerp_to(other[k], a))
+    }
+}
 
 /// The four points of the cubic equal to the Bézier segment `q` of degree `q.len() − 1`
 /// (1 to 3).
@@ -23,7 +41,6 @@ pub fn to_cubic<T: Lerp>(q: &[T]) -> [T; 4] {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::DVec3;
 
     /// Bernstein evaluation of a segment of any degree (de Casteljau).
     fn eval(points: &[DVec3], t: f64) -> DVec3 {
