@@ -1,9 +1,9 @@
 //! Shaping patches and placing lights by hand: the selection and hover of their handles
 //! ([`Handle`]), the gesture in progress (dragging handles, or orbiting/panning/dollying the
-//! camera), and the undo history (handles, the camera, materials). The control points and lights themselves are the
-//! document's ([`Document`]): the editor keeps the state of editing and does the geometry of a
-//! gesture; the viewer ([`super::Viewer::apply`]) carries actions out and sends the document's
-//! changes to the render session.
+//! camera), and the undo history (handles, the camera, materials). The control points and
+//! lights themselves are the document's ([`Document`]): the editor keeps the state of editing
+//! and does the geometry of a gesture; the viewer ([`super::Viewer::apply`]) carries actions
+//! out and sends the document's changes to the render session.
 
 use std::collections::BTreeSet;
 use std::sync::Arc;
@@ -128,24 +128,21 @@ impl History {
         };
         let token = drag.map(|d| (*index, d));
         let same_drag = token.is_some() && token == self.drag && self.undone.is_empty();
-        match self.done.pop() {
+        match self.done.last_mut() {
             Some((
-                _,
+                id,
                 Edit::Material {
-                    index: last, before, ..
-                },
-            )) if same_drag && last == *index => {
-                // A new id: the merged step is not the one a save may have marked.
-                self.record(Edit::Material {
                     index: last,
-                    before,
-                    after: after.clone(),
-                });
+                    after: a,
+                    ..
+                },
+            )) if same_drag && last == index => {
+                // A new id: the merged step is not the one a save may have marked.
+                self.next_id += 1;
+                *id = self.next_id;
+                a.clone_from(after);
             }
-            other => {
-                self.done.extend(other);
-                self.record(edit);
-            }
+            _ => self.record(edit),
         }
         // After the record, which forgets the drag of any other change.
         self.drag = token;

@@ -49,9 +49,9 @@ pub struct FreeformError {
 /// A Bézier patch and its `(u,v)` window in the parameters of the surface it came from.
 pub type DomainPatch = (BezierPatch, Window);
 
-/// Reads every free-form surface (degree 1 to 3) of an OBJ file as bicubic Bézier patches, a line at a time:
-/// what the reader keeps beyond the patches is the `v` points (40 bytes each) and the open
-/// surface's indices, whatever else the file holds.
+/// Reads every free-form surface (degree 1 to 3) of an OBJ file as bicubic Bézier patches, a
+/// line at a time: what the reader keeps beyond the patches is the `v` points (40 bytes each)
+/// and the open surface's indices, whatever else the file holds.
 pub fn load_freeform_obj(path: &Path) -> Result<Vec<DomainPatch>, FreeformError> {
     let file = crate::input_file::open(path).map_err(|why| FreeformError {
         path: path.to_owned(),

@@ -1,10 +1,11 @@
 //! Materials: Lambertian diffuse with an optional Phong lobe, mirrors and metals (smooth or
-//! rough), and dielectric glass with exact Fresnel reflectance and total internal reflection, smooth or
-//! rough, its index constant or varying with the wavelength ([`super::glasses`]).
+//! rough), and dielectric glass with exact Fresnel reflectance and total internal reflection,
+//! smooth or rough, its index constant or varying with the wavelength ([`super::glasses`]).
 
 use glam::DVec3;
 
 use super::glasses::Dispersion;
+use crate::settings::limits;
 
 /// A surface's reflectance model.
 #[derive(Clone, Debug, PartialEq)]
@@ -70,17 +71,17 @@ impl Material {
     /// and texture (colour and the model's numbers may change), every number in the range a
     /// scene file may give it.
     pub fn can_become(&self, new: &Material) -> bool {
-        let unit = |x: f64| (0.0..=1.0).contains(&x);
+        let rough = |r: f64| limits::roughness(r).is_ok();
         let numbers = match new.kind {
             MaterialKind::Diffuse { specular, shininess } => {
-                unit(specular) && shininess.is_finite() && shininess >= 0.0
+                (0.0..=1.0).contains(&specular) && shininess.is_finite() && shininess >= 0.0
             }
-            MaterialKind::Mirror { roughness } => unit(roughness),
+            MaterialKind::Mirror { roughness } => rough(roughness),
             MaterialKind::Metal { eta, k, roughness } => {
-                unit(roughness) && eta.is_finite() && k.is_finite() && eta.min_element() > 0.0
+                rough(roughness) && eta.is_finite() && k.is_finite() && eta.min_element() > 0.0
             }
             MaterialKind::Glass { ior, roughness, .. } => {
-                unit(roughness) && ior.is_finite() && ior > 0.0 && ior <= 100.0
+                rough(roughness) && ior.is_finite() && ior > 0.0 && ior <= 100.0
             }
         };
         let same_model = std::mem::discriminant(&self.kind) == std::mem::discriminant(&new.kind)

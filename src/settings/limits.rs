@@ -54,7 +54,7 @@ pub fn alpha(a: f64) -> Result<f64, Invalid> {
     }
 }
 
-/// A microfacet roughness α (the near-specular threshold), in [0, 1].
+/// A microfacet roughness α (a material's, or the near-specular threshold), in [0, 1].
 pub fn roughness(a: f64) -> Result<f64, Invalid> {
     if (0.0..=1.0).contains(&a) {
         Ok(a)

@@ -175,16 +175,15 @@ impl Bsdf {
                 ior,
                 roughness,
                 dispersion,
-            } => Bsdf::RoughDielectric(RoughDielectric {
-                color,
-                eta: if surface.front {
-                    index(ior, dispersion)
-                } else {
-                    1.0 / index(ior, dispersion)
-                },
-                alpha: roughness,
-                n,
-            }),
+            } => {
+                let ior = index(ior, dispersion);
+                Bsdf::RoughDielectric(RoughDielectric {
+                    color,
+                    eta: if surface.front { ior } else { 1.0 / ior },
+                    alpha: roughness,
+                    n,
+                })
+            }
         }
     }
 

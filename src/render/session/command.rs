@@ -104,10 +104,10 @@ pub(super) fn valid(
     }
 }
 
-/// Applies the camera, control points, lights and materials of the commands that restart the accumulation to
-/// the scene, in order. Control-point moves are gathered so that each edited patch is
-/// re-prepared once, however many steps of a drag arrived together (the latest position of
-/// each point wins).
+/// Applies the camera, control points, lights and materials of the commands that restart the
+/// accumulation to the scene, in order. Control-point moves are gathered so that each edited
+/// patch is re-prepared once, however many steps of a drag arrived together (the latest
+/// position of each point wins).
 pub fn apply_to_scene(scene: &mut Scene, commands: Vec<Command>) {
     let mut edited: std::collections::BTreeMap<usize, BezierPatch> = Default::default();
     for command in commands {

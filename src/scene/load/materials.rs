@@ -9,6 +9,7 @@ use crate::scene::glasses::{self, Dispersion};
 use crate::scene::material::{Material, MaterialKind};
 use crate::scene::metals;
 use crate::scene::texture::{Mapping, Texture, TextureSource};
+use crate::settings::limits;
 
 pub(super) fn material(
     ctx: &Ctx,
@@ -68,11 +69,8 @@ fn kind(t: &Table, d: &MaterialDesc) -> Result<MaterialKind> {
     ];
     let roughness = || -> Result<f64> {
         let r = d.roughness.map_or(0.0, |r| r.0);
-        if (0.0..=1.0).contains(&r) {
-            Ok(r)
-        } else {
-            Err(t.err(format!("'roughness' (GGX α) must be between 0 and 1, got {r}")))
-        }
+        limits::roughness(r)
+            .map_err(|_| t.err(format!("'roughness' (GGX α) must be between 0 and 1, got {r}")))
     };
     let kind = match d.kind.as_str() {
         "diffuse" => {
