@@ -1,25 +1,29 @@
 #!/usr/bin/env python3
 """Writes the Bézier-patch example scenes: scenes/pool.toml with assets/pool_water.obj (a
 bicubic B-spline water surface, 7×7 control points, so 4×4 Bézier patches), scenes/ring.toml (a
-mirror ring of 4 patches), scenes/ring_gold.toml (the ring in rough gold) and scenes/lens.toml (a biconvex lens of 2 patches) and scenes/lens_dispersive.toml (the
+mirror ring of 4 rational patches), scenes/ring_gold.toml (the ring in rough gold) and scenes/lens.toml (a biconvex lens of 2 patches) and scenes/lens_dispersive.toml (the
 lens in SF11 glass), and scenes/prism.toml with assets/prism.obj (a dispersive prism).
 Run from the project folder: python3 assets/make_example_scenes.py"""
 import math
 
-K = 4 * (math.sqrt(2) - 1) / 3  # cubic Bézier quarter-circle handle length
 
 
 def fmt(v):
     return "%.6g" % v
 
 
-def point(p):
-    return "[" + ", ".join(fmt(c) for c in p) + "]"
+def exact(v):
+    """15 significant digits (every digit of the geometry; rounding noise below 1e-15 is 0)."""
+    return "0" if abs(v) < 1e-15 else "%.15g" % v
 
 
-def patch_toml(points):
+def point(p, digits=fmt):
+    return "[" + ", ".join(digits(c) for c in p) + "]"
+
+
+def patch_toml(points, digits=fmt):
     """16 points, row i (along u) of four points (along v) per line."""
-    rows = [", ".join(point(points[4 * i + j]) for j in range(4)) for i in range(4)]
+    rows = [", ".join(point(points[4 * i + j], digits) for j in range(4)) for i in range(4)]
     return "[\n    " + ",\n    ".join(rows) + ",\n]"
 
 
@@ -45,18 +49,29 @@ lines += ["cstype bspline", "deg 3 3",
           "parm v " + " ".join(str(k) for k in range(n + 4)), "end"]
 open("assets/pool_water.obj", "w").write("\n".join(lines) + "\n")
 
-# --- ring: a mirror cylinder of radius 1, height 0.6, 4 patches (one per quarter) ---
+# --- ring: a mirror cylinder of radius 1, height 0.6, 4 rational patches (one per quarter) ---
+# A quarter circle is exactly the rational quadratic through its ends with the corner of its
+# tangents between them, weighted 1, sqrt(1/2), 1 (Piegl & Tiller, The NURBS Book, 7.3); raised
+# to a cubic in homogeneous coordinates, its points weigh 1, (1 + 2h)/3, (1 + 2h)/3, 1.
+h = math.sqrt(0.5)
 ring = []
+ring_weights = []
 for q in range(4):
     a0, a1 = q * math.pi / 2, (q + 1) * math.pi / 2
     c0, s0, c1, s1 = math.cos(a0), math.sin(a0), math.cos(a1), math.sin(a1)
-    arc = [(c0, s0), (c0 - K * s0, s0 + K * c0), (c1 + K * s1, s1 - K * c1), (c1, s1)]
+    corner = (c0 - s0, s0 + c0)
+
+    def inner(end):
+        return tuple((e + 2 * h * c) / (1 + 2 * h) for e, c in zip(end, corner))
+
+    arc = [(c0, s0), inner((c0, s0)), inner((c1, s1)), (c1, s1)]
     pts = []
     for i in range(4):              # u: up the wall
         y = 0.6 * i / 3
         for (x, z) in arc:          # v: around
             pts.append((x, y, z))
     ring.append(pts)
+    ring_weights.append([1, (1 + 2 * h) / 3, (1 + 2 * h) / 3, 1] * 4)
 
 # --- lens: two pillow-shaped patches sharing their square boundary, in the plane x = 0 ---
 def lens_patch(sign):
@@ -159,7 +174,8 @@ edge_v = [4.8, 0, 0]
 material = "wall"
 """)
 
-ring_text = ",\n".join(patch_toml(p) for p in ring)
+ring_text = ",\n".join(patch_toml(p, exact) for p in ring)
+ring_weights_text = ",\n".join("    [" + ", ".join(exact(w) for w in ws) + "]" for ws in ring_weights)
 
 
 def ring_scene(path, about, name, material):
@@ -197,6 +213,8 @@ normal = [0, 1, 0]
 material = "table"
 
 # Each line is one row of four control points at fixed u (height), running around the ring.
+# The patches are rational (each quarter exactly circular): `weights` holds each point's weight,
+# in the same order.
 [[objects]]
 type = "patches"
 name = "ring"
@@ -204,11 +222,14 @@ material = \"""" + name + """\"
 patches = [
 """ + ring_text + """,
 ]
+weights = [
+""" + ring_weights_text + """,
+]
 """)
 
 
-ring_scene("scenes/ring.toml", """# The coffee-cup caustic: a mirror ring (a cylinder of 4 bicubic patches, each a quarter
-# circle) on a table, lit by a point light low and off to one side. Light reflected inside the
+ring_scene("scenes/ring.toml", """# The coffee-cup caustic: a mirror ring (a cylinder of 4 rational bicubic patches, each exactly
+# a quarter circle) on a table, lit by a point light low and off to one side. Light reflected inside the
 # ring gathers into a cardioid-like cusp on the table. Drag the ring's control points to bend
 # the cusp.
 """, "mirror", """type = "mirror"

@@ -62,8 +62,11 @@ fn vertices(text: &str) -> Vec<DVec3> {
         .collect()
 }
 
+/// The non-rational patches of `text` with their windows.
 fn parse(text: &str) -> Result<Vec<(BezierPatch, Window)>, String> {
-    parse_freeform_obj(text, Path::new("surface.obj")).map_err(|e| e.to_string())
+    let patches = parse_freeform_obj(text, Path::new("surface.obj")).map_err(|e| e.to_string())?;
+    assert!(patches.iter().all(|(_, _, w)| w.is_none()), "a rational patch");
+    Ok(patches.into_iter().map(|(p, w, _)| (p, w)).collect())
 }
 
 #[test]
@@ -211,7 +214,11 @@ fn patches_round_trip_bit_for_bit_through_the_freeform_writer() {
         )])
         .collect();
     let mut out = Vec::new();
-    write_freeform_obj(&[("teapot".to_owned(), patches.clone())], &mut out).expect("writes");
+    let groups = [(
+        "teapot".to_owned(),
+        patches.iter().map(|&(p, w)| (p, w, None)).collect(),
+    )];
+    write_freeform_obj(&groups, &mut out).expect("writes");
     let text = String::from_utf8(out).expect("utf-8");
     assert_eq!(parse(&text).expect("reads back"), patches);
 }
@@ -235,12 +242,12 @@ fn malformed_surfaces_are_errors_naming_the_file_and_line() {
     let p = sixteen_points();
     let cases = [
         (
-            format!("{p}cstype rat bspline\ndeg 3 3\n{SURF}\nparm u 0 0 0 0 1 1 1 1\nparm v 0 0 0 0 1 1 1 1\nend\n"),
-            "surface.obj:19: rational surfaces",
+            format!("{}v 3 3 0 0\ncstype rat bspline\ndeg 3 3\n{SURF}\nparm u 0 0 0 0 1 1 1 1\nparm v 0 0 0 0 1 1 1 1\nend\n", &p[..p.rfind("v ").expect("v")]),
+            "surface.obj:19: control point on line 16 has weight 0: a rational surface's weights must be above 0",
         ),
         (
             format!("{}v 3 3 0 2\ncstype bezier\ndeg 3 3\n{SURF}\nparm u 0 1\nparm v 0 1\nend\n", &p[..p.rfind("v ").expect("v")]),
-            "surface.obj:19: control point on line 16 has weight 2",
+            "surface.obj:19: control point on line 16 has weight 2, but the surface is not rational (use 'cstype rat bezier')",
         ),
         (
             format!("{p}cstype bspline\ndeg 4 3\n{SURF}\nparm u 0 0 0 0 0 1 1 1 1 1\nparm v 0 0 0 0 1 1 1 1\nend\n"),
@@ -372,11 +379,11 @@ fn export_obj_freeform_reads_back_to_the_same_patches() {
     let count = builtin.geometry.patches().len();
     assert!(common::text(&run).contains(&format!("{count} patches as free-form Bézier surfaces")));
     let read = caustic::geometry::load_freeform_obj(&out).expect("reads back");
-    let expected: Vec<(BezierPatch, Window)> = builtin
+    let expected: Vec<_> = builtin
         .geometry
         .patches()
         .iter()
-        .map(|(p, _)| (*p, Window::FULL))
+        .map(|(p, _)| (*p, Window::FULL, None))
         .collect();
     assert_eq!(read, expected);
     // Without --force an existing file is kept.
@@ -406,9 +413,9 @@ fn a_surface_from_geomdl_matches_geomdls_own_evaluation() {
             .map(|w| w.parse().expect("number"))
             .collect();
         let (u, v, expected) = (n[0], n[1], DVec3::new(n[2], n[3], n[4]));
-        let (patch, w) = patches
+        let (patch, w, _) = patches
             .iter()
-            .find(|(_, w)| (w.u0..=w.u1).contains(&u) && (w.v0..=w.v1).contains(&v))
+            .find(|(_, w, _)| (w.u0..=w.u1).contains(&u) && (w.v0..=w.v1).contains(&v))
             .expect("a patch covers every parameter");
         let s = (u - w.u0) / (w.u1 - w.u0);
         let t = (v - w.v0) / (w.v1 - w.v0);

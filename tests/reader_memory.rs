@@ -9,7 +9,8 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use caustic::geometry::{load_bpt, load_freeform_obj, BezierPatch, TriangleMesh, Window};
+use caustic::geometry::freeform::DomainPatch;
+use caustic::geometry::{load_bpt, load_freeform_obj, BezierPatch, TriangleMesh};
 
 /// The system allocator, counting the bytes held now and their peak.
 struct Counting;
@@ -86,8 +87,8 @@ fn write(dir: &Path, name: &str, text: &str) -> std::path::PathBuf {
     path
 }
 
-fn domain_patches_bytes(patches: &Vec<(BezierPatch, Window)>) -> usize {
-    patches.capacity() * std::mem::size_of::<(BezierPatch, Window)>()
+fn domain_patches_bytes(patches: &Vec<DomainPatch>) -> usize {
+    patches.capacity() * std::mem::size_of::<DomainPatch>()
 }
 
 #[test]

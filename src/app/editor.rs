@@ -324,8 +324,9 @@ impl Editor {
                     (doc.lights()[k], self.point(doc, Handle::Light(aim)))
                 })
                 .collect();
+            let weights = |k| doc.scene().geometry.patch_weights(k);
             self.overlay = Arc::new(overlay_geometry(
-                doc.patches(),
+                doc.patches().enumerate().map(|(k, p)| (p, weights(k))),
                 &lights,
                 self.hovered,
                 &self.selection,

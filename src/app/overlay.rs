@@ -8,6 +8,7 @@ use std::collections::BTreeSet;
 use egui::{Pos2, Rect};
 use glam::{DMat4, DVec2, DVec3, DVec4};
 
+use crate::geometry::rational::{RationalPatch, Weights};
 use crate::geometry::BezierPatch;
 use crate::gpu::wireframe::{Marker, Segment, Uniforms, WireframeGeometry};
 use crate::scene::{Camera, Light};
@@ -149,12 +150,12 @@ const LIGHT: [f32; 4] = [1.0, 0.85, 0.35, 0.95];
 /// Segments of a sphere light's outline circles.
 const CIRCLE_SEGMENTS: usize = 32;
 
-/// The overlay for `patches` and `lights` (each with its aim point): each control net (rows
-/// and columns), each patch's four boundary curves, a marker per control point, and the lights'
+/// The overlay for `patches` (each with its weights when rational) and `lights` (each with
+/// its aim point): each control net (rows and columns), each patch's four boundary curves, a marker per control point, and the lights'
 /// gizmos (`light_gizmos`); hovered and selected handles, and the nets of patches with a
 /// selected point, stand out.
 pub fn overlay_geometry<'a>(
-    patches: impl IntoIterator<Item = &'a BezierPatch>,
+    patches: impl IntoIterator<Item = (&'a BezierPatch, Option<&'a Weights>)>,
     lights: &[(Light, DVec3)],
     hovered: Option<Handle>,
     selection: &BTreeSet<Handle>,
@@ -166,7 +167,9 @@ pub fn overlay_geometry<'a>(
         color,
         width,
     };
-    for (k, p) in patches.into_iter().enumerate() {
+    for (k, (p, weights)) in patches.into_iter().enumerate() {
+        let rational = weights.map(|w| RationalPatch::new(p, w));
+        let eval = |u: f64, v: f64| rational.as_ref().map_or_else(|| p.eval(u, v), |r| r.eval(u, v));
         let active =
             selection.iter().any(|s| s.patch() == Some(k)) || hovered.is_some_and(|h| h.patch() == Some(k));
         let (net, width) = if active { (NET_SELECTED, 1.6) } else { (NET, 1.0) };
@@ -180,10 +183,10 @@ pub fn overlay_geometry<'a>(
         }
         for edge in 0..4 {
             let at = |t: f64| match edge {
-                0 => p.eval(t, 0.0),
-                1 => p.eval(t, 1.0),
-                2 => p.eval(0.0, t),
-                _ => p.eval(1.0, t),
+                0 => eval(t, 0.0),
+                1 => eval(t, 1.0),
+                2 => eval(0.0, t),
+                _ => eval(1.0, t),
             };
             for s in 0..CURVE_SEGMENTS {
                 let (t0, t1) = (
@@ -353,8 +356,13 @@ mod tests {
             part: LightPart::Place,
         });
         let point = Handle::Control(PointRef { patch: 0, index: 5 });
-        let plain = overlay_geometry(&patches, &lights, None, &BTreeSet::new());
-        let chosen = overlay_geometry(&patches, &lights, Some(point), &BTreeSet::from([light]));
+        let plain = overlay_geometry(patches.iter().map(|p| (p, None)), &lights, None, &BTreeSet::new());
+        let chosen = overlay_geometry(
+            patches.iter().map(|p| (p, None)),
+            &lights,
+            Some(point),
+            &BTreeSet::from([light]),
+        );
         assert_eq!(chosen.markers.len(), plain.markers.len() + 2);
         for (marker, colour) in [
             (patches[0].points[5], POINT_HOVERED),

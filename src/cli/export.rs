@@ -8,7 +8,7 @@ use anyhow::{bail, Context, Result};
 use caustic::args::Overwrite;
 use caustic::files::write_atomically;
 use caustic::geometry::freeform::{write_freeform_obj, DomainPatch};
-use caustic::geometry::tessellate::{tessellate, write_obj};
+use caustic::geometry::tessellate::{tessellate_weighted, write_obj};
 use caustic::run::load_scene;
 
 /// `caustic export-obj`'s flags.
@@ -62,7 +62,10 @@ pub fn export_obj(args: ExportArgs) -> Result<()> {
         .enumerate()
         .map(|(k, (p, obj))| {
             let name = format!("{}_patch{k}", group_name(&scene, *obj));
-            (name, tessellate(p, resolution))
+            (
+                name,
+                tessellate_weighted(p, scene.geometry.patch_weights(k), resolution),
+            )
         })
         .collect();
     write_obj_file(out, force, |file| write_obj(&meshes, file))?;
@@ -102,11 +105,12 @@ fn group_name(scene: &caustic::scene::Scene, object: u32) -> String {
 fn export_freeform(scene: &caustic::scene::Scene, out: &Path, force: bool) -> Result<()> {
     let mut groups: Vec<(String, Vec<DomainPatch>)> = Vec::new();
     let patches = scene.geometry.patches();
-    for ((p, object), domain) in patches.iter().zip(scene.geometry.patch_domains()) {
+    for (k, ((p, object), domain)) in patches.iter().zip(scene.geometry.patch_domains()).enumerate() {
         let name = group_name(scene, *object);
+        let patch = (*p, *domain, scene.geometry.patch_weights(k).copied());
         match groups.last_mut() {
-            Some((last, list)) if *last == name => list.push((*p, *domain)),
-            _ => groups.push((name, vec![(*p, *domain)])),
+            Some((last, list)) if *last == name => list.push(patch),
+            _ => groups.push((name, vec![patch])),
         }
     }
     write_obj_file(out, force, |file| write_freeform_obj(&groups, file))?;

@@ -16,12 +16,13 @@
 //! [`de_boor`] evaluates a curve directly (de Boor 1972): the tests check the conversion
 //! against it.
 
-use glam::DVec3;
+use glam::{DVec3, DVec4};
 
 use super::bezier::BezierPatch;
 use super::elevate::to_cubic;
 pub use super::elevate::Lerp;
 use super::patch::Window;
+use super::rational::Weights;
 
 /// The degree of the patches made here: bicubic (lower degrees are raised to it).
 pub const DEGREE: usize = 3;
@@ -369,29 +370,58 @@ impl BsplineSurface {
     /// The bicubic Bézier patches of the surface over its range, each with its `(u,v)` window in the
     /// surface's own parameters, ordered by `u` span, then `v` span.
     pub fn to_bezier(&self) -> Vec<(BezierPatch, Window)> {
-        let nu = self.nu();
-        let r = self.range;
-        // Along u for every row of constant v: rows[j] = segments of row j.
-        let rows: Vec<Vec<Segment<DVec3>>> = self
-            .points
-            .chunks_exact(nu)
-            .map(|row| bezier_segments(row, &self.u_knots, r.u0, r.u1))
-            .collect();
-        let u_spans = rows.first().map_or(0, Vec::len);
-        let mut out = Vec::with_capacity(u_spans * self.v_knots.spans_in(r.v0, r.v1));
-        for su in 0..u_spans {
-            // The column of 4-point groups along v for this u span, converted along v.
-            let column: Vec<[DVec3; 4]> = rows.iter().map(|row| row[su].0).collect();
-            let v_segments = bezier_segments(&column, &self.v_knots, r.v0, r.v1);
-            let (u0, u1) = rows[0][su].1;
-            for (quad, (v0, v1)) in v_segments {
-                // quad[jv][iu]: BezierPatch wants points[4 * iu + jv].
-                let points = std::array::from_fn(|k| quad[k % 4][k / 4]);
-                out.push((BezierPatch::new(points), Window { u0, u1, v0, v1 }));
-            }
-        }
-        out
+        spans(&self.points, self)
+            .into_iter()
+            .map(|(points, window)| (BezierPatch::new(points), window))
+            .collect()
     }
+
+    /// [`BsplineSurface::to_bezier`] for a rational surface whose points have `weights`
+    /// (positive, one per point): converted in homogeneous form (Piegl & Tiller §4.4), each
+    /// patch with its projected control points and their weights.
+    pub fn to_rational_bezier(&self, weights: &[f64]) -> Vec<(BezierPatch, Window, Weights)> {
+        let homogeneous: Vec<DVec4> = self
+            .points
+            .iter()
+            .zip(weights)
+            .map(|(p, &w)| (*p * w).extend(w))
+            .collect();
+        spans(&homogeneous, self)
+            .into_iter()
+            .map(|(h, window)| {
+                let points = h.map(|q| q.truncate() / q.w);
+                (BezierPatch::new(points), window, h.map(|q| q.w))
+            })
+            .collect()
+    }
+}
+
+/// `surface`'s Bézier patches as 16 points each (row `i` along `u`), with their windows, for
+/// its control points given as `points` (any [`Lerp`] type, `u` fastest).
+fn spans<T: Lerp>(points: &[T], surface: &BsplineSurface) -> Vec<([T; 16], Window)> {
+    let nu = surface.nu();
+    let r = surface.range;
+    // Along u for every row of constant v: rows[j] = segments of row j.
+    let rows: Vec<Vec<Segment<T>>> = points
+        .chunks_exact(nu)
+        .map(|row| bezier_segments(row, &surface.u_knots, r.u0, r.u1))
+        .collect();
+    let u_spans = rows.first().map_or(0, Vec::len);
+    let mut out = Vec::with_capacity(u_spans * surface.v_knots.spans_in(r.v0, r.v1));
+    for su in 0..u_spans {
+        // The column of 4-point groups along v for this u span, converted along v.
+        let column: Vec<[T; 4]> = rows.iter().map(|row| row[su].0).collect();
+        let v_segments = bezier_segments(&column, &surface.v_knots, r.v0, r.v1);
+        let (u0, u1) = rows[0][su].1;
+        for (quad, (v0, v1)) in v_segments {
+            // quad[jv][iu]: a patch wants points[4 * iu + jv].
+            out.push((
+                std::array::from_fn(|k| quad[k % 4][k / 4]),
+                Window { u0, u1, v0, v1 },
+            ));
+        }
+    }
+    out
 }
 
 #[cfg(test)]

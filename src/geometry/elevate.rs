@@ -4,9 +4,10 @@
 //! surface of degree 1 or 2 along an axis becomes bicubic patches that are the same surface,
 //! parameter for parameter.
 
-use glam::DVec3;
+use glam::{DVec3, DVec4};
 
-/// What knot insertion and elevation blend: a point, or a row of points converted together.
+/// What knot insertion and elevation blend: a point (a rational one in homogeneous form,
+/// `(w x, w y, w z, w)`), or a row of points converted together.
 pub trait Lerp: Copy {
     /// `self · (1 − a) + other · a`.
     fn lerp_to(self, other: Self, a: f64) -> Self;
@@ -18,7 +19,13 @@ impl Lerp for DVec3 {
     }
 }
 
-impl<const N: usize> Lerp for [DVec3; N] {
+impl Lerp for DVec4 {
+    fn lerp_to(self, other: Self, a: f64) -> Self {
+        self * (1.0 - a) + other * a
+    }
+}
+
+impl<T: Lerp, const N: usize> Lerp for [T; N] {
     fn lerp_to(self, other: Self, a: f64) -> Self {
         std::array::from_fn(|k| self[k].lerp_to(other[k], a))
     }

@@ -1,8 +1,9 @@
-//! Wavefront OBJ free-form surfaces in and out: the non-rational `cstype bezier` and `cstype
+//! Wavefront OBJ free-form surfaces in and out: the `cstype [rat] bezier` and `cstype [rat]
 //! bspline` surfaces of degree 1 to 3 along each axis that CAD programs (Rhino, for one)
 //! export, read as bicubic Bézier patches (lower degrees raised exactly,
-//! [`super::elevate`]) with their parameter windows, and patches written back as `cstype
-//! bezier` surfaces.
+//! [`super::elevate`]; rational ones converted in homogeneous coordinates and kept with their
+//! weights, [`super::rational`]) with their parameter windows, and patches written back as
+//! `cstype [rat] bezier` surfaces.
 //!
 //! The statements read (Wavefront's *Object Files* appendix B1, "Free-form curve/surface
 //! attributes" and "body statements"): `v x y z [w]`, `cstype [rat] bezier|bspline`,
@@ -32,6 +33,7 @@ use glam::DVec3;
 use super::bezier::BezierPatch;
 use super::bspline::{BsplineSurface, Knots, DEGREE};
 use super::patch::Window;
+use super::rational::{weights_error, Weights};
 use crate::settings::limits::{MAX_KNOTS, MAX_PATCHES};
 
 /// A free-form OBJ file that cannot be read: which file, which line, what was wrong.
@@ -46,8 +48,9 @@ pub struct FreeformError {
     pub message: String,
 }
 
-/// A Bézier patch and its `(u,v)` window in the parameters of the surface it came from.
-pub type DomainPatch = (BezierPatch, Window);
+/// A Bézier patch, its `(u,v)` window in the parameters of the surface it came from and, for
+/// a rational surface, its weights ([`super::rational`]).
+pub type DomainPatch = (BezierPatch, Window, Option<Weights>);
 
 /// Reads every free-form surface (degree 1 to 3) of an OBJ file as bicubic Bézier patches, a
 /// line at a time: what the reader keeps beyond the patches is the `v` points (40 bytes each)
@@ -341,21 +344,12 @@ impl Reader<'_> {
         Ok(())
     }
 
-    /// Whether the open surface is a Bézier surface (else a B-spline), and its degrees along
-    /// `u` and `v`: checks its type, degree and weights.
-    fn check_kind(&self, open: &OpenSurface) -> Result<(bool, [usize; 2]), FreeformError> {
+    /// Whether the open surface is a Bézier surface (else a B-spline), its degrees along `u`
+    /// and `v`, and whether it is rational: checks its type, degree and weights.
+    fn check_kind(&self, open: &OpenSurface) -> Result<(bool, [usize; 2], bool), FreeformError> {
         let line = open.line;
         let bezier = match &open.cstype {
             None => return Err(self.err(line, "the surface has no 'cstype' before it".to_owned())),
-            Some(c) if c.rational => {
-                return Err(self.err(
-                    line,
-                    format!(
-                    "rational surfaces ('cstype rat {}', line {}) are not supported; only non-rational ones",
-                    c.name, c.line
-                ),
-                ))
-            }
             Some(c) => match c.name.as_str() {
                 "bezier" => true,
                 "bspline" => false,
@@ -379,21 +373,30 @@ impl Reader<'_> {
                 ))
             }
         };
-        if let Some(v) = open
-            .indices
-            .iter()
-            .map(|&i| &self.vertices[i])
-            .find(|v| v.weight != 1.0)
+        let rational = open.cstype.as_ref().is_some_and(|c| c.rational);
+        let weights = open.indices.iter().map(|&i| &self.vertices[i]);
+        let bad = |v: &&Vertex| !(v.weight.is_finite() && v.weight > 0.0);
+        if let Some(v) = weights
+            .clone()
+            .find(|v| if rational { bad(v) } else { v.weight != 1.0 })
         {
-            return Err(self.err(
-                line,
+            let message = if rational {
                 format!(
-                    "control point on line {} has weight {}: rational surfaces are not supported",
+                    "control point on line {} has weight {}: a rational surface's weights must be above 0",
                     v.line, v.weight
-                ),
-            ));
+                )
+            } else {
+                format!(
+                    "control point on line {} has weight {}, but the surface is not rational \
+                     (use 'cstype rat {}')",
+                    v.line,
+                    v.weight,
+                    open.cstype.as_ref().map_or("bspline", |c| c.name.as_str())
+                )
+            };
+            return Err(self.err(line, message));
         }
-        Ok((bezier, degrees))
+        Ok((bezier, degrees, rational))
     }
 
     /// The degrees along `u` and `v` of a `deg` line (`dline`) set for the surface on `line`:
@@ -455,7 +458,7 @@ impl Reader<'_> {
             return Ok(());
         };
         let line = open.line;
-        let (bezier, [pu, pv]) = self.check_kind(&open)?;
+        let (bezier, [pu, pv], rational) = self.check_kind(&open)?;
         let (u_values, u_line) = self.knot_values(&open, ('u', pu), bezier, end_line)?;
         let (v_values, v_line) = self.knot_values(&open, ('v', pv), bezier, end_line)?;
         let nu = u_values.len().saturating_sub(pu + 1);
@@ -495,9 +498,25 @@ impl Reader<'_> {
                 ),
             ));
         }
-        let patches = surface.to_bezier();
-        let finite = |(p, w): &DomainPatch| {
-            p.points.iter().all(|q| q.is_finite()) && (w.u1 - w.u0).is_finite() && (w.v1 - w.v0).is_finite()
+        let patches: Vec<DomainPatch> = if rational {
+            let weights: Vec<f64> = open.indices.iter().map(|&i| self.vertices[i].weight).collect();
+            surface
+                .to_rational_bezier(&weights)
+                .into_iter()
+                .map(|(p, window, w)| (p, window, Some(w)))
+                .collect()
+        } else {
+            surface
+                .to_bezier()
+                .into_iter()
+                .map(|(p, w)| (p, w, None))
+                .collect()
+        };
+        let finite = |(p, w, weights): &DomainPatch| {
+            p.points.iter().all(|q| q.is_finite())
+                && (w.u1 - w.u0).is_finite()
+                && (w.v1 - w.v0).is_finite()
+                && weights.as_ref().is_none_or(|w| weights_error(w).is_none())
         };
         if !patches.iter().all(finite) {
             return Err(self.err(
@@ -530,15 +549,19 @@ pub fn write_freeform_obj(
     let mut next = 1usize;
     for (name, patches) in groups {
         writeln!(out, "g {name}")?;
-        for (patch, w) in patches {
+        for (patch, w, weights) in patches {
             // OBJ lists control points with u varying fastest: point iu + 4 jv.
             for jv in 0..4 {
                 for iu in 0..4 {
                     let p = patch.point(iu, jv);
-                    writeln!(out, "v {} {} {}", p.x, p.y, p.z)?;
+                    match weights {
+                        Some(weights) => writeln!(out, "v {} {} {} {}", p.x, p.y, p.z, weights[4 * iu + jv])?,
+                        None => writeln!(out, "v {} {} {}", p.x, p.y, p.z)?,
+                    }
                 }
             }
-            writeln!(out, "cstype bezier\ndeg 3 3")?;
+            let rat = if weights.is_some() { "rat " } else { "" };
+            writeln!(out, "cstype {rat}bezier\ndeg 3 3")?;
             let indices: Vec<String> = (next..next + 16).map(|i| i.to_string()).collect();
             writeln!(
                 out,

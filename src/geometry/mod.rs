@@ -12,6 +12,7 @@ pub mod freeform;
 pub mod mesh;
 pub mod patch;
 pub mod quad;
+pub mod rational;
 pub mod ray;
 pub mod scene_geometry;
 pub mod sphere;

@@ -20,10 +20,12 @@ use super::bezier::BezierPatch;
 use super::bvh::{Bvh, FLAT_PRIMITIVES};
 use super::mesh::TriangleMesh;
 use super::patch::{
-    intersect_leaf, intersect_per_ray, leaf_occludes, subdivide, PatchHit, PatchLeaf, PatchPoint, RayFrame,
-    SubdivisionParams, Window,
+    intersect_leaf, intersect_per_ray_weighted, intersect_rational_leaf, leaf_occludes,
+    rational_leaf_occludes, subdivide_weighted, PatchHit, PatchLeaf, PatchPoint, RayFrame, SubdivisionParams,
+    Window,
 };
 use super::quad::{Plane, Quad};
+use super::rational::{window_weights, RationalPatch, Weights};
 use super::ray::{spawn_ray, Ray};
 use super::sphere::Sphere;
 use super::sphere_batch::SphereBatch;
@@ -146,6 +148,8 @@ pub struct GeometryBuilder {
     patches: Vec<(BezierPatch, u32)>,
     /// Each patch's `(u,v)` window in the parameters of the surface it came from.
     patch_domains: Vec<Window>,
+    /// Each patch's weights, when it is rational.
+    patch_weights: Vec<Option<Box<Weights>>>,
     /// The patch intersector.
     pub patch_method: PatchMethod,
 }
@@ -192,8 +196,22 @@ impl GeometryBuilder {
     /// Adds a Bézier patch that is the piece `domain` of a larger surface (a B-spline span):
     /// its hits report `(u,v)` in the surface's parameters, so textures follow the surface.
     pub fn add_patch_in(&mut self, patch: BezierPatch, domain: Window, object: u32) -> ShapeRef {
+        self.add_weighted_patch_in(patch, None, domain, object)
+    }
+
+    /// [`GeometryBuilder::add_patch_in`] for a patch that may be rational: `patch` holds its
+    /// control points, `weights` their weights, which the caller has checked are positive
+    /// ([`crate::geometry::rational::weights_error`]).
+    pub fn add_weighted_patch_in(
+        &mut self,
+        patch: BezierPatch,
+        weights: Option<Weights>,
+        domain: Window,
+        object: u32,
+    ) -> ShapeRef {
         self.patches.push((patch, object));
         self.patch_domains.push(domain);
+        self.patch_weights.push(weights.map(Box::new));
         ShapeRef::Patch(self.patches.len() as u32 - 1)
     }
 
@@ -211,8 +229,8 @@ impl GeometryBuilder {
             params.max_leaves = params
                 .max_leaves
                 .min(super::patch::leaf_budget(self.patches.len()));
-            for (k, (patch, _)) in self.patches.iter().enumerate() {
-                leaves.extend(subdivide(patch, k as u32, params));
+            for (k, ((patch, _), w)) in self.patches.iter().zip(&self.patch_weights).enumerate() {
+                leaves.extend(subdivide_weighted(patch, w.as_deref(), k as u32, params));
             }
         }
         let mut primitives = Vec::new();
@@ -251,20 +269,25 @@ impl GeometryBuilder {
         let bvh = Bvh::build(&bounds);
         let flat_spheres = flat_spheres(&bvh, &primitives, &self.spheres);
         // Grown by pushing: give back the spare capacity (up to half of a large scene's).
-        let (mut patches, mut patch_domains) = (self.patches, self.patch_domains);
+        let (mut patches, mut patch_domains, mut patch_weights) =
+            (self.patches, self.patch_domains, self.patch_weights);
         leaves.shrink_to_fit();
         primitives.shrink_to_fit();
         bounds.shrink_to_fit();
         patches.shrink_to_fit();
         patch_domains.shrink_to_fit();
+        patch_weights.shrink_to_fit();
         SceneGeometry {
             primitive_bounds: bounds,
             spheres: self.spheres,
             quads: self.quads,
             planes: self.planes,
             meshes: self.meshes,
+            has_rational: patch_weights.iter().any(Option::is_some),
+            leaf_weights: leaf_weights(&leaves, &patch_weights),
             patches,
             patch_domains,
+            patch_weights,
             patch_scales,
             leaves,
             primitives,
@@ -273,6 +296,21 @@ impl GeometryBuilder {
             patch_method,
         }
     }
+}
+
+/// Each leaf's weights when some patch is rational (a polynomial patch's leaves weigh 1);
+/// none otherwise.
+fn leaf_weights(leaves: &[PatchLeaf], patch_weights: &[Option<Box<Weights>>]) -> Vec<Weights> {
+    if patch_weights.iter().all(Option::is_none) {
+        return Vec::new();
+    }
+    leaves
+        .iter()
+        .map(|l| match &patch_weights[l.patch as usize] {
+            Some(w) => window_weights(w, &l.window),
+            None => [1.0; 16],
+        })
+        .collect()
 }
 
 /// The spheres of a tree [`Bvh::traverse`] does not walk, when it holds nothing else, in the
@@ -301,6 +339,12 @@ pub struct SceneGeometry {
     meshes: Vec<(TriangleMesh, u32)>,
     patches: Vec<(BezierPatch, u32)>,
     patch_domains: Vec<Window>,
+    patch_weights: Vec<Option<Box<Weights>>>,
+    /// Whether any patch is rational.
+    has_rational: bool,
+    /// With a rational patch, each leaf's weights (the patch's over the leaf's window; unused
+    /// for a polynomial patch's leaf); otherwise empty.
+    leaf_weights: Vec<Weights>,
     patch_scales: Vec<f64>,
     leaves: Vec<PatchLeaf>,
     /// Everything in the BVH; its leaves index this list. Patch leaves (or whole patches,
@@ -338,18 +382,20 @@ impl SceneGeometry {
             meshes: self.meshes.clone(),
             patches: Vec::new(),
             patch_domains: Vec::new(),
+            patch_weights: Vec::new(),
             patch_method: method,
         };
-        for ((p, object), domain) in self.patches.iter().zip(&self.patch_domains) {
+        for (k, ((p, object), domain)) in self.patches.iter().zip(&self.patch_domains).enumerate() {
+            let weights = self.patch_weights(k);
             match tessellate_segments {
                 Some(n) => {
-                    let mut mesh = super::tessellate::tessellate(p, n);
+                    let mut mesh = super::tessellate::tessellate_weighted(p, weights, n);
                     for uv in &mut mesh.texcoords {
                         *uv = domain.map(uv.x, uv.y);
                     }
                     builder.add_mesh(mesh, *object)
                 }
-                None => builder.add_patch_in(*p, *domain, *object),
+                None => builder.add_weighted_patch_in(*p, weights.copied(), *domain, *object),
             };
         }
         builder.build()
@@ -377,6 +423,27 @@ impl SceneGeometry {
     /// in the order of [`SceneGeometry::patches`].
     pub fn patch_domains(&self) -> &[Window] {
         &self.patch_domains
+    }
+
+    /// Patch `k`'s weights, when it is rational (its control points are
+    /// [`SceneGeometry::patches`]' own).
+    pub fn patch_weights(&self, k: usize) -> Option<&Weights> {
+        self.patch_weights.get(k).and_then(|w| w.as_deref())
+    }
+
+    /// Leaf `leaf`'s weights when its patch is rational, on a ray's path: asks nothing of a
+    /// scene without rational patches.
+    #[inline(always)]
+    fn rational_weights(&self, leaf: u32) -> Option<&Weights> {
+        if self.has_rational
+            && self
+                .patch_weights(self.leaves[leaf as usize].patch as usize)
+                .is_some()
+        {
+            self.leaf_weights.get(leaf as usize)
+        } else {
+            None
+        }
     }
 
     /// Moves control point `index` (0–15, `4i + j`) of patch `patch` to `position` and
@@ -448,7 +515,7 @@ impl SceneGeometry {
             PatchMethod::Prepared(params) => {
                 let fresh: Vec<(usize, Vec<PatchLeaf>)> = edits
                     .iter()
-                    .map(|(&k, p)| (k, subdivide(p, k as u32, &params)))
+                    .map(|(&k, p)| (k, subdivide_weighted(p, self.patch_weights(k), k as u32, &params)))
                     .collect();
                 self.replace_leaves(first, fresh)
             }
@@ -460,6 +527,9 @@ impl SceneGeometry {
                 true
             }
         };
+        if self.has_rational {
+            self.leaf_weights = leaf_weights(&self.leaves, &self.patch_weights);
+        }
         if refit {
             self.bvh.refit(&self.primitive_bounds);
         } else {
@@ -596,19 +666,24 @@ impl SceneGeometry {
                 .map(|h| hit(h.t, h.barycentric)),
             Primitive::PatchLeaf(i) => {
                 let frame = frame.as_ref()?;
-                intersect_leaf(&self.leaves[i as usize], frame, span, 0.0, t_max).map(patch_hit)
+                let leaf = &self.leaves[i as usize];
+                match self.rational_weights(i) {
+                    None => intersect_leaf(leaf, frame, span, 0.0, t_max),
+                    Some(w) => intersect_rational_leaf(leaf, w, frame, span, t_max),
+                }
+                .map(patch_hit)
             }
             Primitive::Patch(i) => {
                 let depth = match self.patch_method {
                     PatchMethod::PerRay { depth } => depth,
                     PatchMethod::Prepared(_) => 0,
                 };
-                intersect_per_ray(
+                intersect_per_ray_weighted(
                     &self.patches[i as usize].0,
+                    self.patch_weights(i as usize),
                     self.patch_scales[i as usize],
                     ray,
-                    0.0,
-                    t_max,
+                    (0.0, t_max),
                     depth,
                 )
                 .map(patch_hit)
@@ -721,10 +796,16 @@ impl SceneGeometry {
         scale: Option<f64>,
     ) -> (DVec3, DVec3, DVec2, u32, ShapeRef) {
         let (p, obj) = &self.patches[patch as usize];
-        let n = match (known, scale) {
+        let n = match (known, self.patch_weights(patch as usize)) {
             (Some(n), _) => Some(n),
-            (None, Some(scale)) => p.normal_at_scale(uv.x, uv.y, scale),
-            (None, None) => p.normal(uv.x, uv.y),
+            (None, Some(w)) => {
+                let scale = scale.unwrap_or(self.patch_scales[patch as usize]);
+                RationalPatch::new(p, w).normal_at_scale(uv.x, uv.y, scale)
+            }
+            (None, None) => match scale {
+                Some(scale) => p.normal_at_scale(uv.x, uv.y, scale),
+                None => p.normal(uv.x, uv.y),
+            },
         };
         // A patch degenerate everywhere has no normal; any unit vector keeps shading finite.
         let n = n.unwrap_or(DVec3::Z);
@@ -757,9 +838,10 @@ impl SceneGeometry {
             let primitive = self.primitives[k as usize];
             counts(self.object_of(primitive))
                 && match (primitive, &frame) {
-                    (Primitive::PatchLeaf(i), Some(frame)) => {
-                        leaf_occludes(&self.leaves[i as usize], frame, span, 0.0, t_max)
-                    }
+                    (Primitive::PatchLeaf(i), Some(frame)) => match self.rational_weights(i) {
+                        None => leaf_occludes(&self.leaves[i as usize], frame, span, 0.0, t_max),
+                        Some(w) => rational_leaf_occludes(&self.leaves[i as usize], w, frame, span, t_max),
+                    },
                     _ => self.test(primitive, ray, &frame, span, t_max).is_some(),
                 }
         })

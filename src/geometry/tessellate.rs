@@ -5,17 +5,33 @@ use glam::{DVec2, DVec3};
 
 use super::bezier::BezierPatch;
 use super::mesh::TriangleMesh;
+use super::rational::{RationalPatch, Weights};
 
 /// A `resolution × resolution` grid of quads (two triangles each) over the patch, with exact
 /// normals and the patch's `(u,v)` as texture coordinates.
 pub fn tessellate(patch: &BezierPatch, resolution: usize) -> TriangleMesh {
+    tessellate_weighted(patch, None, resolution)
+}
+
+/// [`tessellate`] for a patch that may be rational (`weights`, positive).
+pub fn tessellate_weighted(
+    patch: &BezierPatch,
+    weights: Option<&Weights>,
+    resolution: usize,
+) -> TriangleMesh {
     let n = resolution.max(1);
+    let rational = weights.map(|w| RationalPatch::new(patch, w));
+    let scale = patch.bounds().diagonal().length();
     let mut mesh = TriangleMesh::default();
     for i in 0..=n {
         for j in 0..=n {
             let (u, v) = (i as f64 / n as f64, j as f64 / n as f64);
-            mesh.positions.push(patch.eval(u, v));
-            mesh.normals.push(patch.normal(u, v).unwrap_or(DVec3::Z));
+            let (position, normal) = match &rational {
+                None => (patch.eval(u, v), patch.normal(u, v)),
+                Some(r) => (r.eval(u, v), r.normal_at_scale(u, v, scale)),
+            };
+            mesh.positions.push(position);
+            mesh.normals.push(normal.unwrap_or(DVec3::Z));
             mesh.texcoords.push(DVec2::new(u, v));
         }
     }

@@ -252,6 +252,9 @@ pub struct ObjectDesc {
     /// With inline `patches`: each patch's `(u,v)` window `[u0, u1, v0, v1]` in the parameters
     /// of the surface it was cut from (a B-spline span), so textures follow that surface.
     pub domains: Option<Vec<[Real; 4]>>,
+    /// With inline `patches`: each patch's 16 control-point weights (positive), for rational
+    /// patches; absent, every weight is 1.
+    pub weights: Option<Vec<Vec<Real>>>,
     /// Placement (mesh, patches, quad, sphere).
     pub transform: Option<TransformDesc>,
 }

@@ -12,6 +12,7 @@ use toml_edit::{Array, DocumentMut, Item, Table, Value};
 
 use super::{Camera, Light, Material, MaterialKind, RenderParams, Scene};
 use crate::files::{write_atomically, WriteError};
+use crate::geometry::rational::Weights;
 use crate::geometry::{BezierPatch, Window};
 
 /// Why a scene could not be saved.
@@ -411,7 +412,7 @@ fn write_patches(doc: &mut DocumentMut, scene: &Scene, loaded: &[BezierPatch]) {
         if edit_inline_points(object, &own, loaded) {
             continue;
         }
-        for key in ["file", "builtin", "transform", "domains"] {
+        for key in ["file", "builtin", "transform", "domains", "weights"] {
             object.remove(key);
         }
         object.insert("patches", toml_edit::value(patch_list(&own)));
@@ -423,6 +424,18 @@ fn write_patches(doc: &mut DocumentMut, scene: &Scene, loaded: &[BezierPatch]) {
                 .map(|w| Value::from(Array::from_iter([w.u0, w.u1, w.v0, w.v1])))
                 .collect();
             object.insert("domains", toml_edit::value(list));
+        }
+        // Rational patches keep their weights (a plain patch in the same object weighs 1).
+        let weights: Vec<Option<&Weights>> = own
+            .iter()
+            .map(|(i, _)| scene.geometry.patch_weights(*i))
+            .collect();
+        if weights.iter().any(Option::is_some) {
+            let list: Array = weights
+                .iter()
+                .map(|w| Value::from(Array::from_iter(w.copied().unwrap_or([1.0; 16]))))
+                .collect();
+            object.insert("weights", toml_edit::value(list));
         }
     }
 }

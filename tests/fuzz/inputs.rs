@@ -5,9 +5,9 @@
 
 use std::path::Path;
 
+use caustic::geometry::freeform::DomainPatch;
 use caustic::geometry::{
-    parse_bpt, parse_freeform_obj, write_freeform_obj, BezierPatch, GeometryBuilder, Ray, TriangleMesh,
-    Window,
+    parse_bpt, parse_freeform_obj, write_freeform_obj, GeometryBuilder, Ray, TriangleMesh, Window,
 };
 use caustic::scene::texture::TextureSource;
 use caustic::scene::Scene;
@@ -39,12 +39,13 @@ pub fn bpt(data: &[u8]) {
     let Ok(patches) = parse_bpt(text, Path::new("fuzz.bpt")) else {
         return;
     };
-    let whole: Vec<(BezierPatch, Window)> = patches.iter().map(|p| (*p, Window::FULL)).collect();
+    let whole: Vec<DomainPatch> = patches.iter().map(|p| (*p, Window::FULL, None)).collect();
     shoot_at(&whole);
 }
 
-/// A free-form OBJ file: parse it; what it accepts has increasing windows, writes out and
-/// reads back to the same patches, and up to 8 of them intersect to finite hits.
+/// A free-form OBJ file: parse it; what it accepts has increasing windows and positive weights,
+/// writes out and reads back to the same patches (a rational patch's points to rounding: they
+/// are read through their homogeneous form), and up to 8 of them intersect to finite hits.
 pub fn freeform(data: &[u8]) {
     let Ok(text) = std::str::from_utf8(data) else {
         return;
@@ -53,29 +54,42 @@ pub fn freeform(data: &[u8]) {
         return;
     };
     assert!(
-        patches.iter().all(|(_, w)| w.u0 < w.u1 && w.v0 < w.v1),
+        patches.iter().all(|(_, w, weights)| w.u0 < w.u1
+            && w.v0 < w.v1
+            && weights.is_none_or(|w| w.iter().all(|&x| x > 0.0 && x.is_finite()))),
         "{patches:?}"
     );
     let mut out = Vec::new();
     write_freeform_obj(&[("fuzz".to_owned(), patches.clone())], &mut out).expect("writes to memory");
-    let back = parse_freeform_obj(&String::from_utf8_lossy(&out), Path::new("fuzz-out.obj"));
-    assert_eq!(
-        back.ok().as_ref(),
-        Some(&patches),
-        "the written surfaces read back differently"
-    );
+    let back = parse_freeform_obj(&String::from_utf8_lossy(&out), Path::new("fuzz-out.obj"))
+        .expect("the written surfaces read back");
+    assert_eq!(back.len(), patches.len());
+    for ((p, w, weights), (q, v, back_weights)) in patches.iter().zip(&back) {
+        assert_eq!(
+            (w, weights),
+            (v, back_weights),
+            "windows and weights read back the same"
+        );
+        let close =
+            |a: DVec3, b: DVec3| (a - b).abs().max_element() <= 1e-14 * a.abs().max_element().max(1e-300);
+        let same = match weights {
+            None => p == q,
+            Some(_) => p.points.iter().zip(&q.points).all(|(a, b)| close(*a, *b)),
+        };
+        assert!(same, "the written surfaces read back differently: {p:?} {q:?}");
+    }
     shoot_at(&patches);
 }
 
 /// Prepares up to 8 patches and shoots rays through their bounds: every hit must be finite,
 /// its (u,v) too.
-fn shoot_at(patches: &[(BezierPatch, Window)]) {
+fn shoot_at(patches: &[DomainPatch]) {
     let mut builder = GeometryBuilder::default();
-    for (p, w) in patches.iter().take(8) {
-        builder.add_patch_in(*p, *w, 0);
+    for (p, w, weights) in patches.iter().take(8) {
+        builder.add_weighted_patch_in(*p, *weights, *w, 0);
     }
     let geometry = builder.build();
-    for (p, _) in patches.iter().take(8) {
+    for (p, _, _) in patches.iter().take(8) {
         let bounds = p.bounds();
         let centre = (bounds.min + bounds.max) * 0.5;
         let size = (bounds.max - bounds.min).length().max(1e-9);

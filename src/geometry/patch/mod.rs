@@ -47,15 +47,18 @@ use glam::{DVec2, DVec3};
 
 use super::aabb::{safe_inverse, Aabb};
 use super::bezier::BezierPatch;
+use super::rational::{RationalPatch, Weights};
 use super::ray::Ray;
 
 mod cone;
+mod ray_space;
 mod root;
 mod slab;
 
 pub use cone::NormalCone;
 pub use slab::Slab;
 
+use ray_space::{RationalRay, RaySpace};
 use root::{beside, bilinear_start, jacobian_at, jacobian_sign, newton, Root};
 
 /// A rectangle `[u0,u1] × [v0,v1]` of a patch's parameter domain.
@@ -120,6 +123,12 @@ impl Window {
 
 /// A piece of a patch prepared for intersection: its window in the original patch, its own
 /// control points (the original restricted to the window) and their bounds.
+///
+/// A rational patch's leaves hold their projected control points, which bound them as a
+/// polynomial patch's do; their weights (the patch's restricted to the window,
+/// [`crate::geometry::rational::window_weights`]) are kept beside the leaves by the scene
+/// geometry and given to [`intersect_rational_leaf`], not here: a larger leaf made the
+/// polynomial leaves' search slower.
 #[derive(Clone, Debug)]
 pub struct PatchLeaf {
     /// Index of the original patch in the scene geometry.
@@ -202,17 +211,34 @@ const BOUNDS_PAD: f64 = 1e-9;
 /// their middle to converge to the only root (for all but grazing rays), within
 /// [`SubdivisionParams::max_leaves`].
 pub fn subdivide(patch: &BezierPatch, patch_index: u32, params: &SubdivisionParams) -> Vec<PatchLeaf> {
+    subdivide_weighted(patch, None, patch_index, params)
+}
+
+/// [`subdivide`] for a patch that may be rational: `patch` holds its control points, `weights`
+/// their weights (positive). The pieces are split in homogeneous form and judged flat by their
+/// projected control points.
+pub fn subdivide_weighted(
+    patch: &BezierPatch,
+    weights: Option<&Weights>,
+    patch_index: u32,
+    params: &SubdivisionParams,
+) -> Vec<PatchLeaf> {
     let scale = patch.bounds().diagonal().length();
     let leaf = |piece: Piece| piece.leaf(patch_index, scale);
-    match depth_first(patch, params, scale) {
+    let whole = Piece::new(*patch, weights.copied(), Window::FULL, 0, params, scale);
+    match depth_first(&whole, params, scale) {
         Some(pieces) => pieces.into_iter().map(leaf).collect(),
-        None => worst_first(patch, params, scale).into_iter().map(leaf).collect(),
+        None => worst_first(whole, params, scale).into_iter().map(leaf).collect(),
     }
 }
 
 /// A piece of a patch on its way to becoming a leaf.
+#[derive(Clone)]
 struct Piece {
+    /// Its control points (projected, when rational).
     sub: BezierPatch,
+    /// Its weights, when rational.
+    weights: Option<Weights>,
     window: Window,
     depth: u32,
     deviation: f64,
@@ -221,7 +247,14 @@ struct Piece {
 }
 
 impl Piece {
-    fn new(sub: BezierPatch, window: Window, depth: u32, params: &SubdivisionParams, scale: f64) -> Self {
+    fn new(
+        sub: BezierPatch,
+        weights: Option<Weights>,
+        window: Window,
+        depth: u32,
+        params: &SubdivisionParams,
+        scale: f64,
+    ) -> Self {
         let diag = sub.bounds().diagonal().length();
         let deviation = sub.bilinear_deviation();
         let flat = deviation <= params.flatness * diag;
@@ -235,6 +268,7 @@ impl Piece {
         };
         Self {
             sub,
+            weights,
             window,
             depth,
             deviation,
@@ -248,12 +282,27 @@ impl Piece {
     }
 
     fn split(&self, params: &SubdivisionParams, scale: f64) -> [Piece; 4] {
-        let children = self.sub.split_quad();
         let windows = self.window.quarters();
-        std::array::from_fn(|k| Piece::new(children[k], windows[k], self.depth + 1, params, scale))
+        let depth = self.depth + 1;
+        match &self.weights {
+            None => {
+                let children = self.sub.split_quad();
+                std::array::from_fn(|k| Piece::new(children[k], None, windows[k], depth, params, scale))
+            }
+            Some(w) => {
+                let children = RationalPatch::new(&self.sub, w).split_quad();
+                std::array::from_fn(|k| {
+                    let (sub, w) = (children[k].points(), children[k].weights);
+                    Piece::new(sub, Some(w), windows[k], depth, params, scale)
+                })
+            }
+        }
     }
 
     fn leaf(self, patch: u32, scale: f64) -> PatchLeaf {
+        // A rational leaf's numerator, which the ray is solved against, is not bounded by the
+        // projected points' deviation, nor its normals by their cone: neither is claimed.
+        let rational = self.weights.is_some();
         PatchLeaf {
             patch,
             window: self.window,
@@ -263,8 +312,12 @@ impl Piece {
                 .padded(BOUNDS_PAD * scale.max(f64::MIN_POSITIVE)),
             sub_patch: self.sub,
             scale,
-            deviation: self.deviation,
-            normals: NormalCone::of(&self.sub),
+            deviation: if rational { f64::INFINITY } else { self.deviation },
+            normals: if rational {
+                NormalCone::NONE
+            } else {
+                NormalCone::of(&self.sub)
+            },
             slab: Slab::of(&self.sub),
         }
     }
@@ -272,9 +325,9 @@ impl Piece {
 
 /// The pieces the criteria ask for, depth first; `None` as soon as they are more than
 /// [`SubdivisionParams::max_leaves`].
-fn depth_first(patch: &BezierPatch, params: &SubdivisionParams, scale: f64) -> Option<Vec<Piece>> {
+fn depth_first(whole: &Piece, params: &SubdivisionParams, scale: f64) -> Option<Vec<Piece>> {
     let mut pieces = Vec::new();
-    let mut stack = vec![Piece::new(*patch, Window::FULL, 0, params, scale)];
+    let mut stack = vec![whole.clone()];
     while let Some(piece) = stack.pop() {
         if pieces.len() + stack.len() + 1 > params.max_leaves {
             return None;
@@ -290,7 +343,7 @@ fn depth_first(patch: &BezierPatch, params: &SubdivisionParams, scale: f64) -> O
 
 /// At most [`SubdivisionParams::max_leaves`] pieces: the piece furthest from the criteria is
 /// split first (ties: the one found first), while splitting it stays within the budget.
-fn worst_first(patch: &BezierPatch, params: &SubdivisionParams, scale: f64) -> Vec<Piece> {
+fn worst_first(whole: Piece, params: &SubdivisionParams, scale: f64) -> Vec<Piece> {
     use std::cmp::Reverse;
     use std::collections::BinaryHeap;
     /// A piece's place in the queue: its excess (larger first), then the order it was found.
@@ -325,7 +378,7 @@ fn worst_first(patch: &BezierPatch, params: &SubdivisionParams, scale: f64) -> V
         }
     }
     let mut pieces = Pieces::default();
-    pieces.add(Piece::new(*patch, Window::FULL, 0, params, scale), params);
+    pieces.add(whole, params);
     // Splitting one piece into four adds three.
     while pieces.done.len() + pieces.queue.len() + 3 <= params.max_leaves {
         let Some(Key(_, Reverse(k))) = pieces.queue.pop() else {
@@ -514,23 +567,17 @@ struct Problem {
     deviation: f64,
 }
 
-/// Bounds of the ray-space control points: `(lo, hi)`.
-#[inline]
-fn hull(p: &BezierPatch) -> (DVec3, DVec3) {
-    let b = p.bounds();
-    (b.min, b.max)
-}
-
 impl Problem {
     /// A search over the ray-space sub-patch `p` of a patch whose bounds' diagonal is `scale`:
     /// its tolerance and its normals' rounding bound come from `p`'s own coordinates
     /// ([`rounding`], [`tolerance`]); `deviation` is [`Problem::deviation`]'s.
-    fn new(p: &BezierPatch, scale: f64, t_min: f64, any: bool, deviation: f64) -> Self {
-        let rounding = rounding(p);
+    fn new<P: RaySpace>(p: &P, scale: f64, t_min: f64, any: bool, deviation: f64) -> Self {
+        let rounding = p.rounding();
         Self {
             budget: SPLIT_BUDGET,
             t_min,
-            tolerance: tolerance(scale, rounding),
+            // A rational patch's numerator is its distance from the ray times the weight.
+            tolerance: tolerance(scale * p.least_scale(), rounding),
             scale,
             rounding,
             best: None,
@@ -584,12 +631,13 @@ impl Problem {
     /// fails or a second, nearer root cannot be ruled out. `known` is a root of `p` already
     /// found in the sub-patch this one was split from: it stands for the Newton solve, which
     /// would only find it again.
-    fn solve(&mut self, p: &BezierPatch, window: Window, depth: u32, t_max: f64, known: Option<Root>) {
+    fn solve<P: RaySpace>(&mut self, p: &P, window: Window, depth: u32, t_max: f64, known: Option<Root>) {
         let t_max = self.t_max(t_max);
+        let r = p.roots();
         let root = match known {
             Some(root) => Some(root),
-            None if beside(p, self.tolerance, self.deviation_at(depth)) => return,
-            None => newton(p, self.tolerance, bilinear_start(p)),
+            None if beside(r, self.tolerance, self.deviation_at(depth)) => return,
+            None => newton(r, self.tolerance, bilinear_start(r)).map(|root| p.complete(root)),
         };
         self.budget = self.budget.saturating_sub(1);
         if let Some(root) = root {
@@ -609,7 +657,7 @@ impl Problem {
             }
             // With n·d of one sign over the sub-patch the ray crosses it at most once: the
             // root Newton found (inside or outside the window) is the only one there is.
-            if jacobian_sign(p).is_some() {
+            if jacobian_sign(r).is_some() {
                 return;
             }
         }
@@ -628,17 +676,17 @@ impl Problem {
     /// At the depth limit, a tiny sub-patch that still surrounds the ray: accepts the corner
     /// nearest the ray when nothing was found. Corners lie exactly on the surface, and at a
     /// pole one of them is the pole.
-    fn settle_at_corner(&mut self, p: &BezierPatch, window: Window, t_max: f64) {
+    fn settle_at_corner<P: RaySpace>(&mut self, p: &P, window: Window, t_max: f64) {
         if self.best.is_some() {
             return;
         }
         let corners = [(0, 0.0, 0.0), (3, 0.0, 1.0), (12, 1.0, 0.0), (15, 1.0, 1.0)];
-        let off = |k: usize| p.points[k].truncate().length();
+        let off = |k: usize| p.roots().points[k].truncate().length();
         let (k, s, t) = corners
             .into_iter()
             .min_by(|a, b| off(a.0).total_cmp(&off(b.0)))
             .unwrap_or((0, 0.0, 0.0));
-        let dist = p.points[k].z;
+        let dist = p.corner_distance(k);
         if dist > self.t_min && dist < t_max {
             self.best = Some(Found {
                 t: dist,
@@ -652,9 +700,9 @@ impl Problem {
     /// nearest first so that later ones are pruned by the nearer root found. `root`, the root
     /// Newton found in `p` (if any), goes to the quarter that holds it ([`Problem::solve`]'s
     /// `known`).
-    fn solve_quarters(
+    fn solve_quarters<P: RaySpace>(
         &mut self,
-        p: &BezierPatch,
+        p: &P,
         window: Window,
         depth: u32,
         t_max: f64,
@@ -667,7 +715,7 @@ impl Problem {
         let mut live = [(0.0f64, 0usize); 4];
         let mut n = 0;
         for (k, child) in children.iter().enumerate() {
-            let h = hull(child);
+            let h = child.hull();
             if self.may_hit(h, t_max) {
                 live[n] = (h.0.z, k);
                 n += 1;
@@ -702,8 +750,8 @@ impl Problem {
     }
 
     /// Culls, then solves the ray-space patch `p`.
-    fn run(&mut self, p: &BezierPatch, window: Window, depth: u32, t_max: f64) {
-        if self.may_hit(hull(p), self.t_max(t_max)) {
+    fn run<P: RaySpace>(&mut self, p: &P, window: Window, depth: u32, t_max: f64) {
+        if self.may_hit(p.hull(), self.t_max(t_max)) {
             self.solve(p, window, depth, t_max, None);
         }
     }
@@ -723,17 +771,6 @@ const LEAF_FALLBACK_DEPTH: u32 = 24;
 /// intersector leaves the normal to [`BezierPatch::normal_at_scale`] ([`Problem::normal`]).
 const NORMAL_TURN: f64 = 1e-10;
 
-/// A bound on the rounding of the ray-space sub-patch `p`'s coordinates (the projection's and
-/// the splits'), from its two opposite corners' distance from the ray's origin.
-#[inline]
-fn rounding(p: &BezierPatch) -> f64 {
-    let far = p.points[0]
-        .abs()
-        .max_element()
-        .max(p.points[15].abs().max_element());
-    16.0 * f64::EPSILON * far
-}
-
 /// Tolerance for a patch of size `scale` whose ray-space coordinates round by `rounding`: the
 /// relative target, or the rounding if that is larger.
 #[inline]
@@ -751,7 +788,31 @@ pub fn intersect_leaf(
     t_min: f64,
     t_max: f64,
 ) -> Option<PatchHit> {
-    search_leaf(leaf, frame, span, t_min, t_max, false)
+    search_leaf(leaf, None, frame, span, (t_min, t_max), false)
+}
+
+/// [`intersect_leaf`] (from 0) for a leaf of a rational patch, `weights` its own.
+#[inline(never)]
+pub fn intersect_rational_leaf(
+    leaf: &PatchLeaf,
+    weights: &Weights,
+    frame: &RayFrame,
+    span: (f64, f64),
+    t_max: f64,
+) -> Option<PatchHit> {
+    search_leaf(leaf, Some(weights), frame, span, (0.0, t_max), false)
+}
+
+/// [`leaf_occludes`] (from 0) for a leaf of a rational patch, `weights` its own.
+#[inline(never)]
+pub fn rational_leaf_occludes(
+    leaf: &PatchLeaf,
+    weights: &Weights,
+    frame: &RayFrame,
+    span: (f64, f64),
+    t_max: f64,
+) -> bool {
+    search_leaf(leaf, Some(weights), frame, span, (0.0, t_max), true).is_some()
 }
 
 /// Whether `ray` meets a prepared leaf anywhere in `(t_min, t_max)` (shadow rays): the same
@@ -759,15 +820,17 @@ pub fn intersect_leaf(
 /// hold two roots (the ray nearly tangent to it, as shadow rays often are) the nearest-hit
 /// search splits it to rule out a nearer one; this has no need to.
 pub fn leaf_occludes(leaf: &PatchLeaf, frame: &RayFrame, span: (f64, f64), t_min: f64, t_max: f64) -> bool {
-    search_leaf(leaf, frame, span, t_min, t_max, true).is_some()
+    search_leaf(leaf, None, frame, span, (t_min, t_max), true).is_some()
 }
 
+/// The search of one leaf, whose weights are `weights` when it is rational.
+#[inline(always)]
 fn search_leaf(
     leaf: &PatchLeaf,
+    weights: Option<&Weights>,
     frame: &RayFrame,
     span: (f64, f64),
-    t_min: f64,
-    t_max: f64,
+    (t_min, t_max): (f64, f64),
     any: bool,
 ) -> Option<PatchHit> {
     // The ray's piece in a box holding the leaf passes above or below it: no projection needed.
@@ -790,19 +853,37 @@ fn search_leaf(
         }
     }
     let p = frame.project(&leaf.sub_patch);
-    let mut problem = Problem::new(&p, leaf.scale, t_min, any, leaf.deviation);
-    if problem.may_hit(hull(&p), t_max) {
+    let found = match weights {
+        None => solve_leaf(&p, leaf, from, (t_min, t_max), any),
+        Some(w) => solve_leaf(&RationalRay::new(&p, w), leaf, from, (t_min, t_max), any),
+    };
+    found.map(|found| frame.hit(found))
+}
+
+/// [`search_leaf`]'s solve of the leaf's ray-space sub-patch `p`, `from` the ray's departure
+/// point in it (if any), for a root within `(t_min, t_max)`.
+#[inline(always)]
+fn solve_leaf<P: RaySpace>(
+    p: &P,
+    leaf: &PatchLeaf,
+    from: Option<(f64, f64)>,
+    (t_min, t_max): (f64, f64),
+    any: bool,
+) -> Option<Found> {
+    let mut problem = Problem::new(p, leaf.scale, t_min, any, leaf.deviation);
+    if problem.may_hit(p.hull(), t_max) {
         // In ray space the Jacobian is n·d too; its interval test sometimes proves the sign
         // where the cone does not.
-        let known = match from.map(|st| departure(st, jacobian_sign(&p), || jacobian_at(&p, st.0, st.1))) {
+        let r = p.roots();
+        let known = match from.map(|st| departure(st, jacobian_sign(r), || jacobian_at(r, st.0, st.1))) {
             Some(Departure::Only) => return None,
             // The departure stands for the root Newton would find there (behind the ray).
             Some(Departure::Inside(s, t)) => Some(Root::without_derivatives(s, t, f64::NEG_INFINITY)),
             _ => None,
         };
-        problem.solve(&p, leaf.window, LEAF_FALLBACK_DEPTH, t_max, known);
+        problem.solve(p, leaf.window, LEAF_FALLBACK_DEPTH, t_max, known);
     }
-    problem.best.map(|found| frame.hit(found))
+    problem.best
 }
 
 /// The seed's per-ray intersector: a queue of quarters culled by their bounding boxes down to
@@ -819,38 +900,67 @@ pub fn intersect_per_ray(
     t_max: f64,
     depth: u32,
 ) -> Option<PatchHit> {
+    intersect_per_ray_weighted(patch, None, scale, ray, (t_min, t_max), depth)
+}
+
+/// [`intersect_per_ray`] for a patch that may be rational (`weights`, positive), within
+/// `(t_min, t_max)`.
+pub fn intersect_per_ray_weighted(
+    patch: &BezierPatch,
+    weights: Option<&Weights>,
+    scale: f64,
+    ray: &Ray,
+    (t_min, t_max): (f64, f64),
+    depth: u32,
+) -> Option<PatchHit> {
     let frame = RayFrame::new(ray);
     let inv_dir = super::aabb::safe_inverse(ray.dir);
     let pad = BOUNDS_PAD * scale.max(f64::MIN_POSITIVE);
     let mut survivors = Vec::new();
     let mut queue = std::collections::VecDeque::new();
-    queue.push_back((*patch, Window::FULL, 0u32));
-    while let Some((sub, window, level)) = queue.pop_front() {
+    queue.push_back((*patch, weights.copied(), Window::FULL, 0u32));
+    while let Some((sub, w, window, level)) = queue.pop_front() {
         if level == depth {
-            survivors.push((sub, window));
+            survivors.push((sub, w, window));
             continue;
         }
-        for (child, w) in sub.split_quad().into_iter().zip(window.quarters()) {
+        let children: [(BezierPatch, Option<Weights>); 4] = match &w {
+            None => sub.split_quad().map(|c| (c, None)),
+            Some(w) => RationalPatch::new(&sub, w)
+                .split_quad()
+                .map(|c| (c.points(), Some(c.weights))),
+        };
+        for ((child, cw), quarter) in children.into_iter().zip(window.quarters()) {
             if child
                 .bounds()
                 .padded(pad)
                 .hit_interval(ray.origin, inv_dir, t_max)
                 .is_some()
             {
-                queue.push_back((child, w, level + 1));
+                queue.push_back((child, cw, quarter, level + 1));
             }
         }
     }
     let mut best: Option<PatchHit> = None;
-    for (sub, window) in survivors {
+    for (sub, w, window) in survivors {
         let p = frame.project(&sub);
-        let mut problem = Problem::new(&p, scale, t_min, false, f64::INFINITY);
-        problem.run(&p, window, LEAF_FALLBACK_DEPTH, best.map_or(t_max, |h| h.t));
-        if let Some(found) = problem.best {
+        let t_max = best.map_or(t_max, |h| h.t);
+        let found = match &w {
+            None => solve_whole(&p, scale, window, (t_min, t_max)),
+            Some(w) => solve_whole(&RationalRay::new(&p, w), scale, window, (t_min, t_max)),
+        };
+        if let Some(found) = found {
             best = Some(frame.hit(found));
         }
     }
     best
+}
+
+/// The per-ray intersector's solve of one surviving ray-space sub-patch.
+fn solve_whole<P: RaySpace>(p: &P, scale: f64, window: Window, (t_min, t_max): (f64, f64)) -> Option<Found> {
+    let mut problem = Problem::new(p, scale, t_min, false, f64::INFINITY);
+    problem.run(p, window, LEAF_FALLBACK_DEPTH, t_max);
+    problem.best
 }
 
 #[cfg(test)]

@@ -7,6 +7,8 @@ use glam::{DAffine3, DMat3, DVec3};
 use toml::Spanned;
 
 use super::diagnostics::{v3, Ctx, Result, Table};
+use crate::geometry::freeform::DomainPatch;
+use crate::geometry::rational::{weights_error, Weights};
 use crate::geometry::{
     load_bpt, load_freeform_obj, BezierPatch, GeometryBuilder, Plane, Quad, Sphere, TriangleMesh, Window,
 };
@@ -126,7 +128,7 @@ fn add_shape(t: &Table, d: &ObjectDesc, label: &str, builder: &mut GeometryBuild
             t.only(
                 "patches",
                 &given,
-                &["file", "builtin", "patches", "domains", "transform"],
+                &["file", "builtin", "patches", "domains", "weights", "transform"],
             )?;
             let list = patch_list(t, d, label)?;
             let limit = crate::settings::limits::MAX_PATCHES;
@@ -137,8 +139,8 @@ fn add_shape(t: &Table, d: &ObjectDesc, label: &str, builder: &mut GeometryBuild
                     builder.patch_count() + list.len()
                 )));
             }
-            for (p, domain) in list {
-                builder.add_patch_in(p.transformed(&m), domain, id);
+            for (p, domain, weights) in list {
+                builder.add_weighted_patch_in(p.transformed(&m), weights, domain, id);
             }
         }
         other => {
@@ -151,11 +153,7 @@ fn add_shape(t: &Table, d: &ObjectDesc, label: &str, builder: &mut GeometryBuild
 }
 
 /// Applies inline `domains` (one `[u0, u1, v0, v1]` per patch, each range increasing).
-pub(super) fn patch_domains(
-    t: &Table,
-    patches: &mut [(BezierPatch, Window)],
-    domains: &[[Real; 4]],
-) -> Result<()> {
+pub(super) fn patch_domains(t: &Table, patches: &mut [DomainPatch], domains: &[[Real; 4]]) -> Result<()> {
     if domains.len() != patches.len() {
         return Err(t.err(format!(
             "'domains' has {} entries for {} patches",
@@ -163,7 +161,7 @@ pub(super) fn patch_domains(
             patches.len()
         )));
     }
-    for (i, ((_, window), d)) in patches.iter_mut().zip(domains).enumerate() {
+    for (i, ((_, window, _), d)) in patches.iter_mut().zip(domains).enumerate() {
         let [u0, u1, v0, v1] = d.map(|r| r.0);
         if !(u0 < u1 && v0 < v1) {
             return Err(t.err(format!(
@@ -171,6 +169,30 @@ pub(super) fn patch_domains(
             )));
         }
         *window = Window { u0, u1, v0, v1 };
+    }
+    Ok(())
+}
+
+/// Applies inline `weights` (16 positive numbers per patch): the patches become rational.
+fn patch_weights(t: &Table, patches: &mut [DomainPatch], weights: &[Vec<Real>]) -> Result<()> {
+    if weights.len() != patches.len() {
+        return Err(t.err(format!(
+            "'weights' has {} entries for {} patches",
+            weights.len(),
+            patches.len()
+        )));
+    }
+    for (i, ((_, _, out), w)) in patches.iter_mut().zip(weights).enumerate() {
+        let w: Weights = w
+            .iter()
+            .map(|r| r.0)
+            .collect::<Vec<f64>>()
+            .try_into()
+            .map_err(|w: Vec<f64>| t.err(format!("'weights[{i}]' must have 16 weights, has {}", w.len())))?;
+        if let Some(why) = weights_error(&w) {
+            return Err(t.err(format!("'weights[{i}]': {why}")));
+        }
+        *out = Some(w);
     }
     Ok(())
 }
@@ -191,7 +213,7 @@ fn material_index(t: &Table, name: &str, materials: &BTreeMap<String, usize>) ->
 }
 
 /// The keys an `[[objects]]` table gave, for [`Table::only`].
-fn given_keys(d: &ObjectDesc) -> [(&'static str, bool); 12] {
+fn given_keys(d: &ObjectDesc) -> [(&'static str, bool); 13] {
     [
         ("center", d.center.is_some()),
         ("radius", d.radius.is_some()),
@@ -204,6 +226,7 @@ fn given_keys(d: &ObjectDesc) -> [(&'static str, bool); 12] {
         ("builtin", d.builtin.is_some()),
         ("patches", d.patches.is_some()),
         ("domains", d.domains.is_some()),
+        ("weights", d.weights.is_some()),
         ("transform", d.transform.is_some()),
     ]
 }
@@ -223,11 +246,16 @@ fn placed_mesh(t: &Table, path: &std::path::Path, m: &DAffine3) -> Result<Triang
 
 /// The patches of a `patches` object, each with its `(u,v)` window: from a `.bpt` or a
 /// free-form `.obj` file, built in, or written inline (with optional `domains`).
-fn patch_list(t: &Table, d: &ObjectDesc, label: &str) -> Result<Vec<(BezierPatch, Window)>> {
+fn patch_list(t: &Table, d: &ObjectDesc, label: &str) -> Result<Vec<DomainPatch>> {
     if d.domains.is_some() && d.patches.is_none() {
         return Err(t.err("'domains' applies only to inline 'patches'"));
     }
-    let whole = |patches: Vec<BezierPatch>| patches.into_iter().map(|p| (p, Window::FULL)).collect();
+    if d.weights.is_some() && d.patches.is_none() {
+        return Err(t.err(
+            "'weights' applies only to inline 'patches' (an OBJ file's rational surfaces carry their own)",
+        ));
+    }
+    let whole = |patches: Vec<BezierPatch>| patches.into_iter().map(|p| (p, Window::FULL, None)).collect();
     match (d.file.as_deref(), d.builtin.as_deref(), &d.patches) {
         (Some(file), None, None) => {
             let path = t.ctx.resolve(&t.span, &format!("{label}: 'file'"), file)?;
@@ -253,6 +281,7 @@ fn patch_list(t: &Table, d: &ObjectDesc, label: &str) -> Result<Vec<(BezierPatch
                 out.push((
                     BezierPatch::new(std::array::from_fn(|j| v3(&points[j]))),
                     Window::FULL,
+                    None,
                 ));
             }
             if out.is_empty() {
@@ -260,6 +289,9 @@ fn patch_list(t: &Table, d: &ObjectDesc, label: &str) -> Result<Vec<(BezierPatch
             }
             if let Some(domains) = &d.domains {
                 patch_domains(t, &mut out, domains)?;
+            }
+            if let Some(weights) = &d.weights {
+                patch_weights(t, &mut out, weights)?;
             }
             Ok(out)
         }
