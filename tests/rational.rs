@@ -309,3 +309,40 @@ fn the_example_ring_is_exactly_round() {
         }
     }
 }
+
+#[test]
+fn export_obj_writes_the_rational_ring_round_and_as_rational_surfaces() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mesh = dir.path().join("ring_mesh.obj");
+    let run = common::caustic(&["export-obj", "scenes/ring.toml", "--out", mesh.to_str().expect("utf-8")]);
+    assert!(run.status.success(), "{}", common::text(&run));
+    let text = std::fs::read_to_string(&mesh).expect("reads");
+    let mut vertices = 0;
+    for line in text.lines().filter(|l| l.starts_with("v ")) {
+        let n: Vec<f64> = line[2..].split_whitespace().map(|w| w.parse().expect("number")).collect();
+        let radius = (n[0] * n[0] + n[2] * n[2]).sqrt();
+        assert!((radius - 1.0).abs() < 1e-5, "{line}");
+        vertices += 1;
+    }
+    assert!(vertices > 100, "{vertices} vertices");
+    let freeform = dir.path().join("ring.obj");
+    let run = common::caustic(&[
+        "export-obj",
+        "scenes/ring.toml",
+        "--freeform",
+        "--out",
+        freeform.to_str().expect("utf-8"),
+    ]);
+    assert!(run.status.success(), "{}", common::text(&run));
+    let text = std::fs::read_to_string(&freeform).expect("reads");
+    assert_eq!(text.matches("cstype rat bezier").count(), 4);
+    let back = parse_freeform_obj(&text, &freeform).expect("reads back");
+    let scene = Scene::load(Path::new("scenes/ring.toml")).expect("loads");
+    for (k, (p, _, w)) in back.iter().enumerate() {
+        assert_eq!(w.as_ref(), scene.geometry.patch_weights(k), "patch {k}");
+        let q = &scene.geometry.patches()[k].0;
+        for (a, b) in p.points.iter().zip(&q.points) {
+            assert!((*a - *b).length() < 1e-15, "patch {k}: {a} against {b}");
+        }
+    }
+}
