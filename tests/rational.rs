@@ -314,12 +314,20 @@ fn the_example_ring_is_exactly_round() {
 fn export_obj_writes_the_rational_ring_round_and_as_rational_surfaces() {
     let dir = tempfile::tempdir().expect("temp dir");
     let mesh = dir.path().join("ring_mesh.obj");
-    let run = common::caustic(&["export-obj", "scenes/ring.toml", "--out", mesh.to_str().expect("utf-8")]);
+    let run = common::caustic(&[
+        "export-obj",
+        "scenes/ring.toml",
+        "--out",
+        mesh.to_str().expect("utf-8"),
+    ]);
     assert!(run.status.success(), "{}", common::text(&run));
     let text = std::fs::read_to_string(&mesh).expect("reads");
     let mut vertices = 0;
     for line in text.lines().filter(|l| l.starts_with("v ")) {
-        let n: Vec<f64> = line[2..].split_whitespace().map(|w| w.parse().expect("number")).collect();
+        let n: Vec<f64> = line[2..]
+            .split_whitespace()
+            .map(|w| w.parse().expect("number"))
+            .collect();
         let radius = (n[0] * n[0] + n[2] * n[2]).sqrt();
         assert!((radius - 1.0).abs() < 1e-5, "{line}");
         vertices += 1;
