@@ -1,6 +1,6 @@
-//! Geometry in `f64`: rays, bounds, Bézier patch maths and exact ray/patch intersection,
-//! spheres, quads and planes, triangle meshes, the BVH, and the container that holds a scene's
-//! shapes.
+//! Geometry in `f64`: rays, bounds, Bézier patch maths (rational patches too) and exact
+//! ray/patch intersection, spheres, quads and planes, triangle meshes, the BVH, and the
+//! container that holds a scene's shapes.
 
 pub mod aabb;
 pub mod bezier;

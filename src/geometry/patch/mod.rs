@@ -42,6 +42,9 @@
 //! Sub-patch `(s,t)` map back to the original patch as `u = u0 + s(u1-u0)`, `v = v0 + t(v1-v0)`
 //! (seed report §2.4: the linear map survives any number of De Casteljau splits), so texture
 //! coordinates always refer to the original patch.
+//!
+//! Rational patches ([`crate::geometry::rational`]) take the same path: the root finder solves
+//! their numerator, a polynomial patch with the same roots ([`ray_space`] explains it).
 
 use glam::{DVec2, DVec3};
 
