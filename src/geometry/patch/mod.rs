@@ -44,7 +44,7 @@
 //! coordinates always refer to the original patch.
 //!
 //! Rational patches ([`crate::geometry::rational`]) take the same path: the root finder solves
-//! their numerator, a polynomial patch with the same roots ([`ray_space`] explains it).
+//! their numerator, a polynomial patch with the same roots (the `ray_space` module explains it).
 
 use glam::{DVec2, DVec3};
 
