@@ -60,6 +60,86 @@ where
     ([p[0], p01, p012, mid], [mid, p123, p23, p[3]])
 }
 
+/// What a grid of 4×4 Bézier coefficients may hold: points, or a rational patch's weights.
+pub trait Coefficient:
+    Copy + Add<Output = Self> + std::ops::Sub<Output = Self> + Mul<f64, Output = Self>
+{
+}
+
+impl<T: Copy + Add<Output = T> + std::ops::Sub<Output = T> + Mul<f64, Output = T>> Coefficient for T {}
+
+/// The 4×4 coefficients `c` (`c[4 * i + j]`, `i` along `u`) split along `u` at `t` with De
+/// Casteljau's construction: those over `u ∈ [0,t]` and `u ∈ [t,1]`.
+#[inline]
+pub fn split_grid_u<T: Coefficient>(c: &[T; 16], t: f64) -> ([T; 16], [T; 16]) {
+    let (mut lo, mut hi) = (*c, *c);
+    for j in 0..4 {
+        let (a, b) = split_cubic([c[j], c[4 + j], c[8 + j], c[12 + j]], t);
+        for i in 0..4 {
+            lo[4 * i + j] = a[i];
+            hi[4 * i + j] = b[i];
+        }
+    }
+    (lo, hi)
+}
+
+/// [`split_grid_u`] along `v`.
+#[inline]
+pub fn split_grid_v<T: Coefficient>(c: &[T; 16], t: f64) -> ([T; 16], [T; 16]) {
+    let (mut lo, mut hi) = (*c, *c);
+    for i in 0..4 {
+        let (a, b) = split_cubic([c[4 * i], c[4 * i + 1], c[4 * i + 2], c[4 * i + 3]], t);
+        lo[4 * i..4 * i + 4].copy_from_slice(&a);
+        hi[4 * i..4 * i + 4].copy_from_slice(&b);
+    }
+    (lo, hi)
+}
+
+/// The coefficients split in four at `(0.5, 0.5)`: `[u-low v-low, u-high v-low, u-low v-high,
+/// u-high v-high]`.
+#[inline]
+pub fn split_grid_quad<T: Coefficient>(c: &[T; 16]) -> [[T; 16]; 4] {
+    let (ul, uh) = split_grid_u(c, 0.5);
+    let (a, cc) = split_grid_v(&ul, 0.5);
+    let (b, d) = split_grid_v(&uh, 0.5);
+    [a, b, cc, d]
+}
+
+/// The coefficients restricted to `[u0,u1] × [v0,v1]` and reparameterised over `[0,1]²`.
+pub fn sub_grid<T: Coefficient>(c: &[T; 16], (u0, u1): (f64, f64), (v0, v1): (f64, f64)) -> [T; 16] {
+    type Split<T> = fn(&[T; 16], f64) -> ([T; 16], [T; 16]);
+    let cut = |c: [T; 16], lo: f64, hi: f64, split: Split<T>| {
+        // Cut off above `hi`, then below `lo` measured in the remaining piece.
+        let below_hi = if hi < 1.0 { split(&c, hi).0 } else { c };
+        if lo > 0.0 && hi > 0.0 {
+            split(&below_hi, lo / hi).1
+        } else {
+            below_hi
+        }
+    };
+    let c = cut(*c, u0, u1, split_grid_u);
+    cut(c, v0, v1, split_grid_v)
+}
+
+/// The unit normal `∂P/∂u × ∂P/∂v` of a surface whose point and derivatives `eval` gives, at
+/// `(u,v)`, or where it vanishes (a collapsed edge) the limit normal from points approaching
+/// `(u,v)` from the inside; `scale` is the surface's size, below `1e-12 · scale²` a cross
+/// product is rounding noise. `None` for a surface degenerate everywhere near `(u,v)`.
+pub fn limit_normal(u: f64, v: f64, scale: f64, eval: impl Fn(f64, f64) -> SurfacePoint) -> Option<DVec3> {
+    if scale == 0.0 || !scale.is_finite() {
+        return None;
+    }
+    let tiny = 1e-12 * scale * scale;
+    for step in [0.0, 1e-7, 1e-5, 1e-3, 1e-2] {
+        let sp = eval(u + (0.5 - u) * step, v + (0.5 - v) * step);
+        let n = sp.dp_du.cross(sp.dp_dv);
+        if n.length() > tiny {
+            return Some(n.normalize());
+        }
+    }
+    None
+}
+
 /// Point and first partial derivatives of a patch.
 #[derive(Clone, Copy, Debug)]
 pub struct SurfacePoint {
@@ -161,86 +241,33 @@ impl BezierPatch {
     /// [`BezierPatch::normal`] for a patch whose bounds' diagonal, `scale`, the caller knows
     /// (a prepared patch: finding the bounds again is a fifth of the work).
     pub fn normal_at_scale(&self, u: f64, v: f64, scale: f64) -> Option<DVec3> {
-        if scale == 0.0 || !scale.is_finite() {
-            return None;
-        }
-        // Relative threshold below which the cross product is rounding noise.
-        let tiny = 1e-12 * scale * scale;
-        for step in [0.0, 1e-7, 1e-5, 1e-3, 1e-2] {
-            let su = u + (0.5 - u) * step;
-            let sv = v + (0.5 - v) * step;
-            let sp = self.eval_with_derivs(su, sv);
-            let n = sp.dp_du.cross(sp.dp_dv);
-            if n.length() > tiny {
-                return Some(n.normalize());
-            }
-        }
-        None
+        limit_normal(u, v, scale, |u, v| self.eval_with_derivs(u, v))
     }
 
     /// Splits along `u` at `t`: the patches over `u ∈ [0,t]` and `u ∈ [t,1]`.
     #[inline]
     pub fn split_u(&self, t: f64) -> (Self, Self) {
-        let mut lo = [DVec3::ZERO; 16];
-        let mut hi = [DVec3::ZERO; 16];
-        for j in 0..4 {
-            let col = [
-                self.point(0, j),
-                self.point(1, j),
-                self.point(2, j),
-                self.point(3, j),
-            ];
-            let (a, b) = split_cubic(col, t);
-            for i in 0..4 {
-                lo[4 * i + j] = a[i];
-                hi[4 * i + j] = b[i];
-            }
-        }
+        let (lo, hi) = split_grid_u(&self.points, t);
         (Self::new(lo), Self::new(hi))
     }
 
     /// Splits along `v` at `t`: the patches over `v ∈ [0,t]` and `v ∈ [t,1]`.
     #[inline]
     pub fn split_v(&self, t: f64) -> (Self, Self) {
-        let mut lo = [DVec3::ZERO; 16];
-        let mut hi = [DVec3::ZERO; 16];
-        for i in 0..4 {
-            let row = [
-                self.point(i, 0),
-                self.point(i, 1),
-                self.point(i, 2),
-                self.point(i, 3),
-            ];
-            let (a, b) = split_cubic(row, t);
-            lo[4 * i..4 * i + 4].copy_from_slice(&a);
-            hi[4 * i..4 * i + 4].copy_from_slice(&b);
-        }
+        let (lo, hi) = split_grid_v(&self.points, t);
         (Self::new(lo), Self::new(hi))
     }
 
     /// Splits into four at `(0.5, 0.5)`: `[u-low v-low, u-high v-low, u-low v-high, u-high v-high]`.
     #[inline]
     pub fn split_quad(&self) -> [Self; 4] {
-        let (ul, uh) = self.split_u(0.5);
-        let (a, c) = ul.split_v(0.5);
-        let (b, d) = uh.split_v(0.5);
-        [a, b, c, d]
+        split_grid_quad(&self.points).map(Self::new)
     }
 
     /// The patch restricted to `[u0,u1] × [v0,v1]`, reparameterised over `[0,1]²`: its point at
     /// `(s,t)` is this patch's point at `(u0 + s(u1-u0), v0 + t(v1-v0))`.
     pub fn sub_patch(&self, u0: f64, u1: f64, v0: f64, v1: f64) -> Self {
-        let cut = |p: Self, lo: f64, hi: f64, split: fn(&Self, f64) -> (Self, Self)| {
-            // Cut off above `hi`, then below `lo` measured in the remaining piece.
-            let below_hi = if hi < 1.0 { split(&p, hi).0 } else { p };
-            if lo > 0.0 && hi > 0.0 {
-                split(&below_hi, lo / hi).1
-            } else {
-                below_hi
-            }
-        };
-        let p = cut(*self, u0, u1, Self::split_u);
-        cut(p, v0, v1, Self::split_v)
+        Self::new(sub_grid(&self.points, (u0, u1), (v0, v1)))
     }
 
     /// Bounds of the control hull, which contain the patch (convex hull property).

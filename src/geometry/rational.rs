@@ -13,7 +13,9 @@
 
 use glam::DVec3;
 
-use super::bezier::{bernstein, bernstein_deriv, split_cubic, BezierPatch, SurfacePoint};
+use super::bezier::{
+    bernstein, bernstein_deriv, limit_normal, split_grid_quad, sub_grid, BezierPatch, SurfacePoint,
+};
 use super::patch::Window;
 
 /// The weights of a rational patch's 16 control points, `weights[4 * i + j]` as the points.
@@ -80,25 +82,13 @@ impl RationalPatch {
     /// The unit normal `∂P/∂u × ∂P/∂v`, or the limit normal nearby where it vanishes (as
     /// [`BezierPatch::normal_at_scale`], `scale` the patch's size).
     pub fn normal_at_scale(&self, u: f64, v: f64, scale: f64) -> Option<DVec3> {
-        if scale == 0.0 || !scale.is_finite() {
-            return None;
-        }
-        let tiny = 1e-12 * scale * scale;
-        for step in [0.0, 1e-7, 1e-5, 1e-3, 1e-2] {
-            let (su, sv) = (u + (0.5 - u) * step, v + (0.5 - v) * step);
-            let sp = self.eval_with_derivs(su, sv);
-            let n = sp.dp_du.cross(sp.dp_dv);
-            if n.length() > tiny {
-                return Some(n.normalize());
-            }
-        }
-        None
+        limit_normal(u, v, scale, |u, v| self.eval_with_derivs(u, v))
     }
 
     /// Splits into four at `(0.5, 0.5)`, in [`BezierPatch::split_quad`]'s order.
     pub fn split_quad(&self) -> [Self; 4] {
         let n = self.numerator.split_quad();
-        let w = split_quad_weights(&self.weights);
+        let w = split_grid_quad(&self.weights);
         std::array::from_fn(|k| Self {
             numerator: n[k],
             weights: w[k],
@@ -125,39 +115,7 @@ pub fn weight_with_derivs(w: &Weights, u: f64, v: f64) -> [f64; 3] {
 /// The weights `w` restricted to `window` and reparameterised over `[0,1]²`, as
 /// [`BezierPatch::sub_patch`] restricts points.
 pub fn window_weights(w: &Weights, window: &Window) -> Weights {
-    // Each weight as a point's x: the same De Casteljau cuts as the points'.
-    let as_patch = BezierPatch::new(w.map(|x| DVec3::new(x, 0.0, 0.0)));
-    let cut = as_patch.sub_patch(window.u0, window.u1, window.v0, window.v1);
-    cut.points.map(|p| p.x)
-}
-
-/// The weights of [`BezierPatch::split_quad`]'s four quarters: the same De Casteljau splits
-/// on the scalar patch.
-pub fn split_quad_weights(w: &Weights) -> [Weights; 4] {
-    let split_u = |w: &Weights| {
-        let (mut lo, mut hi) = ([0.0; 16], [0.0; 16]);
-        for j in 0..4 {
-            let (a, b) = split_cubic([w[j], w[4 + j], w[8 + j], w[12 + j]], 0.5);
-            for i in 0..4 {
-                lo[4 * i + j] = a[i];
-                hi[4 * i + j] = b[i];
-            }
-        }
-        (lo, hi)
-    };
-    let split_v = |w: &Weights| {
-        let (mut lo, mut hi) = ([0.0; 16], [0.0; 16]);
-        for i in 0..4 {
-            let (a, b) = split_cubic([w[4 * i], w[4 * i + 1], w[4 * i + 2], w[4 * i + 3]], 0.5);
-            lo[4 * i..4 * i + 4].copy_from_slice(&a);
-            hi[4 * i..4 * i + 4].copy_from_slice(&b);
-        }
-        (lo, hi)
-    };
-    let (ul, uh) = split_u(w);
-    let (a, c) = split_v(&ul);
-    let (b, d) = split_v(&uh);
-    [a, b, c, d]
+    sub_grid(w, (window.u0, window.u1), (window.v0, window.v1))
 }
 
 #[cfg(test)]

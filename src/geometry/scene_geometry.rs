@@ -283,7 +283,6 @@ impl GeometryBuilder {
             quads: self.quads,
             planes: self.planes,
             meshes: self.meshes,
-            has_rational: patch_weights.iter().any(Option::is_some),
             leaf_weights: leaf_weights(&leaves, &patch_weights),
             patches,
             patch_domains,
@@ -298,17 +297,18 @@ impl GeometryBuilder {
     }
 }
 
-/// Each leaf's weights when some patch is rational (a polynomial patch's leaves weigh 1);
-/// none otherwise.
-fn leaf_weights(leaves: &[PatchLeaf], patch_weights: &[Option<Box<Weights>>]) -> Vec<Weights> {
+/// When some patch is rational, each leaf's weights (a rational patch's over the leaf's
+/// window, none for a polynomial patch's leaf); nothing otherwise.
+fn leaf_weights(leaves: &[PatchLeaf], patch_weights: &[Option<Box<Weights>>]) -> Vec<Option<Weights>> {
     if patch_weights.iter().all(Option::is_none) {
         return Vec::new();
     }
     leaves
         .iter()
-        .map(|l| match &patch_weights[l.patch as usize] {
-            Some(w) => window_weights(w, &l.window),
-            None => [1.0; 16],
+        .map(|l| {
+            patch_weights[l.patch as usize]
+                .as_deref()
+                .map(|w| window_weights(w, &l.window))
         })
         .collect()
 }
@@ -340,11 +340,8 @@ pub struct SceneGeometry {
     patches: Vec<(BezierPatch, u32)>,
     patch_domains: Vec<Window>,
     patch_weights: Vec<Option<Box<Weights>>>,
-    /// Whether any patch is rational.
-    has_rational: bool,
-    /// With a rational patch, each leaf's weights (the patch's over the leaf's window; unused
-    /// for a polynomial patch's leaf); otherwise empty.
-    leaf_weights: Vec<Weights>,
+    /// With a rational patch, each leaf's weights ([`leaf_weights`]); otherwise empty.
+    leaf_weights: Vec<Option<Weights>>,
     patch_scales: Vec<f64>,
     leaves: Vec<PatchLeaf>,
     /// Everything in the BVH; its leaves index this list. Patch leaves (or whole patches,
@@ -431,19 +428,11 @@ impl SceneGeometry {
         self.patch_weights.get(k).and_then(|w| w.as_deref())
     }
 
-    /// Leaf `leaf`'s weights when its patch is rational, on a ray's path: asks nothing of a
-    /// scene without rational patches.
+    /// Leaf `leaf`'s weights when its patch is rational, on a ray's path: a scene without
+    /// rational patches keeps no leaf weights, so this asks nothing more of it.
     #[inline(always)]
     fn rational_weights(&self, leaf: u32) -> Option<&Weights> {
-        if self.has_rational
-            && self
-                .patch_weights(self.leaves[leaf as usize].patch as usize)
-                .is_some()
-        {
-            self.leaf_weights.get(leaf as usize)
-        } else {
-            None
-        }
+        self.leaf_weights.get(leaf as usize).and_then(Option::as_ref)
     }
 
     /// Moves control point `index` (0–15, `4i + j`) of patch `patch` to `position` and
@@ -527,9 +516,7 @@ impl SceneGeometry {
                 true
             }
         };
-        if self.has_rational {
-            self.leaf_weights = leaf_weights(&self.leaves, &self.patch_weights);
-        }
+        self.leaf_weights = leaf_weights(&self.leaves, &self.patch_weights);
         if refit {
             self.bvh.refit(&self.primitive_bounds);
         } else {

@@ -61,7 +61,7 @@ mod slab;
 pub use cone::NormalCone;
 pub use slab::Slab;
 
-use ray_space::{RationalRay, RaySpace};
+use ray_space::RaySpace;
 use root::{beside, bilinear_start, jacobian_at, jacobian_sign, newton, Root};
 
 /// A rectangle `[u0,u1] × [v0,v1]` of a patch's parameter domain.
@@ -858,7 +858,7 @@ fn search_leaf(
     let p = frame.project(&leaf.sub_patch);
     let found = match weights {
         None => solve_leaf(&p, leaf, from, (t_min, t_max), any),
-        Some(w) => solve_leaf(&RationalRay::new(&p, w), leaf, from, (t_min, t_max), any),
+        Some(w) => solve_leaf(&RationalPatch::new(&p, w), leaf, from, (t_min, t_max), any),
     };
     found.map(|found| frame.hit(found))
 }
@@ -950,7 +950,7 @@ pub fn intersect_per_ray_weighted(
         let t_max = best.map_or(t_max, |h| h.t);
         let found = match &w {
             None => solve_whole(&p, scale, window, (t_min, t_max)),
-            Some(w) => solve_whole(&RationalRay::new(&p, w), scale, window, (t_min, t_max)),
+            Some(w) => solve_whole(&RationalPatch::new(&p, w), scale, window, (t_min, t_max)),
         };
         if let Some(found) = found {
             best = Some(frame.hit(found));

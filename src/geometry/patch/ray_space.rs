@@ -13,7 +13,7 @@ use glam::DVec3;
 
 use super::root::Root;
 use crate::geometry::bezier::BezierPatch;
-use crate::geometry::rational::{split_quad_weights, weight_with_derivs, Weights};
+use crate::geometry::rational::{weight_with_derivs, RationalPatch};
 
 /// Bounds of the ray-space control points: `(lo, hi)`.
 #[inline]
@@ -91,24 +91,8 @@ impl RaySpace for BezierPatch {
     }
 }
 
-/// A rational sub-patch in ray space: its numerator and weights.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct RationalRay {
-    numerator: BezierPatch,
-    weights: Weights,
-}
-
-impl RationalRay {
-    /// From the ray-space projected control points `points` and their `weights`.
-    pub fn new(points: &BezierPatch, weights: &Weights) -> Self {
-        Self {
-            numerator: BezierPatch::new(std::array::from_fn(|k| points.points[k] * weights[k])),
-            weights: *weights,
-        }
-    }
-}
-
-impl RaySpace for RationalRay {
+/// A rational sub-patch in ray space ([`RationalPatch::new`] of the ray-space projected points).
+impl RaySpace for RationalPatch {
     fn roots(&self) -> &BezierPatch {
         &self.numerator
     }
@@ -124,12 +108,7 @@ impl RaySpace for RationalRay {
     }
 
     fn split_quad(&self) -> [Self; 4] {
-        let n = self.numerator.split_quad();
-        let w = split_quad_weights(&self.weights);
-        std::array::from_fn(|k| Self {
-            numerator: n[k],
-            weights: w[k],
-        })
+        RationalPatch::split_quad(self)
     }
 
     fn complete(&self, root: Root) -> Root {
