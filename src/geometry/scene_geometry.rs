@@ -597,10 +597,17 @@ impl SceneGeometry {
             .sum();
         vec![
             (
-                "patches (control points, domains, scales)",
-                bytes(&self.patches) + bytes(&self.patch_domains) + bytes(&self.patch_scales),
+                "patches (control points, domains, scales, weights)",
+                bytes(&self.patches)
+                    + bytes(&self.patch_domains)
+                    + bytes(&self.patch_scales)
+                    + bytes(&self.patch_weights)
+                    + self.patch_weights.iter().flatten().count() * std::mem::size_of::<Weights>(),
             ),
-            ("patch leaves (sub-patches and their tests)", bytes(&self.leaves)),
+            (
+                "patch leaves (sub-patches and their tests, weights)",
+                bytes(&self.leaves) + bytes(&self.leaf_weights),
+            ),
             (
                 "primitive list and bounds",
                 bytes(&self.primitives) + bytes(&self.primitive_bounds),
