@@ -8,6 +8,7 @@ mod common;
 use std::path::Path;
 
 use caustic::geometry::bspline::{BsplineSurface, Knots};
+use caustic::geometry::freeform::DomainPatch;
 use caustic::geometry::{parse_freeform_obj, write_freeform_obj, BezierPatch, Ray, Window};
 use caustic::scene::Scene;
 use glam::DVec3;
@@ -65,8 +66,8 @@ fn vertices(text: &str) -> Vec<DVec3> {
 /// The non-rational patches of `text` with their windows.
 fn parse(text: &str) -> Result<Vec<(BezierPatch, Window)>, String> {
     let patches = parse_freeform_obj(text, Path::new("surface.obj")).map_err(|e| e.to_string())?;
-    assert!(patches.iter().all(|(_, _, w)| w.is_none()), "a rational patch");
-    Ok(patches.into_iter().map(|(p, w, _)| (p, w)).collect())
+    assert!(patches.iter().all(|d| d.weights.is_none()), "a rational patch");
+    Ok(patches.into_iter().map(|d| (d.patch, d.window)).collect())
 }
 
 #[test]
@@ -216,7 +217,13 @@ fn patches_round_trip_bit_for_bit_through_the_freeform_writer() {
     let mut out = Vec::new();
     let groups = [(
         "teapot".to_owned(),
-        patches.iter().map(|&(p, w)| (p, w, None)).collect(),
+        patches
+            .iter()
+            .map(|&(patch, window)| DomainPatch {
+                window,
+                ..DomainPatch::whole(patch)
+            })
+            .collect(),
     )];
     write_freeform_obj(&groups, &mut out).expect("writes");
     let text = String::from_utf8(out).expect("utf-8");
@@ -295,7 +302,7 @@ fn malformed_surfaces_are_errors_naming_the_file_and_line() {
         ),
         (
             format!("{p}cstype bezier\ndeg 3 3\n{SURF}\nparm u 0 1\nparm v 0 1\ntrim 0 1 1\nend\n"),
-            "surface.obj:22: 'trim': trimmed surfaces",
+            "surface.obj:22: 'trim': curve 1 is not in the file (0 'curv2' curves)",
         ),
         (
             format!("{p}cstype cardinal\ndeg 3 3\n{SURF}\nparm u 0 1\nparm v 0 1\nend\n"),
@@ -382,8 +389,9 @@ fn export_obj_freeform_reads_back_to_the_same_patches() {
     assert_eq!(read.len(), count);
     // Plain patches bit for bit; the ring's rational ones (read through their homogeneous form)
     // to rounding, with their weights exactly.
-    for (k, ((p, window, weights), (q, _))) in read.iter().zip(builtin.geometry.patches()).enumerate() {
-        assert_eq!(*window, Window::FULL);
+    for (k, (d, (q, _))) in read.iter().zip(builtin.geometry.patches()).enumerate() {
+        let (p, weights) = (&d.patch, &d.weights);
+        assert_eq!(d.window, Window::FULL);
         assert_eq!(weights.as_ref(), builtin.geometry.patch_weights(k), "patch {k}");
         if weights.is_none() {
             assert_eq!(p, q, "patch {k}");
@@ -397,7 +405,7 @@ fn export_obj_freeform_reads_back_to_the_same_patches() {
         }
     }
     assert!(
-        read.iter().any(|(_, _, w)| w.is_some()),
+        read.iter().any(|d| d.weights.is_some()),
         "the ring's patches are rational"
     );
     // Without --force an existing file is kept.
@@ -427,10 +435,11 @@ fn a_surface_from_geomdl_matches_geomdls_own_evaluation() {
             .map(|w| w.parse().expect("number"))
             .collect();
         let (u, v, expected) = (n[0], n[1], DVec3::new(n[2], n[3], n[4]));
-        let (patch, w, _) = patches
+        let found = patches
             .iter()
-            .find(|(_, w, _)| (w.u0..=w.u1).contains(&u) && (w.v0..=w.v1).contains(&v))
+            .find(|d| (d.window.u0..=d.window.u1).contains(&u) && (d.window.v0..=d.window.v1).contains(&v))
             .expect("a patch covers every parameter");
+        let (patch, w) = (&found.patch, &found.window);
         let s = (u - w.u0) / (w.u1 - w.u0);
         let t = (v - w.v0) / (w.v1 - w.v0);
         let d = (patch.eval(s, t) - expected).length();

@@ -61,10 +61,10 @@ fn a_nurbs_cylinder_from_obj_is_hit_on_its_true_circle() {
     let patches = parse_freeform_obj(&cylinder_obj(), Path::new("cylinder.obj")).expect("reads");
     // Four quadratic spans around, one linear span along: four rational bicubic patches.
     assert_eq!(patches.len(), 4);
-    assert!(patches.iter().all(|(_, _, w)| w.is_some()));
+    assert!(patches.iter().all(|d| d.weights.is_some()));
     let mut builder = GeometryBuilder::default();
-    for (p, window, weights) in &patches {
-        builder.add_weighted_patch_in(*p, *weights, *window, 0);
+    for d in &patches {
+        builder.add_weighted_patch_in(d.patch, d.weights, d.window, 0);
     }
     let geometry = builder.build();
     let mut rng = common::rng(11);
@@ -346,11 +346,102 @@ fn export_obj_writes_the_rational_ring_round_and_as_rational_surfaces() {
     assert_eq!(text.matches("cstype rat bezier").count(), 4);
     let back = parse_freeform_obj(&text, &freeform).expect("reads back");
     let scene = Scene::load(Path::new("scenes/ring.toml")).expect("loads");
-    for (k, (p, _, w)) in back.iter().enumerate() {
-        assert_eq!(w.as_ref(), scene.geometry.patch_weights(k), "patch {k}");
+    for (k, d) in back.iter().enumerate() {
+        let p = &d.patch;
+        assert_eq!(d.weights.as_ref(), scene.geometry.patch_weights(k), "patch {k}");
         let q = &scene.geometry.patches()[k].0;
         for (a, b) in p.points.iter().zip(&q.points) {
             assert!((*a - *b).length() < 1e-15, "patch {k}: {a} against {b}");
         }
+    }
+}
+
+/// The unit sphere as CAD programs write it: a rational quadratic semicircle (5 points,
+/// weights 1, √½, 1, √½, 1) revolved by a rational quadratic circle (9 points), each point's
+/// weight the product of the two (Piegl & Tiller, *The NURBS Book*, §8.5).
+fn sphere_obj() -> String {
+    let h = std::f64::consts::FRAC_1_SQRT_2;
+    let profile = [
+        (0.0, -1.0, 1.0),
+        (1.0, -1.0, h),
+        (1.0, 0.0, 1.0),
+        (1.0, 1.0, h),
+        (0.0, 1.0, 1.0),
+    ];
+    let circle = [
+        (1.0, 0.0, 1.0),
+        (1.0, 1.0, h),
+        (0.0, 1.0, 1.0),
+        (-1.0, 1.0, h),
+        (-1.0, 0.0, 1.0),
+        (-1.0, -1.0, h),
+        (0.0, -1.0, 1.0),
+        (1.0, -1.0, h),
+        (1.0, 0.0, 1.0),
+    ];
+    let mut text = String::new();
+    // u along the profile (fastest), v around.
+    for (x, y, c) in circle {
+        for (r, z, w) in profile {
+            text += &format!("v {} {} {z} {}\n", r * x, r * y, w * c);
+        }
+    }
+    let indices: Vec<String> = (1..=45).map(|i| i.to_string()).collect();
+    text += "cstype rat bspline\ndeg 2 2\n";
+    text += &format!("surf 0 2 0 4 {}\n", indices.join(" "));
+    text += "parm u 0 0 0 1 1 2 2 2\nparm v 0 0 0 1 1 2 2 3 3 4 4 4\nend\n";
+    text
+}
+
+/// The NURBS cylinder and sphere, exactly: every vertex of their patches' tessellation lies on
+/// the analytic shape within 1e-12, and rays hit the sphere where the analytic sphere is hit,
+/// within 1e-9, with its radial normal.
+#[test]
+fn a_nurbs_sphere_and_cylinder_are_exact_in_tessellation_and_intersection() {
+    use caustic::geometry::tessellate::tessellate_weighted;
+    let cylinder = parse_freeform_obj(&cylinder_obj(), Path::new("cylinder.obj")).expect("reads");
+    let sphere = parse_freeform_obj(&sphere_obj(), Path::new("sphere.obj")).expect("reads");
+    assert_eq!(sphere.len(), 8);
+    for (pieces, on_shape) in [
+        (
+            &cylinder,
+            (|p: DVec3| (p.x * p.x + p.y * p.y).sqrt() - 1.0) as fn(DVec3) -> f64,
+        ),
+        (&sphere, |p: DVec3| p.length() - 1.0),
+    ] {
+        for d in pieces.iter() {
+            let mesh = tessellate_weighted(&d.patch, d.weights.as_ref(), 24);
+            for p in &mesh.positions {
+                assert!(
+                    on_shape(*p).abs() < 1e-12,
+                    "a vertex {:e} off the shape",
+                    on_shape(*p)
+                );
+            }
+        }
+    }
+    let mut builder = GeometryBuilder::default();
+    for d in &sphere {
+        builder.add_weighted_patch_in(d.patch, d.weights, d.window, 0);
+    }
+    let geometry = builder.build();
+    let mut rng = common::rng(12);
+    for k in 0..4000 {
+        let origin = common::unit_vector(&mut rng) * 3.0;
+        let target = common::unit_vector(&mut rng) * 0.9;
+        let ray = Ray::new(origin, target - origin);
+        // The analytic sphere: |o + t d| = 1, the nearer root.
+        let (o, dir) = (ray.origin, ray.dir);
+        let (a, b, c) = (dir.dot(dir), 2.0 * o.dot(dir), o.dot(o) - 1.0);
+        let t = (-b - (b * b - 4.0 * a * c).sqrt()) / (2.0 * a);
+        let hit = geometry
+            .intersect(&ray, f64::INFINITY)
+            .unwrap_or_else(|| panic!("ray {k} missed"));
+        assert!((hit.t - t).abs() < 1e-9, "ray {k}: t {} against {t}", hit.t);
+        assert!(
+            hit.normal.dot(hit.point.normalize()).abs() > 1.0 - 1e-9,
+            "ray {k}: normal {}",
+            hit.normal
+        );
     }
 }

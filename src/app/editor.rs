@@ -324,9 +324,12 @@ impl Editor {
                     (doc.lights()[k], self.point(doc, Handle::Light(aim)))
                 })
                 .collect();
-            let weights = |k| doc.scene().geometry.patch_weights(k);
+            let geometry = &doc.scene().geometry;
+            let trim = |k: usize| geometry.patch_trim(k).map(|t| (t, geometry.patch_domains()[k]));
             self.overlay = Arc::new(overlay_geometry(
-                doc.patches().enumerate().map(|(k, p)| (p, weights(k))),
+                doc.patches()
+                    .enumerate()
+                    .map(|(k, p)| (p, geometry.patch_weights(k), trim(k))),
                 &lights,
                 self.hovered,
                 &self.selection,

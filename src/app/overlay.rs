@@ -9,7 +9,8 @@ use egui::{Pos2, Rect};
 use glam::{DMat4, DVec2, DVec3, DVec4};
 
 use crate::geometry::rational::{RationalPatch, Weights};
-use crate::geometry::BezierPatch;
+use crate::geometry::trim::TrimRegion;
+use crate::geometry::{BezierPatch, Window};
 use crate::gpu::wireframe::{Marker, Segment, Uniforms, WireframeGeometry};
 use crate::scene::{Camera, Light};
 
@@ -19,6 +20,8 @@ pub use super::handle::{Handle, LightPart, LightRef, PointRef};
 pub const PICK_RADIUS: f32 = 8.0;
 /// Samples per patch boundary curve.
 const CURVE_SEGMENTS: usize = 16;
+/// Samples per trim curve segment.
+const TRIM_SEGMENTS: usize = 24;
 
 /// The camera's projection into the view: `clip_from_world` maps a world point to the clip
 /// space of `view` (the paint callback's viewport), with the image occupying `image`.
@@ -143,6 +146,7 @@ fn f32x3(p: DVec3) -> [f32; 3] {
 const NET: [f32; 4] = [0.55, 0.85, 1.0, 0.55];
 const NET_SELECTED: [f32; 4] = [0.7, 0.95, 1.0, 0.95];
 const BOUNDARY: [f32; 4] = [1.0, 0.62, 0.2, 0.85];
+const TRIM: [f32; 4] = [1.0, 0.35, 0.85, 0.95];
 const POINT: [f32; 4] = [0.92, 0.95, 1.0, 0.9];
 const POINT_HOVERED: [f32; 4] = [1.0, 0.92, 0.2, 1.0];
 const POINT_SELECTED: [f32; 4] = [1.0, 0.25, 0.45, 1.0];
@@ -150,12 +154,20 @@ const LIGHT: [f32; 4] = [1.0, 0.85, 0.35, 0.95];
 /// Segments of a sphere light's outline circles.
 const CIRCLE_SEGMENTS: usize = 32;
 
-/// The overlay for `patches` (each with its weights when rational) and `lights` (each with
-/// its aim point): each control net (rows and columns), each patch's four boundary curves, a marker per control point, and the lights'
-/// gizmos (`light_gizmos`); hovered and selected handles, and the nets of patches with a
-/// selected point, stand out.
+/// One patch as the overlay draws it: its control points, its weights when rational, and its
+/// surface's trim loops with the patch's window in that surface when trimmed.
+pub type OverlayPatch<'a> = (
+    &'a BezierPatch,
+    Option<&'a Weights>,
+    Option<(&'a TrimRegion, Window)>,
+);
+
+/// The overlay for `patches` and `lights` (each with its aim point): each control net (rows
+/// and columns), each patch's four boundary curves and the part of its surface's trim curves
+/// that lies on it, a marker per control point, and the lights' gizmos (`light_gizmos`);
+/// hovered and selected handles, and the nets of patches with a selected point, stand out.
 pub fn overlay_geometry<'a>(
-    patches: impl IntoIterator<Item = (&'a BezierPatch, Option<&'a Weights>)>,
+    patches: impl IntoIterator<Item = OverlayPatch<'a>>,
     lights: &[(Light, DVec3)],
     hovered: Option<Handle>,
     selection: &BTreeSet<Handle>,
@@ -167,7 +179,7 @@ pub fn overlay_geometry<'a>(
         color,
         width,
     };
-    for (k, (p, weights)) in patches.into_iter().enumerate() {
+    for (k, (p, weights, trim)) in patches.into_iter().enumerate() {
         let rational = weights.map(|w| RationalPatch::new(p, w));
         let eval = |u: f64, v: f64| rational.as_ref().map_or_else(|| p.eval(u, v), |r| r.eval(u, v));
         let active =
@@ -196,6 +208,12 @@ pub fn overlay_geometry<'a>(
                 g.segments.push(segment(at(t0), at(t1), BOUNDARY, 1.5));
             }
         }
+        if let Some((region, window)) = trim {
+            for (a, b) in trim_pieces(region, &window) {
+                g.segments
+                    .push(segment(eval(a.x, a.y), eval(b.x, b.y), TRIM, 2.0));
+            }
+        }
         for (index, q) in p.points.iter().enumerate() {
             let r = Handle::Control(PointRef { patch: k, index });
             push_handle_marker(&mut g.markers, *q, r, (POINT, 5.0), hovered, selection);
@@ -205,6 +223,29 @@ pub fn overlay_geometry<'a>(
         light_gizmos(&mut g, k, light, *aim, hovered, selection);
     }
     g
+}
+
+/// The pieces of `region`'s trim curves (sampled) that lie on the patch whose window in the
+/// surface is `window`, in the patch's `[0,1]²`: each piece whose middle lies on the patch,
+/// its ends kept on it (the neighbouring patch draws the rest of a piece that crosses over).
+fn trim_pieces(region: &TrimRegion, window: &Window) -> Vec<(DVec2, DVec2)> {
+    let local = |q: DVec2| {
+        DVec2::new(
+            (q.x - window.u0) / (window.u1 - window.u0),
+            (q.y - window.v0) / (window.v1 - window.v0),
+        )
+    };
+    let on = |q: DVec2| (0.0..=1.0).contains(&q.x) && (0.0..=1.0).contains(&q.y);
+    let mut pieces = Vec::new();
+    for (points, _) in region.polylines(TRIM_SEGMENTS) {
+        for pair in points.windows(2) {
+            let (a, b) = (local(pair[0]), local(pair[1]));
+            if on(0.5 * (a + b)) {
+                pieces.push((a.clamp(DVec2::ZERO, DVec2::ONE), b.clamp(DVec2::ZERO, DVec2::ONE)));
+            }
+        }
+    }
+    pieces
 }
 
 /// The dark rim around a hovered or selected handle's marker (points each side), so that it
@@ -356,9 +397,14 @@ mod tests {
             part: LightPart::Place,
         });
         let point = Handle::Control(PointRef { patch: 0, index: 5 });
-        let plain = overlay_geometry(patches.iter().map(|p| (p, None)), &lights, None, &BTreeSet::new());
+        let plain = overlay_geometry(
+            patches.iter().map(|p| (p, None, None)),
+            &lights,
+            None,
+            &BTreeSet::new(),
+        );
         let chosen = overlay_geometry(
-            patches.iter().map(|p| (p, None)),
+            patches.iter().map(|p| (p, None, None)),
             &lights,
             Some(point),
             &BTreeSet::from([light]),
@@ -382,6 +428,45 @@ mod tests {
                 (chosen.markers[at].position, HALO_COLOR)
             );
             assert_eq!(halo.size, chosen.markers[at].size + 2.0 * HALO);
+        }
+    }
+
+    /// A trimmed patch's overlay draws its trim curve on the surface (here a diamond on a flat
+    /// patch whose `(u,v)` is its `(x,y)`), and a patch of the same surface the curve does not
+    /// reach draws none of it.
+    #[test]
+    fn trim_curves_are_drawn_on_the_patches_they_cross() {
+        use crate::geometry::trim::{line, TrimLoop};
+        let flat = BezierPatch::new(std::array::from_fn(|k| {
+            DVec3::new((k / 4) as f64 / 3.0, (k % 4) as f64 / 3.0, 0.0)
+        }));
+        let p = |x: f64, y: f64| DVec2::new(x, y);
+        let corners = [p(0.5, 0.1), p(0.9, 0.5), p(0.5, 0.9), p(0.1, 0.5)];
+        let diamond = TrimLoop {
+            segments: (0..4).map(|k| line(corners[k], corners[(k + 1) % 4])).collect(),
+            hole: false,
+        };
+        let region = TrimRegion::new(vec![diamond]);
+        let beside = Window {
+            u0: 1.0,
+            u1: 2.0,
+            ..Window::FULL
+        };
+        for (window, expected) in [(Window::FULL, 4 * TRIM_SEGMENTS), (beside, 0)] {
+            let g = overlay_geometry(
+                [(&flat, None, Some((&region, window)))],
+                &[],
+                None,
+                &BTreeSet::new(),
+            );
+            let trims: Vec<&Segment> = g.segments.iter().filter(|s| s.color == TRIM).collect();
+            assert_eq!(trims.len(), expected);
+            for s in trims {
+                for q in [s.a, s.b] {
+                    let on_diamond = (q[0] - 0.5).abs() + (q[1] - 0.5).abs();
+                    assert!((on_diamond - 0.4).abs() < 1e-5 && q[2] == 0.0, "{q:?}");
+                }
+            }
         }
     }
 }

@@ -9,6 +9,7 @@ use caustic::args::Overwrite;
 use caustic::files::write_atomically;
 use caustic::geometry::freeform::{write_freeform_obj, DomainPatch};
 use caustic::geometry::tessellate::{tessellate_weighted, write_obj};
+use caustic::geometry::trimmed::trim_mesh;
 use caustic::run::load_scene;
 
 /// `caustic export-obj`'s flags.
@@ -62,10 +63,11 @@ pub fn export_obj(args: ExportArgs) -> Result<()> {
         .enumerate()
         .map(|(k, (p, obj))| {
             let name = format!("{}_patch{k}", group_name(&scene, *obj));
-            (
-                name,
-                tessellate_weighted(p, scene.geometry.patch_weights(k), resolution),
-            )
+            let mut mesh = tessellate_weighted(p, scene.geometry.patch_weights(k), resolution);
+            if let Some(trim) = scene.geometry.patch_trim(k) {
+                trim_mesh(&mut mesh, trim, &scene.geometry.patch_domains()[k]);
+            }
+            (name, mesh)
         })
         .collect();
     write_obj_file(out, force, |file| write_obj(&meshes, file))?;
@@ -105,9 +107,9 @@ fn group_name(scene: &caustic::scene::Scene, object: u32) -> String {
 fn export_freeform(scene: &caustic::scene::Scene, out: &Path, force: bool) -> Result<()> {
     let mut groups: Vec<(String, Vec<DomainPatch>)> = Vec::new();
     let patches = scene.geometry.patches();
-    for (k, ((p, object), domain)) in patches.iter().zip(scene.geometry.patch_domains()).enumerate() {
+    for (k, (_, object)) in patches.iter().enumerate() {
         let name = group_name(scene, *object);
-        let patch = (*p, *domain, scene.geometry.patch_weights(k).copied());
+        let patch = scene.geometry.domain_patch(k);
         match groups.last_mut() {
             Some((last, list)) if *last == name => list.push(patch),
             _ => groups.push((name, vec![patch])),

@@ -27,13 +27,16 @@
 //! ```
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
 use super::bezier::BezierPatch;
 use super::bspline::{BsplineSurface, Knots, DEGREE};
+use super::freeform_trim::TrimReader;
 use super::patch::Window;
 use super::rational::{weights_error, Weights};
+use super::trim::TrimRegion;
 use crate::settings::limits::{MAX_KNOTS, MAX_PATCHES};
 
 /// A free-form OBJ file that cannot be read: which file, which line, what was wrong.
@@ -48,9 +51,31 @@ pub struct FreeformError {
     pub message: String,
 }
 
-/// A Bézier patch, its `(u,v)` window in the parameters of the surface it came from and, for
-/// a rational surface, its weights ([`super::rational`]).
-pub type DomainPatch = (BezierPatch, Window, Option<Weights>);
+/// A Bézier patch as a piece of the surface it came from.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DomainPatch {
+    /// Its control points (a rational patch's projected ones).
+    pub patch: BezierPatch,
+    /// Its `(u,v)` window in the parameters of the surface it came from.
+    pub window: Window,
+    /// Its weights, for a rational surface ([`super::rational`]).
+    pub weights: Option<Weights>,
+    /// The surface's trim loops, in the surface's `(u,v)`, shared by its patches
+    /// ([`super::trim`]).
+    pub trim: Option<Arc<TrimRegion>>,
+}
+
+impl DomainPatch {
+    /// A whole polynomial patch over `[0,1]²`, untrimmed.
+    pub fn whole(patch: BezierPatch) -> Self {
+        Self {
+            patch,
+            window: Window::FULL,
+            weights: None,
+            trim: None,
+        }
+    }
+}
 
 /// Reads every free-form surface (degree 1 to 3) of an OBJ file as bicubic Bézier patches, a
 /// line at a time: what the reader keeps beyond the patches is the `v` points (40 bytes each)
@@ -150,8 +175,10 @@ struct Reader<'a> {
     cstype: Option<CurveType>,
     degree: Option<(Vec<String>, usize)>,
     surface: Option<OpenSurface>,
-    /// A free-form curve is open: its `parm` and `end` are skipped.
+    /// A free-form curve in space is open: its `parm` and `end` are skipped.
     in_curve: bool,
+    /// Trim curves and the surfaces' loops.
+    trims: TrimReader,
     patches: Vec<DomainPatch>,
 }
 
@@ -172,6 +199,7 @@ pub fn read_freeform_obj(
         degree: None,
         surface: None,
         in_curve: false,
+        trims: TrimReader::default(),
         patches: Vec::new(),
     };
     let mut lines = LogicalLines::new(input);
@@ -197,7 +225,23 @@ pub fn read_freeform_obj(
             "no free-form surfaces ('surf' … 'end') in the file; a polygon mesh is an object of type \"mesh\"".to_owned(),
         ));
     }
-    Ok(reader.patches)
+    let Reader {
+        path,
+        trims,
+        mut patches,
+        ..
+    } = reader;
+    let err = |(line, message)| FreeformError {
+        path: path.to_owned(),
+        line,
+        message,
+    };
+    for (range, region) in trims.finish().map_err(err)? {
+        for p in &mut patches[range] {
+            p.trim = Some(region.clone());
+        }
+    }
+    Ok(patches)
 }
 
 impl Reader<'_> {
@@ -207,6 +251,28 @@ impl Reader<'_> {
             line,
             message,
         }
+    }
+
+    fn line_err(&self, (line, message): (usize, String)) -> FreeformError {
+        self.err(line, message)
+    }
+
+    /// A `curv2` line: a trim curve of the type and degree set before it.
+    fn open_curve(&mut self, line: usize, args: &[&str]) -> Result<(), FreeformError> {
+        if self.surface.is_some() {
+            return Err(self.err(
+                line,
+                "'curv2' inside a surface; trim curves come before or after it".to_owned(),
+            ));
+        }
+        let Some(cstype) = self.cstype.clone() else {
+            return Err(self.err(line, "the trim curve has no 'cstype' before it".to_owned()));
+        };
+        let degree = self.degree.as_ref().map_or(&[][..], |(d, _)| d.as_slice());
+        self.in_curve = false;
+        self.trims
+            .open_curve(line, args, (&cstype.name, cstype.rational), degree)
+            .map_err(|e| self.line_err(e))
     }
 
     fn numbers(&self, line: usize, keyword: &str, args: &[&str]) -> Result<Vec<f64>, FreeformError> {
@@ -225,7 +291,10 @@ impl Reader<'_> {
             "v" => {
                 let n = self.numbers(line, "v", args)?;
                 if !(3..=4).contains(&n.len()) {
-                    return Err(self.err(line, format!("'v' takes 3 or 4 numbers 'x y z [w]', found {}", n.len())));
+                    return Err(self.err(
+                        line,
+                        format!("'v' takes 3 or 4 numbers 'x y z [w]', found {}", n.len()),
+                    ));
                 }
                 self.vertices.push(Vertex {
                     point: DVec3::new(n[0], n[1], n[2]),
@@ -245,19 +314,29 @@ impl Reader<'_> {
                     line,
                 });
             }
+            "vp" => {
+                let n = self.numbers(line, "vp", args)?;
+                self.trims.vp(line, &n).map_err(|e| self.line_err(e))?;
+            }
             "deg" => self.degree = Some((args.iter().map(|a| a.to_string()).collect(), line)),
             "surf" => self.open_surface(line, args)?,
-            "curv" | "curv2" => self.in_curve = true,
+            "curv" => self.in_curve = true,
+            "curv2" => self.open_curve(line, args)?,
             "parm" => self.parm(line, args)?,
-            "trim" | "hole" | "scrv" | "sp" if self.surface.is_some() => {
-                return Err(self.err(
-                    line,
-                    format!("'{keyword}': trimmed surfaces and curves on surfaces are not supported (only whole surfaces)"),
-                ))
+            "trim" | "hole" => {
+                if self.surface.is_none() {
+                    return Err(self.err(line, format!("'{keyword}' outside a surface ('surf' … 'end')")));
+                }
+                let n = self.numbers(line, keyword, args)?;
+                self.trims
+                    .add_loop(line, keyword == "hole", &n)
+                    .map_err(|e| self.line_err(e))?;
             }
             "end" => {
                 if self.surface.is_some() {
                     self.close_surface(line)?;
+                } else if self.trims.curve_open() {
+                    self.trims.close_curve(line).map_err(|e| self.line_err(e))?;
                 } else if !std::mem::take(&mut self.in_curve) {
                     return Err(self.err(line, "'end' without a 'surf' before it".to_owned()));
                 }
@@ -270,6 +349,9 @@ impl Reader<'_> {
     fn open_surface(&mut self, line: usize, args: &[&str]) -> Result<(), FreeformError> {
         if self.surface.is_some() {
             return Err(self.err(line, "'surf' before the previous surface's 'end'".to_owned()));
+        }
+        if self.trims.curve_open() {
+            return Err(self.err(line, "'surf' before the trim curve's 'end'".to_owned()));
         }
         if args.len() < 5 {
             return Err(self.err(
@@ -316,6 +398,22 @@ impl Reader<'_> {
         if self.surface.is_none() {
             if self.in_curve {
                 return Ok(());
+            }
+            if self.trims.curve_open() {
+                let [axis, values @ ..] = args else {
+                    return Err(self.err(line, "'parm' takes 'u' and its values".to_owned()));
+                };
+                if values.len() > MAX_KNOTS {
+                    return Err(self.err(
+                        line,
+                        format!(
+                            "'parm' gives {} values; at most {MAX_KNOTS} are read",
+                            values.len()
+                        ),
+                    ));
+                }
+                let values = self.numbers(line, "parm", values)?;
+                return self.trims.parm(line, axis, values).map_err(|e| self.line_err(e));
             }
             return Err(self.err(line, "'parm' without a 'surf' before it".to_owned()));
         }
@@ -453,6 +551,51 @@ impl Reader<'_> {
         Ok((Knots::from_breakpoints(&values, degree), pline))
     }
 
+    /// The Bézier patches of the open surface's B-spline `surface` (rational with the points'
+    /// weights when `rational`), checked finite.
+    fn bezier_pieces(
+        &self,
+        surface: &BsplineSurface,
+        open: &OpenSurface,
+        rational: bool,
+    ) -> Result<Vec<DomainPatch>, FreeformError> {
+        let piece = |patch, window, weights| DomainPatch {
+            patch,
+            window,
+            weights,
+            trim: None,
+        };
+        let patches: Vec<DomainPatch> = if rational {
+            let weights: Vec<f64> = open.indices.iter().map(|&i| self.vertices[i].weight).collect();
+            surface
+                .to_rational_bezier(&weights)
+                .into_iter()
+                .map(|(p, window, w)| piece(p, window, Some(w)))
+                .collect()
+        } else {
+            surface
+                .to_bezier()
+                .into_iter()
+                .map(|(p, w)| piece(p, w, None))
+                .collect()
+        };
+        let finite = |d: &DomainPatch| {
+            let w = &d.window;
+            d.patch.points.iter().all(|q| q.is_finite())
+                && (w.u1 - w.u0).is_finite()
+                && (w.v1 - w.v0).is_finite()
+                && d.weights.as_ref().is_none_or(|w| weights_error(w).is_none())
+        };
+        if !patches.iter().all(finite) {
+            return Err(self.err(
+                open.line,
+                "the surface's knots or points are too large to convert (the result is not finite)"
+                    .to_owned(),
+            ));
+        }
+        Ok(patches)
+    }
+
     fn close_surface(&mut self, end_line: usize) -> Result<(), FreeformError> {
         let Some(open) = self.surface.take() else {
             return Ok(());
@@ -498,45 +641,25 @@ impl Reader<'_> {
                 ),
             ));
         }
-        let patches: Vec<DomainPatch> = if rational {
-            let weights: Vec<f64> = open.indices.iter().map(|&i| self.vertices[i].weight).collect();
-            surface
-                .to_rational_bezier(&weights)
-                .into_iter()
-                .map(|(p, window, w)| (p, window, Some(w)))
-                .collect()
-        } else {
-            surface
-                .to_bezier()
-                .into_iter()
-                .map(|(p, w)| (p, w, None))
-                .collect()
-        };
-        let finite = |(p, w, weights): &DomainPatch| {
-            p.points.iter().all(|q| q.is_finite())
-                && (w.u1 - w.u0).is_finite()
-                && (w.v1 - w.v0).is_finite()
-                && weights.as_ref().is_none_or(|w| weights_error(w).is_none())
-        };
-        if !patches.iter().all(finite) {
-            return Err(self.err(
-                line,
-                "the surface's knots or points are too large to convert (the result is not finite)"
-                    .to_owned(),
-            ));
-        }
+        let patches = self.bezier_pieces(&surface, &open, rational)?;
+        let first = self.patches.len();
         if self.patches.is_empty() {
             self.patches = patches;
         } else {
             self.patches.extend(patches);
         }
+        let size = DVec2::new(r.u1 - r.u0, r.v1 - r.v0).length();
+        self.trims.close_surface(first..self.patches.len(), size);
         Ok(())
     }
 }
 
 /// Writes named groups of patches as OBJ `cstype bezier` surfaces: 16 `v` lines and one
 /// `surf` per patch, its window as the surface's range and breakpoints, numbers in their
-/// shortest round-trip form, so [`parse_freeform_obj`] reads the same points bit for bit.
+/// shortest round-trip form, so [`parse_freeform_obj`] reads the same points bit for bit. A
+/// trimmed patch keeps its surface's loops: each trim segment is written once, as a `cstype
+/// rat bezier` `curv2` of degree 3 over `vp` points, and every patch of the surface lists
+/// the loops (`trim` and `hole`) in the surface's `(u,v)`, which its window is part of.
 pub fn write_freeform_obj(
     groups: &[(String, Vec<DomainPatch>)],
     out: &mut impl std::io::Write,
@@ -547,20 +670,26 @@ pub fn write_freeform_obj(
         env!("CARGO_PKG_VERSION")
     )?;
     let mut next = 1usize;
+    let mut curves = CurveWriter::default();
     for (name, patches) in groups {
         writeln!(out, "g {name}")?;
-        for (patch, w, weights) in patches {
+        for d in patches {
+            let loops = match &d.trim {
+                Some(region) => curves.write(region, out)?,
+                None => Vec::new(),
+            };
+            let (patch, w) = (&d.patch, &d.window);
             // OBJ lists control points with u varying fastest: point iu + 4 jv.
             for jv in 0..4 {
                 for iu in 0..4 {
                     let p = patch.point(iu, jv);
-                    match weights {
+                    match &d.weights {
                         Some(weights) => writeln!(out, "v {} {} {} {}", p.x, p.y, p.z, weights[4 * iu + jv])?,
                         None => writeln!(out, "v {} {} {}", p.x, p.y, p.z)?,
                     }
                 }
             }
-            let rat = if weights.is_some() { "rat " } else { "" };
+            let rat = if d.weights.is_some() { "rat " } else { "" };
             writeln!(out, "cstype {rat}bezier\ndeg 3 3")?;
             let indices: Vec<String> = (next..next + 16).map(|i| i.to_string()).collect();
             writeln!(
@@ -572,9 +701,63 @@ pub fn write_freeform_obj(
                 w.v1,
                 indices.join(" ")
             )?;
-            writeln!(out, "parm u {} {}\nparm v {} {}\nend", w.u0, w.u1, w.v0, w.v1)?;
+            writeln!(out, "parm u {} {}\nparm v {} {}", w.u0, w.u1, w.v0, w.v1)?;
+            for (line, hole) in loops {
+                writeln!(out, "{} {line}", if hole { "hole" } else { "trim" })?;
+            }
+            writeln!(out, "end")?;
             next += 16;
         }
     }
     Ok(())
+}
+
+/// Each loop's `u0 u1 curv2` list, and whether it is a hole.
+type LoopLines = Vec<(String, bool)>;
+
+/// Writes each trim region once as `curv2` curves and remembers their numbers.
+#[derive(Default)]
+struct CurveWriter {
+    /// Regions written, with their loops' lines.
+    written: Vec<(Arc<TrimRegion>, LoopLines)>,
+    /// `vp` points and `curv2` curves written so far.
+    points: usize,
+    curves: usize,
+}
+
+impl CurveWriter {
+    /// The `trim`/`hole` lists of `region`'s loops, its curves written first if they are not yet.
+    fn write(
+        &mut self,
+        region: &Arc<TrimRegion>,
+        out: &mut impl std::io::Write,
+    ) -> std::io::Result<LoopLines> {
+        if let Some((_, loops)) = self.written.iter().find(|(r, _)| Arc::ptr_eq(r, region)) {
+            return Ok(loops.clone());
+        }
+        let mut loops = Vec::new();
+        for l in region.loops() {
+            let mut pieces = Vec::with_capacity(l.segments.len());
+            for s in &l.segments {
+                for p in s {
+                    writeln!(out, "vp {} {} {}", p.x / p.z, p.y / p.z, p.z)?;
+                }
+                let first = self.points + 1;
+                self.points += 4;
+                self.curves += 1;
+                writeln!(
+                    out,
+                    "cstype rat bezier\ndeg 3\ncurv2 {} {} {} {}\nparm u 0 1\nend",
+                    first,
+                    first + 1,
+                    first + 2,
+                    first + 3
+                )?;
+                pieces.push(format!("0 1 {}", self.curves));
+            }
+            loops.push((pieces.join(" "), l.hole));
+        }
+        self.written.push((region.clone(), loops.clone()));
+        Ok(loops)
+    }
 }

@@ -9,6 +9,7 @@ pub mod bspline;
 pub mod bvh;
 pub mod elevate;
 pub mod freeform;
+pub mod freeform_trim;
 pub mod mesh;
 pub mod patch;
 pub mod quad;
@@ -18,6 +19,8 @@ pub mod scene_geometry;
 pub mod sphere;
 pub mod sphere_batch;
 pub mod tessellate;
+pub mod trim;
+pub mod trimmed;
 
 pub use aabb::Aabb;
 pub use bezier::BezierPatch;

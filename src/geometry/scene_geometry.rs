@@ -13,11 +13,14 @@
 //! assert_eq!(hit.map(|h| (h.t, h.object)), Some((2.0, 7)));
 //! ```
 
+use std::sync::Arc;
+
 use glam::{DVec2, DVec3};
 
 use super::aabb::Aabb;
 use super::bezier::BezierPatch;
 use super::bvh::{Bvh, FLAT_PRIMITIVES};
+use super::freeform::DomainPatch;
 use super::mesh::TriangleMesh;
 use super::patch::{
     intersect_leaf, intersect_per_ray_weighted, intersect_rational_leaf, leaf_occludes,
@@ -29,6 +32,8 @@ use super::rational::{window_weights, RationalPatch, Weights};
 use super::ray::{spawn_ray, Ray};
 use super::sphere::Sphere;
 use super::sphere_batch::SphereBatch;
+use super::trim::TrimRegion;
+use super::trimmed::{boundary_leaves, first_kept, kept_leaves, trim_mesh};
 
 /// Which ray/patch intersector the geometry uses.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -150,6 +155,8 @@ pub struct GeometryBuilder {
     patch_domains: Vec<Window>,
     /// Each patch's weights, when it is rational.
     patch_weights: Vec<Option<Box<Weights>>>,
+    /// Each patch's surface's trim loops, when it is trimmed.
+    patch_trims: Vec<Option<Arc<TrimRegion>>>,
     /// The patch intersector.
     pub patch_method: PatchMethod,
 }
@@ -209,30 +216,29 @@ impl GeometryBuilder {
         domain: Window,
         object: u32,
     ) -> ShapeRef {
-        self.patches.push((patch, object));
-        self.patch_domains.push(domain);
-        self.patch_weights.push(weights.map(Box::new));
+        self.add_surface_patch(
+            DomainPatch {
+                patch,
+                window: domain,
+                weights,
+                trim: None,
+            },
+            object,
+        )
+    }
+
+    /// Adds a piece of a surface that may be rational and trimmed
+    /// ([`GeometryBuilder::add_weighted_patch_in`]; hits the trim loops cut away pass it).
+    pub fn add_surface_patch(&mut self, piece: DomainPatch, object: u32) -> ShapeRef {
+        self.patches.push((piece.patch, object));
+        self.patch_domains.push(piece.window);
+        self.patch_weights.push(piece.weights.map(Box::new));
+        self.patch_trims.push(piece.trim);
         ShapeRef::Patch(self.patches.len() as u32 - 1)
     }
 
-    /// Prepares patches (per the patch method) and builds the BVH.
-    pub fn build(self) -> SceneGeometry {
-        let patch_scales: Vec<f64> = self
-            .patches
-            .iter()
-            .map(|(p, _)| p.bounds().diagonal().length())
-            .collect();
-        let mut leaves = Vec::new();
-        let mut patch_method = self.patch_method;
-        if let PatchMethod::Prepared(params) = &mut patch_method {
-            // Each patch's share of the scene's leaves: an edit re-prepares it within the same.
-            params.max_leaves = params
-                .max_leaves
-                .min(super::patch::leaf_budget(self.patches.len()));
-            for (k, ((patch, _), w)) in self.patches.iter().zip(&self.patch_weights).enumerate() {
-                leaves.extend(subdivide_weighted(patch, w.as_deref(), k as u32, params));
-            }
-        }
+    /// The spheres, quads and mesh triangles as primitives, with their bounds, in that order.
+    fn shape_primitives(&self) -> (Vec<Primitive>, Vec<Aabb>) {
         let mut primitives = Vec::new();
         let mut bounds = Vec::new();
         for (k, (s, _)) in self.spheres.iter().enumerate() {
@@ -252,6 +258,29 @@ impl GeometryBuilder {
                 bounds.push(mesh.triangle_bounds(t));
             }
         }
+        (primitives, bounds)
+    }
+
+    /// Prepares patches (per the patch method) and builds the BVH.
+    pub fn build(self) -> SceneGeometry {
+        let patch_scales: Vec<f64> = self
+            .patches
+            .iter()
+            .map(|(p, _)| p.bounds().diagonal().length())
+            .collect();
+        let mut leaves = Vec::new();
+        let mut patch_method = self.patch_method;
+        if let PatchMethod::Prepared(params) = &mut patch_method {
+            // Each patch's share of the scene's leaves: an edit re-prepares it within the same.
+            params.max_leaves = params
+                .max_leaves
+                .min(super::patch::leaf_budget(self.patches.len()));
+            for (k, ((patch, _), w)) in self.patches.iter().zip(&self.patch_weights).enumerate() {
+                let trim = (self.patch_trims[k].as_deref(), &self.patch_domains[k]);
+                leaves.extend(prepared_leaves(patch, w.as_deref(), trim, k, params));
+            }
+        }
+        let (mut primitives, mut bounds) = self.shape_primitives();
         match self.patch_method {
             PatchMethod::Prepared(_) => {
                 for (k, leaf) in leaves.iter().enumerate() {
@@ -269,14 +298,19 @@ impl GeometryBuilder {
         let bvh = Bvh::build(&bounds);
         let flat_spheres = flat_spheres(&bvh, &primitives, &self.spheres);
         // Grown by pushing: give back the spare capacity (up to half of a large scene's).
-        let (mut patches, mut patch_domains, mut patch_weights) =
-            (self.patches, self.patch_domains, self.patch_weights);
+        let (mut patches, mut patch_domains, mut patch_weights, mut patch_trims) = (
+            self.patches,
+            self.patch_domains,
+            self.patch_weights,
+            self.patch_trims,
+        );
         leaves.shrink_to_fit();
         primitives.shrink_to_fit();
         bounds.shrink_to_fit();
         patches.shrink_to_fit();
         patch_domains.shrink_to_fit();
         patch_weights.shrink_to_fit();
+        patch_trims.shrink_to_fit();
         SceneGeometry {
             primitive_bounds: bounds,
             spheres: self.spheres,
@@ -284,9 +318,11 @@ impl GeometryBuilder {
             planes: self.planes,
             meshes: self.meshes,
             leaf_weights: leaf_weights(&leaves, &patch_weights),
+            leaf_trimmed: leaf_trimmed(&leaves, &patch_trims, &patch_domains),
             patches,
             patch_domains,
             patch_weights,
+            patch_trims,
             patch_scales,
             leaves,
             primitives,
@@ -311,6 +347,24 @@ fn leaf_weights(leaves: &[PatchLeaf], patch_weights: &[Option<Box<Weights>>]) ->
                 .map(|w| window_weights(w, &l.window))
         })
         .collect()
+}
+
+/// Patch `k`'s leaves, subdivided per `params`, less those its trim loops (with its window in
+/// their surface) cut away wholly.
+fn prepared_leaves(
+    patch: &BezierPatch,
+    weights: Option<&Weights>,
+    (trim, domain): (Option<&TrimRegion>, &Window),
+    k: usize,
+    params: &SubdivisionParams,
+) -> Vec<PatchLeaf> {
+    kept_leaves(subdivide_weighted(patch, weights, k as u32, params), trim, domain)
+}
+
+/// When some patch is trimmed, whether each leaf tests its hits against the trim loops
+/// ([`boundary_leaves`]); nothing otherwise.
+fn leaf_trimmed(leaves: &[PatchLeaf], trims: &[Option<Arc<TrimRegion>>], domains: &[Window]) -> Vec<bool> {
+    boundary_leaves(leaves, |k| trims[k].as_deref(), |k| domains[k])
 }
 
 /// The spheres of a tree [`Bvh::traverse`] does not walk, when it holds nothing else, in the
@@ -340,8 +394,12 @@ pub struct SceneGeometry {
     patches: Vec<(BezierPatch, u32)>,
     patch_domains: Vec<Window>,
     patch_weights: Vec<Option<Box<Weights>>>,
+    patch_trims: Vec<Option<Arc<TrimRegion>>>,
     /// With a rational patch, each leaf's weights ([`leaf_weights`]); otherwise empty.
     leaf_weights: Vec<Option<Weights>>,
+    /// With a trimmed patch, whether each leaf tests its hits against the trims
+    /// ([`leaf_trimmed`]); otherwise empty.
+    leaf_trimmed: Vec<bool>,
     patch_scales: Vec<f64>,
     leaves: Vec<PatchLeaf>,
     /// Everything in the BVH; its leaves index this list. Patch leaves (or whole patches,
@@ -380,6 +438,7 @@ impl SceneGeometry {
             patches: Vec::new(),
             patch_domains: Vec::new(),
             patch_weights: Vec::new(),
+            patch_trims: Vec::new(),
             patch_method: method,
         };
         for (k, ((p, object), domain)) in self.patches.iter().zip(&self.patch_domains).enumerate() {
@@ -387,12 +446,23 @@ impl SceneGeometry {
             match tessellate_segments {
                 Some(n) => {
                     let mut mesh = super::tessellate::tessellate_weighted(p, weights, n);
+                    if let Some(trim) = self.patch_trim(k) {
+                        trim_mesh(&mut mesh, trim, domain);
+                    }
                     for uv in &mut mesh.texcoords {
                         *uv = domain.map(uv.x, uv.y);
                     }
                     builder.add_mesh(mesh, *object)
                 }
-                None => builder.add_weighted_patch_in(*p, weights.copied(), *domain, *object),
+                None => builder.add_surface_patch(
+                    DomainPatch {
+                        patch: *p,
+                        window: *domain,
+                        weights: weights.copied(),
+                        trim: self.patch_trims[k].clone(),
+                    },
+                    *object,
+                ),
             };
         }
         builder.build()
@@ -426,6 +496,46 @@ impl SceneGeometry {
     /// [`SceneGeometry::patches`]' own).
     pub fn patch_weights(&self, k: usize) -> Option<&Weights> {
         self.patch_weights.get(k).and_then(|w| w.as_deref())
+    }
+
+    /// Patch `k`'s surface's trim loops, when it is trimmed (shared by the surface's patches).
+    pub fn patch_trim(&self, k: usize) -> Option<&TrimRegion> {
+        self.patch_trims.get(k).and_then(|t| t.as_deref())
+    }
+
+    /// Patch `k` as a piece of its surface: points, window, weights and trim loops.
+    pub fn domain_patch(&self, k: usize) -> DomainPatch {
+        DomainPatch {
+            patch: self.patches[k].0,
+            window: self.patch_domains[k],
+            weights: self.patch_weights(k).copied(),
+            trim: self.patch_trims[k].clone(),
+        }
+    }
+
+    /// Whether leaf `leaf` tests its hits against trim loops, on a ray's path: a scene without
+    /// trimmed patches keeps no flags, so this asks nothing more of it.
+    #[inline(always)]
+    fn trimmed_leaf(&self, leaf: u32) -> bool {
+        self.leaf_trimmed.get(leaf as usize).copied().unwrap_or(false)
+    }
+
+    /// The nearest hit on leaf `i`, a trim curve crossing it, that the trim keeps.
+    #[inline(never)]
+    fn trimmed_leaf_hit(&self, i: u32, frame: &RayFrame, span: (f64, f64), t_max: f64) -> Option<PatchHit> {
+        let leaf = &self.leaves[i as usize];
+        let weights = self.rational_weights(i);
+        let (trim, domain) = (
+            self.patch_trim(leaf.patch as usize)?,
+            &self.patch_domains[leaf.patch as usize],
+        );
+        first_kept(
+            |t_min| match weights {
+                None => intersect_leaf(leaf, frame, span, t_min, t_max),
+                Some(w) => intersect_rational_leaf(leaf, w, frame, span, (t_min, t_max)),
+            },
+            |uv| trim.contains(domain.map(uv.x, uv.y)),
+        )
     }
 
     /// Leaf `leaf`'s weights when its patch is rational, on a ray's path: a scene without
@@ -504,7 +614,10 @@ impl SceneGeometry {
             PatchMethod::Prepared(params) => {
                 let fresh: Vec<(usize, Vec<PatchLeaf>)> = edits
                     .iter()
-                    .map(|(&k, p)| (k, subdivide_weighted(p, self.patch_weights(k), k as u32, &params)))
+                    .map(|(&k, p)| {
+                        let trim = (self.patch_trim(k), &self.patch_domains[k]);
+                        (k, prepared_leaves(p, self.patch_weights(k), trim, k, &params))
+                    })
                     .collect();
                 self.replace_leaves(first, fresh)
             }
@@ -517,6 +630,7 @@ impl SceneGeometry {
             }
         };
         self.leaf_weights = leaf_weights(&self.leaves, &self.patch_weights);
+        self.leaf_trimmed = leaf_trimmed(&self.leaves, &self.patch_trims, &self.patch_domains);
         if refit {
             self.bvh.refit(&self.primitive_bounds);
         } else {
@@ -597,16 +711,17 @@ impl SceneGeometry {
             .sum();
         vec![
             (
-                "patches (control points, domains, scales, weights)",
+                "patches (control points, domains, scales, weights, trims)",
                 bytes(&self.patches)
                     + bytes(&self.patch_domains)
                     + bytes(&self.patch_scales)
                     + bytes(&self.patch_weights)
+                    + bytes(&self.patch_trims)
                     + self.patch_weights.iter().flatten().count() * std::mem::size_of::<Weights>(),
             ),
             (
-                "patch leaves (sub-patches and their tests, weights)",
-                bytes(&self.leaves) + bytes(&self.leaf_weights),
+                "patch leaves (sub-patches and their tests, weights, trim flags)",
+                bytes(&self.leaves) + bytes(&self.leaf_weights) + bytes(&self.leaf_trimmed),
             ),
             (
                 "primitive list and bounds",
@@ -660,10 +775,13 @@ impl SceneGeometry {
                 .map(|h| hit(h.t, h.barycentric)),
             Primitive::PatchLeaf(i) => {
                 let frame = frame.as_ref()?;
+                if self.trimmed_leaf(i) {
+                    return self.trimmed_leaf_hit(i, frame, span, t_max).map(patch_hit);
+                }
                 let leaf = &self.leaves[i as usize];
                 match self.rational_weights(i) {
                     None => intersect_leaf(leaf, frame, span, 0.0, t_max),
-                    Some(w) => intersect_rational_leaf(leaf, w, frame, span, t_max),
+                    Some(w) => intersect_rational_leaf(leaf, w, frame, span, (0.0, t_max)),
                 }
                 .map(patch_hit)
             }
@@ -672,14 +790,23 @@ impl SceneGeometry {
                     PatchMethod::PerRay { depth } => depth,
                     PatchMethod::Prepared(_) => 0,
                 };
-                intersect_per_ray_weighted(
-                    &self.patches[i as usize].0,
-                    self.patch_weights(i as usize),
-                    self.patch_scales[i as usize],
-                    ray,
-                    (0.0, t_max),
-                    depth,
-                )
+                let k = i as usize;
+                let search = |t_min| {
+                    intersect_per_ray_weighted(
+                        &self.patches[k].0,
+                        self.patch_weights(k),
+                        self.patch_scales[k],
+                        ray,
+                        (t_min, t_max),
+                        depth,
+                    )
+                };
+                match self.patch_trim(k) {
+                    None => search(0.0),
+                    Some(trim) => {
+                        first_kept(search, |uv| trim.contains(self.patch_domains[k].map(uv.x, uv.y)))
+                    }
+                }
                 .map(patch_hit)
             }
             Primitive::Plane(i) => self.planes[i as usize]
@@ -832,6 +959,9 @@ impl SceneGeometry {
             let primitive = self.primitives[k as usize];
             counts(self.object_of(primitive))
                 && match (primitive, &frame) {
+                    (Primitive::PatchLeaf(i), Some(frame)) if self.trimmed_leaf(i) => {
+                        self.trimmed_leaf_hit(i, frame, span, t_max).is_some()
+                    }
                     (Primitive::PatchLeaf(i), Some(frame)) => match self.rational_weights(i) {
                         None => leaf_occludes(&self.leaves[i as usize], frame, span, 0.0, t_max),
                         Some(w) => rational_leaf_occludes(&self.leaves[i as usize], w, frame, span, t_max),

@@ -255,8 +255,32 @@ pub struct ObjectDesc {
     /// With inline `patches`: each patch's 16 control-point weights (positive), for rational
     /// patches; absent, every weight is 1.
     pub weights: Option<Vec<Vec<Real>>>,
+    /// With inline `patches`: trimmed surfaces, each the patches its loops cut.
+    pub trims: Option<Vec<TrimDesc>>,
     /// Placement (mesh, patches, quad, sphere).
     pub transform: Option<TransformDesc>,
+}
+
+/// One trimmed surface among inline patches: which patches it is made of and its loops, in the
+/// `(u,v)` of the patches' `domains`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrimDesc {
+    /// The patches (0-based, among the object's inline `patches`) the loops cut.
+    pub patches: Vec<usize>,
+    /// The outer loops and holes.
+    pub loops: Vec<TrimLoopDesc>,
+}
+
+/// One closed trim loop: cubic rational Bézier segments end to end.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrimLoopDesc {
+    /// A hole (its inside is cut away); otherwise an outer loop (its inside is kept).
+    #[serde(default)]
+    pub hole: bool,
+    /// Each segment's four control points `u, v, w` in a row (12 numbers; `w` above 0).
+    pub segments: Vec<[Real; 12]>,
 }
 
 /// Scale, then rotate (degrees about x, then y, then z), then translate.

@@ -13,6 +13,7 @@ use toml_edit::{Array, DocumentMut, Item, Table, Value};
 use super::{Camera, Light, Material, MaterialKind, RenderParams, Scene};
 use crate::files::{write_atomically, WriteError};
 use crate::geometry::rational::Weights;
+use crate::geometry::trim::TrimRegion;
 use crate::geometry::{BezierPatch, Window};
 
 /// Why a scene could not be saved.
@@ -412,7 +413,7 @@ fn write_patches(doc: &mut DocumentMut, scene: &Scene, loaded: &[BezierPatch]) {
         if edit_inline_points(object, &own, loaded) {
             continue;
         }
-        for key in ["file", "builtin", "transform", "domains", "weights"] {
+        for key in ["file", "builtin", "transform", "domains", "weights", "trims"] {
             object.remove(key);
         }
         object.insert("patches", toml_edit::value(patch_list(&own)));
@@ -437,7 +438,64 @@ fn write_patches(doc: &mut DocumentMut, scene: &Scene, loaded: &[BezierPatch]) {
                 .collect();
             object.insert("weights", toml_edit::value(list));
         }
+        // Trimmed surfaces keep their loops, each with the patches (numbered in this object) it cuts.
+        if let Some(list) = trims_array(scene, &own) {
+            object.insert("trims", toml_edit::value(list));
+        }
     }
+}
+
+/// The `trims` of an object's patches (`own`: scene patch index and patch), one entry per
+/// trim region they share, or `None` when none is trimmed.
+fn trims_array(scene: &Scene, own: &[(usize, &BezierPatch)]) -> Option<Array> {
+    let mut surfaces: Vec<(std::sync::Arc<TrimRegion>, Vec<usize>)> = Vec::new();
+    for (local, (i, _)) in own.iter().enumerate() {
+        let Some(region) = scene.geometry.domain_patch(*i).trim else {
+            continue;
+        };
+        match surfaces
+            .iter_mut()
+            .find(|(r, _)| std::sync::Arc::ptr_eq(r, &region))
+        {
+            Some((_, patches)) => patches.push(local),
+            None => surfaces.push((region, vec![local])),
+        }
+    }
+    if surfaces.is_empty() {
+        return None;
+    }
+    let list = surfaces
+        .iter()
+        .map(|(region, patches)| {
+            let loops: Array = region
+                .loops()
+                .iter()
+                .map(|l| {
+                    let segments: Array = l
+                        .segments
+                        .iter()
+                        .map(|s| {
+                            Value::from(Array::from_iter(
+                                s.iter().flat_map(|p| [p.x / p.z, p.y / p.z, p.z]),
+                            ))
+                        })
+                        .collect();
+                    let mut t = toml_edit::InlineTable::new();
+                    t.insert("hole", Value::from(l.hole));
+                    t.insert("segments", Value::from(segments));
+                    Value::from(t)
+                })
+                .collect();
+            let mut t = toml_edit::InlineTable::new();
+            t.insert(
+                "patches",
+                Value::from(Array::from_iter(patches.iter().map(|&k| k as i64))),
+            );
+            t.insert("loops", Value::from(loops));
+            Value::from(t)
+        })
+        .collect();
+    Some(list)
 }
 
 /// Saves the scene to `path` (temporary name, then rename); an existing file is replaced only

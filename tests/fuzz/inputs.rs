@@ -7,7 +7,7 @@ use std::path::Path;
 
 use caustic::geometry::freeform::DomainPatch;
 use caustic::geometry::{
-    parse_bpt, parse_freeform_obj, write_freeform_obj, GeometryBuilder, Ray, TriangleMesh, Window,
+    parse_bpt, parse_freeform_obj, write_freeform_obj, GeometryBuilder, Ray, TriangleMesh,
 };
 use caustic::scene::texture::TextureSource;
 use caustic::scene::Scene;
@@ -39,7 +39,7 @@ pub fn bpt(data: &[u8]) {
     let Ok(patches) = parse_bpt(text, Path::new("fuzz.bpt")) else {
         return;
     };
-    let whole: Vec<DomainPatch> = patches.iter().map(|p| (*p, Window::FULL, None)).collect();
+    let whole: Vec<DomainPatch> = patches.iter().copied().map(DomainPatch::whole).collect();
     shoot_at(&whole);
 }
 
@@ -54,9 +54,10 @@ pub fn freeform(data: &[u8]) {
         return;
     };
     assert!(
-        patches.iter().all(|(_, w, weights)| w.u0 < w.u1
-            && w.v0 < w.v1
-            && weights.is_none_or(|w| w.iter().all(|&x| x > 0.0 && x.is_finite()))),
+        patches.iter().all(|d| d.window.u0 < d.window.u1
+            && d.window.v0 < d.window.v1
+            && d.weights
+                .is_none_or(|w| w.iter().all(|&x| x > 0.0 && x.is_finite()))),
         "{patches:?}"
     );
     let mut out = Vec::new();
@@ -64,19 +65,36 @@ pub fn freeform(data: &[u8]) {
     let back = parse_freeform_obj(&String::from_utf8_lossy(&out), Path::new("fuzz-out.obj"))
         .expect("the written surfaces read back");
     assert_eq!(back.len(), patches.len());
-    for ((p, w, weights), (q, v, back_weights)) in patches.iter().zip(&back) {
+    let close = |a: DVec3, b: DVec3| (a - b).abs().max_element() <= 1e-14 * a.abs().max_element().max(1e-300);
+    for (d, e) in patches.iter().zip(&back) {
         assert_eq!(
-            (w, weights),
-            (v, back_weights),
+            (d.window, d.weights),
+            (e.window, e.weights),
             "windows and weights read back the same"
         );
-        let close =
-            |a: DVec3, b: DVec3| (a - b).abs().max_element() <= 1e-14 * a.abs().max_element().max(1e-300);
-        let same = match weights {
+        let (p, q) = (&d.patch, &e.patch);
+        let same = match d.weights {
             None => p == q,
             Some(_) => p.points.iter().zip(&q.points).all(|(a, b)| close(*a, *b)),
         };
         assert!(same, "the written surfaces read back differently: {p:?} {q:?}");
+        // Trim loops read back with the same segments, to rounding (written as projected points).
+        let loops = |d: &DomainPatch| d.trim.as_ref().map(|t| t.loops().to_vec()).unwrap_or_default();
+        let (a, b) = (loops(d), loops(e));
+        assert_eq!(a.len(), b.len(), "trim loops read back");
+        for (x, y) in a.iter().zip(&b) {
+            assert_eq!((x.hole, x.segments.len()), (y.hole, y.segments.len()));
+            let near = |a: DVec3, b: DVec3| {
+                let (pa, pb) = (a.truncate() / a.z, b.truncate() / b.z);
+                (pa - pb).abs().max_element() <= 1e-12 * pa.abs().max_element().max(1.0)
+            };
+            assert!(x
+                .segments
+                .iter()
+                .flatten()
+                .zip(y.segments.iter().flatten())
+                .all(|(a, b)| near(*a, *b)));
+        }
     }
     shoot_at(&patches);
 }
@@ -85,12 +103,12 @@ pub fn freeform(data: &[u8]) {
 /// its (u,v) too.
 fn shoot_at(patches: &[DomainPatch]) {
     let mut builder = GeometryBuilder::default();
-    for (p, w, weights) in patches.iter().take(8) {
-        builder.add_weighted_patch_in(*p, *weights, *w, 0);
+    for d in patches.iter().take(8) {
+        builder.add_surface_patch(d.clone(), 0);
     }
     let geometry = builder.build();
-    for (p, _, _) in patches.iter().take(8) {
-        let bounds = p.bounds();
+    for d in patches.iter().take(8) {
+        let bounds = d.patch.bounds();
         let centre = (bounds.min + bounds.max) * 0.5;
         let size = (bounds.max - bounds.min).length().max(1e-9);
         for dir in [

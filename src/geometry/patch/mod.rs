@@ -794,16 +794,16 @@ pub fn intersect_leaf(
     search_leaf(leaf, None, frame, span, (t_min, t_max), false)
 }
 
-/// [`intersect_leaf`] (from 0) for a leaf of a rational patch, `weights` its own.
+/// [`intersect_leaf`] for a leaf of a rational patch, `weights` its own.
 #[inline(never)]
 pub fn intersect_rational_leaf(
     leaf: &PatchLeaf,
     weights: &Weights,
     frame: &RayFrame,
     span: (f64, f64),
-    t_max: f64,
+    t_range: (f64, f64),
 ) -> Option<PatchHit> {
-    search_leaf(leaf, Some(weights), frame, span, (0.0, t_max), false)
+    search_leaf(leaf, Some(weights), frame, span, t_range, false)
 }
 
 /// [`leaf_occludes`] (from 0) for a leaf of a rational patch, `weights` its own.

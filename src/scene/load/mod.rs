@@ -9,6 +9,7 @@ mod diagnostics;
 mod lights;
 mod materials;
 mod objects;
+mod trims;
 
 use std::collections::BTreeMap;
 use std::path::Path;

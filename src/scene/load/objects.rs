@@ -124,30 +124,50 @@ fn add_shape(t: &Table, d: &ObjectDesc, label: &str, builder: &mut GeometryBuild
             let path = t.ctx.resolve(&t.span, &format!("{label}: 'file'"), file)?;
             builder.add_mesh(placed_mesh(t, &path, &m)?, id);
         }
-        "patches" => {
-            t.only(
-                "patches",
-                &given,
-                &["file", "builtin", "patches", "domains", "weights", "transform"],
-            )?;
-            let list = patch_list(t, d, label)?;
-            let limit = crate::settings::limits::MAX_PATCHES;
-            if builder.patch_count() + list.len() > limit {
-                return Err(t.err(format!(
-                    "its {} patches make the scene's {}; a scene holds at most {limit}",
-                    list.len(),
-                    builder.patch_count() + list.len()
-                )));
-            }
-            for (p, domain, weights) in list {
-                builder.add_weighted_patch_in(p.transformed(&m), weights, domain, id);
-            }
-        }
+        "patches" => add_patches(t, (d, label), builder, &m, id)?,
         other => {
             return Err(t.err(format!(
                 "unknown object type '{other}' (expected sphere, plane, quad, mesh or patches)"
             )))
         }
+    }
+    Ok(())
+}
+
+/// A `patches` object's patches, placed by `m`, into the builder.
+fn add_patches(
+    t: &Table,
+    (d, label): (&ObjectDesc, &str),
+    builder: &mut GeometryBuilder,
+    m: &DAffine3,
+    id: u32,
+) -> Result<()> {
+    let given = given_keys(d);
+    t.only(
+        "patches",
+        &given,
+        &[
+            "file",
+            "builtin",
+            "patches",
+            "domains",
+            "weights",
+            "trims",
+            "transform",
+        ],
+    )?;
+    let list = patch_list(t, d, label)?;
+    let limit = crate::settings::limits::MAX_PATCHES;
+    if builder.patch_count() + list.len() > limit {
+        return Err(t.err(format!(
+            "its {} patches make the scene's {}; a scene holds at most {limit}",
+            list.len(),
+            builder.patch_count() + list.len()
+        )));
+    }
+    for piece in list {
+        let patch = piece.patch.transformed(m);
+        builder.add_surface_patch(DomainPatch { patch, ..piece }, id);
     }
     Ok(())
 }
@@ -161,7 +181,7 @@ pub(super) fn patch_domains(t: &Table, patches: &mut [DomainPatch], domains: &[[
             patches.len()
         )));
     }
-    for (i, ((_, window, _), d)) in patches.iter_mut().zip(domains).enumerate() {
+    for (i, (DomainPatch { window, .. }, d)) in patches.iter_mut().zip(domains).enumerate() {
         let [u0, u1, v0, v1] = d.map(|r| r.0);
         if !(u0 < u1 && v0 < v1) {
             return Err(t.err(format!(
@@ -182,7 +202,7 @@ fn patch_weights(t: &Table, patches: &mut [DomainPatch], weights: &[Vec<Real>]) 
             patches.len()
         )));
     }
-    for (i, ((_, _, out), w)) in patches.iter_mut().zip(weights).enumerate() {
+    for (i, (DomainPatch { weights: out, .. }, w)) in patches.iter_mut().zip(weights).enumerate() {
         let w: Weights = w
             .iter()
             .map(|r| r.0)
@@ -213,7 +233,7 @@ fn material_index(t: &Table, name: &str, materials: &BTreeMap<String, usize>) ->
 }
 
 /// The keys an `[[objects]]` table gave, for [`Table::only`].
-fn given_keys(d: &ObjectDesc) -> [(&'static str, bool); 13] {
+fn given_keys(d: &ObjectDesc) -> [(&'static str, bool); 14] {
     [
         ("center", d.center.is_some()),
         ("radius", d.radius.is_some()),
@@ -227,6 +247,7 @@ fn given_keys(d: &ObjectDesc) -> [(&'static str, bool); 13] {
         ("patches", d.patches.is_some()),
         ("domains", d.domains.is_some()),
         ("weights", d.weights.is_some()),
+        ("trims", d.trims.is_some()),
         ("transform", d.transform.is_some()),
     ]
 }
@@ -250,12 +271,17 @@ fn patch_list(t: &Table, d: &ObjectDesc, label: &str) -> Result<Vec<DomainPatch>
     if d.domains.is_some() && d.patches.is_none() {
         return Err(t.err("'domains' applies only to inline 'patches'"));
     }
+    if d.trims.is_some() && d.patches.is_none() {
+        return Err(t.err(
+            "'trims' applies only to inline 'patches' (an OBJ file's trimmed surfaces carry their own)",
+        ));
+    }
     if d.weights.is_some() && d.patches.is_none() {
         return Err(t.err(
             "'weights' applies only to inline 'patches' (an OBJ file's rational surfaces carry their own)",
         ));
     }
-    let whole = |patches: Vec<BezierPatch>| patches.into_iter().map(|p| (p, Window::FULL, None)).collect();
+    let whole = |patches: Vec<BezierPatch>| patches.into_iter().map(DomainPatch::whole).collect();
     match (d.file.as_deref(), d.builtin.as_deref(), &d.patches) {
         (Some(file), None, None) => {
             let path = t.ctx.resolve(&t.span, &format!("{label}: 'file'"), file)?;
@@ -278,11 +304,9 @@ fn patch_list(t: &Table, d: &ObjectDesc, label: &str) -> Result<Vec<DomainPatch>
                         points.len()
                     )));
                 }
-                out.push((
-                    BezierPatch::new(std::array::from_fn(|j| v3(&points[j]))),
-                    Window::FULL,
-                    None,
-                ));
+                out.push(DomainPatch::whole(BezierPatch::new(std::array::from_fn(|j| {
+                    v3(&points[j])
+                }))));
             }
             if out.is_empty() {
                 return Err(t.err("'patches' is empty"));
@@ -292,6 +316,9 @@ fn patch_list(t: &Table, d: &ObjectDesc, label: &str) -> Result<Vec<DomainPatch>
             }
             if let Some(weights) = &d.weights {
                 patch_weights(t, &mut out, weights)?;
+            }
+            if let Some(trims) = &d.trims {
+                super::trims::patch_trims(t, &mut out, trims)?;
             }
             Ok(out)
         }
