@@ -2,7 +2,8 @@
 """Writes the Bézier-patch example scenes: scenes/pool.toml with assets/pool_water.obj (a
 bicubic B-spline water surface, 7×7 control points, so 4×4 Bézier patches), scenes/ring.toml (a
 mirror ring of 4 rational patches), scenes/ring_gold.toml (the ring in rough gold) and scenes/lens.toml (a biconvex lens of 2 patches) and scenes/lens_dispersive.toml (the
-lens in SF11 glass), and scenes/prism.toml with assets/prism.obj (a dispersive prism).
+lens in SF11 glass), scenes/prism.toml with assets/prism.obj (a dispersive prism), and scenes/ring_window.toml with
+assets/ring_window.obj (the ring as a trimmed NURBS with a window cut in it).
 Run from the project folder: python3 assets/make_example_scenes.py"""
 import math
 
@@ -178,9 +179,26 @@ ring_text = ",\n".join(patch_toml(p, exact) for p in ring)
 ring_weights_text = ",\n".join("    [" + ", ".join(exact(w) for w in ws) + "]" for ws in ring_weights)
 
 
-def ring_scene(path, about, name, material):
+RING_INLINE = """# Each line is one row of four control points at fixed u (height), running around the ring.
+# The patches are rational (each quarter exactly circular): `weights` holds each point's weight,
+# in the same order.
+[[objects]]
+type = "patches"
+name = "ring"
+material = "%s"
+patches = [
+""" + ring_text + """,
+]
+weights = [
+""" + ring_weights_text + """,
+]
+"""
+
+
+def ring_scene(path, about, name, material, ring_object=None):
     """The ring on its table under its lamp, with `about` as its comment and the material
-    table `material` of the ring, named `name`."""
+    table `material` of the ring, named `name`; `ring_object` replaces the ring's inline
+    patches."""
     open(path, "w").write(HEADER + about + """
 [camera]
 position = [0.0, 4.0, 1.6]
@@ -212,20 +230,7 @@ point = [0, 0, 0]
 normal = [0, 1, 0]
 material = "table"
 
-# Each line is one row of four control points at fixed u (height), running around the ring.
-# The patches are rational (each quarter exactly circular): `weights` holds each point's weight,
-# in the same order.
-[[objects]]
-type = "patches"
-name = "ring"
-material = \"""" + name + """\"
-patches = [
-""" + ring_text + """,
-]
-weights = [
-""" + ring_weights_text + """,
-]
-""")
+""" + (ring_object or RING_INLINE) % name)
 
 
 ring_scene("scenes/ring.toml", """# The coffee-cup caustic: a mirror ring (a cylinder of 4 rational bicubic patches, each exactly
@@ -403,4 +408,37 @@ type = "mesh"
 name = "prism"
 file = "../assets/prism.obj"
 material = "prism"
+""")
+
+# --- ring_window: the ring as a trimmed NURBS, a window cut through its wall towards the lamp ---
+# The cylinder is one rational B-spline surface (u up the wall, degree 1; v around, degree 2 with
+# 9 points, weights 1 and sqrt(1/2), knots 0 0 0 1 1 2 2 3 3 4 4 4), as CAD programs write it.
+# The window is a hole: an ellipse in (u, v) (the rational circle scaled, which is exact) that
+# is about round on the wall, 0.3 across, centred 11 degrees round from +x at mid-height.
+h = math.sqrt(0.5)
+circle = [(1, 0, 1), (1, 1, h), (0, 1, 1), (-1, 1, h), (-1, 0, 1), (-1, -1, h), (0, -1, 1), (1, -1, h), (1, 0, 1)]
+lines = ["# The mirror ring of ring.toml as one trimmed rational B-spline surface with a round window",
+         "# cut through its wall. Made by assets/make_example_scenes.py."]
+for (x, z, w) in circle:
+    for y in (0.0, 0.6):
+        lines.append("v %s %s %s %s" % (exact(x), exact(y), exact(z), exact(w)))
+centre_u, centre_v, radius_u, radius_v = 0.5, 11 / 90, 0.15 / 0.6, 0.15 / (math.pi / 2)
+for (a, b, w) in circle:
+    lines.append("vp %s %s %s" % (exact(centre_u + radius_u * a), exact(centre_v + radius_v * b), exact(w)))
+lines += ["cstype rat bspline", "deg 2", "curv2 " + " ".join(str(k) for k in range(1, 10)),
+          "parm u 0 0 0 1 1 2 2 3 3 4 4 4", "end",
+          "cstype rat bspline", "deg 1 2", "surf 0 1 0 4 " + " ".join(str(k) for k in range(1, 19)),
+          "parm u 0 0 1 1", "parm v 0 0 0 1 1 2 2 3 3 4 4 4", "hole 0 4 1", "end"]
+open("assets/ring_window.obj", "w").write("\n".join(lines) + "\n")
+ring_scene("scenes/ring_window.toml", """# The mirror ring with a window: the ring of ring.toml read as one trimmed NURBS surface
+# (assets/ring_window.obj, a rational B-spline with a 'hole' loop), a round window cut through
+# its wall on the lamp's side. Light through the window falls on the table inside the ring,
+# and the cusp loses the light the cut-away wall would have sent it.
+""", "mirror", """type = "mirror"
+color = [0.95, 0.9, 0.8]""", """# One rational B-spline surface (u up the wall, v around) with a trim loop cutting the window.
+[[objects]]
+type = "patches"
+name = "ring"
+material = "%s"
+file = "../assets/ring_window.obj"
 """)
