@@ -980,3 +980,147 @@ fn the_selected_patchs_material_is_edited_undone_and_saved() {
     let back = Scene::load(&path).expect("the saved scene loads");
     assert_eq!(back.materials[index], rough(0.1));
 }
+
+/// `scenes/pool.toml` at the tests' size: its water is an 11 × 11 bicubic B-spline read from
+/// OBJ (8 × 8 Bézier patches).
+fn pool_app<'a>() -> App<'a> {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/pool.toml");
+    let mut scene = Scene::load(&path).expect("the pool loads");
+    (scene.camera.width, scene.camera.height) = SIZE;
+    scene.params.photons_per_pass = 20_000;
+    scene.params.min_photons_per_pixel = 0.0;
+    let mut h = harness(Harness::builder());
+    let mut v = Viewer::with_pause(&h.ctx, scene, ViewerSettings::default(), true);
+    v.show_frame(flat_frame());
+    *h.state_mut() = Some(v);
+    h.run_steps(2);
+    h
+}
+
+/// The first and second derivatives across every border between two of `patches` (each with
+/// its window in the surface) agree within 1e-9 of their size: the surface is C² there.
+fn assert_c2_across_spans(patches: &[(BezierPatch, caustic::geometry::Window)]) {
+    // Rows of points along u at v = t (`q[i]`), for a patch whose point 4i + j lies at row i.
+    let along_u = |p: &BezierPatch, t: f64| -> [DVec3; 4] {
+        let b = [
+            (1.0 - t).powi(3),
+            3.0 * t * (1.0 - t).powi(2),
+            3.0 * t * t * (1.0 - t),
+            t.powi(3),
+        ];
+        std::array::from_fn(|i| (0..4).map(|j| p.points[4 * i + j] * b[j]).sum())
+    };
+    let transpose =
+        |p: &BezierPatch| BezierPatch::new(std::array::from_fn(|k| p.points[4 * (k % 4) + k / 4]));
+    let derivatives = |q: [DVec3; 4], end: bool, width: f64| {
+        let (d1, d2) = if end {
+            (3.0 * (q[3] - q[2]), 6.0 * (q[3] - 2.0 * q[2] + q[1]))
+        } else {
+            (3.0 * (q[1] - q[0]), 6.0 * (q[2] - 2.0 * q[1] + q[0]))
+        };
+        (d1 / width, d2 / (width * width))
+    };
+    let mut borders = 0;
+    for (a, wa) in patches {
+        for (b, wb) in patches {
+            let across_u = wa.u1 == wb.u0 && wa.v0 == wb.v0 && wa.v1 == wb.v1;
+            let across_v = wa.v1 == wb.v0 && wa.u0 == wb.u0 && wa.u1 == wb.u1;
+            if !(across_u || across_v) {
+                continue;
+            }
+            borders += 1;
+            let (pa, pb, la, lb) = if across_u {
+                (*a, *b, wa.u1 - wa.u0, wb.u1 - wb.u0)
+            } else {
+                (transpose(a), transpose(b), wa.v1 - wa.v0, wb.v1 - wb.v0)
+            };
+            for t in [0.0, 0.3, 0.7, 1.0] {
+                let (a1, a2) = derivatives(along_u(&pa, t), true, la);
+                let (b1, b2) = derivatives(along_u(&pb, t), false, lb);
+                let size = a1.length().max(a2.length()).max(1.0);
+                assert!(
+                    (a1 - b1).length() < 1e-9 * size,
+                    "first derivative: {a1} against {b1}"
+                );
+                assert!(
+                    (a2 - b2).length() < 1e-9 * size,
+                    "second derivative: {a2} against {b2}"
+                );
+            }
+        }
+    }
+    assert_eq!(borders, 2 * 8 * 7, "every border between the 8 × 8 patches");
+}
+
+#[test]
+fn a_b_spline_surface_is_edited_by_its_own_net_and_saved_as_one() {
+    use caustic::app::handle::NetRef;
+    let mut h = pool_app();
+    let opened = viewer(&h).scene().clone();
+    let net0 = opened.geometry.nets()[0].net.clone();
+    assert_eq!(opened.geometry.nets().len(), 1);
+    assert_eq!(net0.size(), (11, 11));
+    // The handles are the net's 121 points, not the 64 patches' Bézier points.
+    let grab = Handle::Net(NetRef {
+        net: 0,
+        index: 11 * 5 + 5,
+    });
+    assert!(viewer(&h).handle_position(grab).is_some());
+    assert!(viewer(&h)
+        .handle_position(Handle::Control(PointRef { patch: 0, index: 5 }))
+        .is_none());
+    let original = edited_patches(&h);
+
+    // A drag of one net point moves the patches its basis functions reach, keeping C².
+    let at = on_screen(&h, grab);
+    drag(&mut h, at, Vec2::new(0.0, -30.0), PointerButton::Primary);
+    assert_eq!(viewer(&h).selection().collect::<Vec<_>>(), vec![grab]);
+    let edited = edited_patches(&h);
+    let changed = edited.iter().zip(&original).filter(|(a, b)| a != b).count();
+    assert!((4..=16).contains(&changed), "{changed} patches changed");
+    let geometry = &viewer(&h).scene().geometry;
+    assert_ne!(
+        geometry.nets()[0].net.surface.points[11 * 5 + 5],
+        net0.surface.points[11 * 5 + 5]
+    );
+    let windows = geometry.patch_domains();
+    let pieces: Vec<_> = edited.iter().copied().zip(windows.iter().copied()).collect();
+    assert_c2_across_spans(&pieces);
+    // The session hears every Bézier point that moved.
+    let session = replayed(opened.clone(), &sent(&h));
+    assert_eq!(session.geometry.patches(), viewer(&h).scene().geometry.patches());
+
+    // Undo restores the patches and the net bit for bit; redo brings the edit back.
+    h.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);
+    h.step();
+    assert_eq!(edited_patches(&h), original);
+    assert_eq!(*viewer(&h).scene().geometry.nets()[0].net, *net0);
+    h.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, egui::Key::Z);
+    h.step();
+    assert_eq!(edited_patches(&h), edited);
+
+    // Saved, the surface is written as the B-spline it is, beside the scene, knots and all,
+    // and loads back to the same net and patches.
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("pool-edited.toml");
+    h.state_mut()
+        .as_mut()
+        .expect("viewer")
+        .save_scene_to(path.clone());
+    h.step();
+    assert!(!viewer(&h).unsaved_edits(), "{:?}", viewer(&h).status());
+    let obj = std::fs::read_to_string(dir.path().join("pool-edited.water.obj")).expect("the surface's file");
+    assert!(
+        obj.contains("cstype bspline\ndeg 3 3\n")
+            && obj.contains("parm u 0 1 2 3 4 5 6 7 8 9 10 11 12 13 14\n"),
+        "{obj}"
+    );
+    let text = std::fs::read_to_string(&path).expect("the scene");
+    assert!(text.contains("file = \"pool-edited.water.obj\""), "{text}");
+    let back = Scene::load(&path).expect("the saved scene loads");
+    assert_eq!(back.geometry.patches(), viewer(&h).scene().geometry.patches());
+    assert_eq!(
+        *back.geometry.nets()[0].net,
+        *viewer(&h).scene().geometry.nets()[0].net
+    );
+}

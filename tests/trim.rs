@@ -458,3 +458,44 @@ fn a_trimmed_surface_from_geomdl_matches_geomdls_evaluation() {
         }
     }
 }
+
+/// A trimmed surface edited through its own net is saved as that surface, to an OBJ file
+/// beside the scene, with its loops: it loads back with the same patches and region.
+#[test]
+fn an_edited_trimmed_net_saves_as_a_trimmed_surface_beside_the_scene() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = plane_scene(dir.path(), &plane_obj(0.0, "trim 4 0 2\nhole 0 4 1"));
+    let mut scene = Scene::load(&path).expect("loads");
+    let loaded: Vec<_> = scene.geometry.patches().iter().map(|(p, _)| *p).collect();
+    assert_eq!(scene.geometry.nets().len(), 1);
+    assert!(scene
+        .geometry
+        .move_net_points(0, &[(5, DVec3::new(0.7, 0.7, 0.3))])
+        .is_some());
+    let saved = dir.path().join("saved.toml");
+    caustic::scene::save::save_scene(&scene, &loaded, &saved, false).expect("saves");
+    let obj = std::fs::read_to_string(dir.path().join("saved.plane.obj")).expect("the surface beside it");
+    assert!(
+        obj.contains("cstype bspline\ndeg 3 3\n") && obj.contains("\ntrim ") && obj.contains("\nhole "),
+        "{obj}"
+    );
+    let back = Scene::load(&saved).expect("loads back");
+    assert_eq!(back.geometry.patches(), scene.geometry.patches());
+    let (a, b) = (
+        scene.geometry.patch_trim(0).expect("trimmed"),
+        back.geometry.patch_trim(0).expect("trimmed"),
+    );
+    let mut rng = common::rng(9);
+    for _ in 0..5000 {
+        let p = DVec2::new(
+            rand::Rng::random::<f64>(&mut rng),
+            rand::Rng::random::<f64>(&mut rng),
+        ) * 2.0;
+        if ((p - CENTRE).length() - RADIUS).abs() > 1e-9 {
+            assert_eq!(a.contains(p), b.contains(p), "at {p}");
+        }
+    }
+    // Saving again to the same name without leave to replace is refused, naming the file.
+    let err = caustic::scene::save::save_scene(&scene, &loaded, &saved, false).expect_err("exists");
+    assert!(err.to_string().contains("saved.plane.obj"), "{err}");
+}

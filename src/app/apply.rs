@@ -136,7 +136,20 @@ impl Viewer {
             }
             Action::SelectPatch(patch) => {
                 if patch < self.document.patches().len() {
-                    let points = (0..16).map(|index| Handle::Control(PointRef { patch, index }));
+                    // A patch derived from a net: the whole net, whose points are its handles.
+                    let net = self.document.scene().geometry.patch_net(patch);
+                    let points: Vec<Handle> = match net {
+                        Some(n) => self
+                            .document
+                            .net_handles()
+                            .filter(|(r, _)| r.net == n)
+                            .map(|(r, _)| Handle::Net(r))
+                            .collect(),
+                        None => (0..16)
+                            .map(|index| Handle::Control(PointRef { patch, index }))
+                            .collect(),
+                    };
+                    let points = points.into_iter();
                     let state = &mut self.state;
                     state.editor.selection = points
                         .flat_map(|r| state.editor.welded(&state.document, r))

@@ -11,7 +11,7 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use super::action::Action;
-use super::handle::{Handle, LightPart, LightRef};
+use super::handle::{Handle, LightPart, LightRef, NetRef};
 use super::overlay::PointRef;
 use super::viewer::Viewer;
 use crate::bench::convergence::reference;
@@ -149,7 +149,7 @@ impl DragStage {
     /// The first drag stage after `after` for `viewer`'s scene: the control point, then the
     /// light, each where the scene has it.
     fn next(viewer: &Viewer, after: Option<Handle>, now: Instant) -> Option<Self> {
-        let point = (viewer.patches().len() > 0).then_some(Handle::Control(DRAG_POINT));
+        let point = (viewer.patches().len() > 0).then(|| drag_point(viewer));
         let light = (!viewer.document.lights().is_empty()).then_some(Handle::Light(DRAG_LIGHT));
         let order = [point, light];
         let from = match after {
@@ -225,10 +225,26 @@ impl DragStage {
     }
 }
 
+/// The point handle the bench drags: [`DRAG_POINT`], or where the first patch comes from a
+/// surface's own net, that net's middle point.
+fn drag_point(viewer: &Viewer) -> Handle {
+    match viewer.document.scene().geometry.nets().first() {
+        Some(placed) if viewer.document.patch_in_net(DRAG_POINT.patch) => {
+            let (nu, nv) = placed.net.size();
+            Handle::Net(NetRef {
+                net: 0,
+                index: nu * (nv / 2) + nu / 2,
+            })
+        }
+        _ => Handle::Control(DRAG_POINT),
+    }
+}
+
 /// A dragged handle in words.
 fn name(grab: Handle) -> &'static str {
     match grab {
         Handle::Control(_) => "control point",
+        Handle::Net(_) => "net point",
         Handle::Light(_) => "light",
     }
 }
@@ -245,6 +261,8 @@ fn whole_edit(before: Scene, after: &Scene, grab: Handle) -> Option<(Scene, Comm
             light: r.light,
             value: *after.lights.get(r.light)?,
         },
+        // A net point's drag moves many patches' points: not one command for `bench edit`.
+        Handle::Net(_) => return None,
     };
     Some((before, command))
 }
@@ -517,6 +535,9 @@ fn report_drag(drag: &DragFigures, viewer: &Viewer) {
             Ok(line) => println!("  {what} {line}"),
             Err(e) => println!("  {what} drag preview error: not measured ({e})"),
         },
+        None if matches!(drag.grab, Handle::Net(_)) => println!(
+            "  {what} drag preview error: not measured (a net point moves many patches; bench edit replays one control point)"
+        ),
         None => println!("  {what} drag preview error: not measured (the drag made no edit)"),
     }
     if let Handle::Control(r) = drag.grab {

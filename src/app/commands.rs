@@ -195,7 +195,10 @@ pub const COMMANDS: &[Command] = &[
         keys: "A",
         shortcuts: &[(NONE, Key::A)],
         menu: Menu::Edit,
-        action: |v| v.editor.selection.first().and_then(|h| h.patch()).map(Action::SelectPatch),
+        action: |v| {
+            let first = v.editor.selection.first()?;
+            v.document.handle_patch(*first).map(Action::SelectPatch)
+        },
         checked: None,
     },
     Command {

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use glam::DVec3;
 
-use super::handle::PointRef;
+use super::handle::{Handle, NetRef, PointRef};
 use crate::geometry::BezierPatch;
 use crate::render::session::Command;
 use crate::scene::{Camera, Light, Material, Scene};
@@ -63,6 +63,56 @@ impl Document {
     /// Patch `k` as edited.
     pub fn patch(&self, k: usize) -> Option<&BezierPatch> {
         self.scene.geometry.patches().get(k).map(|(p, _)| p)
+    }
+
+    /// Point `r` of a surface's own net, as edited, and its weight (1 for a polynomial
+    /// surface); `None` for a point out of range.
+    pub fn net_point(&self, r: NetRef) -> Option<(DVec3, f64)> {
+        let net = &self.scene.geometry.nets().get(r.net)?.net;
+        let p = *net.surface.points.get(r.index)?;
+        Some((p, net.weights.as_ref().map_or(1.0, |w| w[r.index])))
+    }
+
+    /// The control points that are handles, with their positions: every point of the patches
+    /// not derived from a net, patch by patch.
+    pub fn patch_handles(&self) -> impl Iterator<Item = (PointRef, DVec3)> + '_ {
+        self.patches()
+            .enumerate()
+            .filter(|(k, _)| !self.patch_in_net(*k))
+            .flat_map(|(patch, p)| (0..16).map(move |index| (PointRef { patch, index }, p.points[index])))
+    }
+
+    /// Every point of the surfaces' own nets, with its position, net by net.
+    pub fn net_handles(&self) -> impl Iterator<Item = (NetRef, DVec3)> + '_ {
+        self.scene
+            .geometry
+            .nets()
+            .iter()
+            .enumerate()
+            .flat_map(|(net, placed)| {
+                placed
+                    .net
+                    .surface
+                    .points
+                    .iter()
+                    .enumerate()
+                    .map(move |(index, q)| (NetRef { net, index }, *q))
+            })
+    }
+
+    /// Whether patch `k` is derived from a surface's own net (its Bézier points are then not
+    /// handles: the net's are).
+    pub fn patch_in_net(&self, k: usize) -> bool {
+        self.scene.geometry.patch_net(k).is_some()
+    }
+
+    /// The patch a point handle belongs to: a control point's own, a net point's net's first.
+    pub fn handle_patch(&self, h: Handle) -> Option<usize> {
+        match h {
+            Handle::Control(r) => Some(r.patch),
+            Handle::Net(r) => self.scene.geometry.nets().get(r.net).map(|n| n.patches.start),
+            Handle::Light(_) => None,
+        }
     }
 
     /// The lights as edited (scene order).
@@ -170,6 +220,41 @@ impl Document {
         }
         if !edits.is_empty() {
             self.scene.geometry.update_patches(&edits);
+        }
+        changes
+    }
+
+    /// Moves points of surfaces' own nets (finite positions of existing points; the rest are
+    /// ignored): each edited net's patches are derived again in one update of the geometry,
+    /// and the session hears of every Bézier point that changed.
+    pub fn move_net_points(&mut self, moves: &[(NetRef, DVec3)]) -> Vec<Change> {
+        let mut by_net: std::collections::BTreeMap<usize, Vec<(usize, DVec3)>> = Default::default();
+        for &(r, position) in moves {
+            if self.net_point(r).is_some() && position.is_finite() {
+                by_net.entry(r.net).or_default().push((r.index, position));
+            }
+        }
+        let mut changes = Vec::new();
+        for (n, net_moves) in by_net {
+            let before: Vec<BezierPatch> = self.scene.geometry.nets()[n]
+                .patches
+                .clone()
+                .filter_map(|k| self.patch(k).copied())
+                .collect();
+            let Some(edits) = self.scene.geometry.move_net_points(n, &net_moves) else {
+                continue;
+            };
+            for ((patch, after), old) in edits.into_iter().zip(before) {
+                for index in (0..16).filter(|&i| after.points[i] != old.points[i]) {
+                    let position = after.points[index];
+                    let command = Command::MoveControlPoint {
+                        patch,
+                        index,
+                        position,
+                    };
+                    changes.push(Change::new(command, &self.scene.params));
+                }
+            }
         }
         changes
     }

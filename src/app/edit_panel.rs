@@ -89,9 +89,12 @@ fn selection_ui(editor: &Editor, doc: &Document, ui: &mut egui::Ui, out: &mut Ve
             }
         }
         Some(_) => {
-            let patches: std::collections::BTreeSet<usize> =
-                editor.selection.iter().filter_map(|h| h.patch()).collect();
-            let lights = editor.selection.iter().filter(|h| h.patch().is_none()).count();
+            let patches: std::collections::BTreeSet<usize> = editor
+                .selection
+                .iter()
+                .filter_map(|h| doc.handle_patch(*h))
+                .collect();
+            let lights = editor.selection.iter().filter(|h| !h.is_point()).count();
             ui.label(match lights {
                 0 => format!("{n} points selected in {} patch(es)", patches.len()),
                 _ => format!(
@@ -109,16 +112,37 @@ fn selection_ui(editor: &Editor, doc: &Document, ui: &mut egui::Ui, out: &mut Ve
 /// the aim changed it).
 fn handle_label(editor: &Editor, doc: &Document, h: Handle) -> (String, f64) {
     match h {
-        Handle::Control(r) => (
-            format!(
-                "Patch {}, point {} (row {}, column {})",
-                r.patch,
-                r.index,
-                r.index / 4,
-                r.index % 4
-            ),
-            doc.patch(r.patch).map_or(1.0, |p| p.bounds().diagonal().length()),
-        ),
+        Handle::Control(r) => {
+            let weight = doc.scene().geometry.patch_weights(r.patch).map(|w| w[r.index]);
+            (
+                format!(
+                    "Patch {}, point {} (row {}, column {}){}",
+                    r.patch,
+                    r.index,
+                    r.index / 4,
+                    r.index % 4,
+                    weight.map_or(String::new(), |w| format!(", weight {w:.6}"))
+                ),
+                doc.patch(r.patch).map_or(1.0, |p| p.bounds().diagonal().length()),
+            )
+        }
+        Handle::Net(r) => {
+            let geometry = &doc.scene().geometry;
+            let net = &geometry.nets()[r.net];
+            let (nu, nv) = net.net.size();
+            let weight = doc.net_point(r).map_or(1.0, |(_, w)| w);
+            let patch = geometry.patches().get(net.patches.start);
+            (
+                format!(
+                    "Surface {} ({nu} × {nv} points), point {} (u {}, v {}), weight {weight:.6}",
+                    r.net,
+                    r.index,
+                    r.index % nu,
+                    r.index / nu
+                ),
+                patch.map_or(1.0, |(p, _)| p.bounds().diagonal().length()),
+            )
+        }
         Handle::Light(l) => (
             format!(
                 "Light {}: {}",

@@ -12,9 +12,9 @@ use egui::{Pos2, Vec2};
 use glam::DVec3;
 
 use super::document::{Change, Document};
-use super::handle::{light_handles, light_place, Handle, LightPart, LightRef};
+use super::handle::{light_handles, light_place, Handle, LightPart, LightRef, NetRef};
 use super::navigate;
-use super::overlay::{control_points, overlay_geometry, OverlayProjection, PICK_RADIUS};
+use super::overlay::{overlay_geometry, OverlayPatch, OverlayProjection, PICK_RADIUS};
 use crate::gpu::wireframe::WireframeGeometry;
 use crate::scene::{Camera, Light, Material, Scene};
 
@@ -237,6 +237,7 @@ impl Editor {
     pub fn point(&self, doc: &Document, h: Handle) -> DVec3 {
         match h {
             Handle::Control(r) => doc.patch(r.patch).map_or(DVec3::ZERO, |p| p.points[r.index]),
+            Handle::Net(r) => doc.net_point(r).map_or(DVec3::ZERO, |(p, _)| p),
             Handle::Light(LightRef { light, part }) => {
                 let l = &doc.lights()[light];
                 match (part, l) {
@@ -256,23 +257,37 @@ impl Editor {
         if !self.exists(doc, h) {
             return Vec::new();
         }
-        let Handle::Control(r) = h else {
-            return vec![h];
-        };
         let p = self.point(doc, h);
-        let tolerance = doc
-            .patch(r.patch)
-            .map_or(0.0, |q| 1e-9 * q.bounds().diagonal().length());
-        let twins = control_points(doc.patches()).filter(|(o, q)| *o != r && (*q - p).length() <= tolerance);
-        std::iter::once(h)
-            .chain(twins.map(|(o, _)| Handle::Control(o)))
-            .collect()
+        let twins: Vec<Handle> = match h {
+            Handle::Control(r) => {
+                let tolerance = doc
+                    .patch(r.patch)
+                    .map_or(0.0, |q| 1e-9 * q.bounds().diagonal().length());
+                doc.patch_handles()
+                    .filter(|(o, q)| *o != r && (*q - p).length() <= tolerance)
+                    .map(|(o, _)| Handle::Control(o))
+                    .collect()
+            }
+            // A closed surface's first and last rows of points (a cylinder's seam) coincide.
+            Handle::Net(r) => {
+                let points = &doc.scene().geometry.nets()[r.net].net.surface.points;
+                let (lo, hi) = points.iter().fold((p, p), |(lo, hi), q| (lo.min(*q), hi.max(*q)));
+                let tolerance = 1e-9 * (hi - lo).length();
+                (0..points.len())
+                    .filter(|&i| i != r.index && (points[i] - p).length() <= tolerance)
+                    .map(|index| Handle::Net(NetRef { net: r.net, index }))
+                    .collect()
+            }
+            Handle::Light(_) => Vec::new(),
+        };
+        std::iter::once(h).chain(twins).collect()
     }
 
     /// Whether `h` names a handle of this scene.
     pub fn exists(&self, doc: &Document, h: Handle) -> bool {
         match h {
-            Handle::Control(r) => r.patch < doc.patches().len() && r.index < 16,
+            Handle::Control(r) => r.patch < doc.patches().len() && r.index < 16 && !doc.patch_in_net(r.patch),
+            Handle::Net(r) => doc.net_point(r).is_some(),
             Handle::Light(l) => doc
                 .lights()
                 .get(l.light)
@@ -280,16 +295,18 @@ impl Editor {
         }
     }
 
-    /// Every handle with its position: control points patch by patch, then the lights'.
+    /// Every handle with its position: control points patch by patch (the points of the nets
+    /// that patches came from in their place), then the lights'.
     pub fn handles<'a>(&'a self, doc: &'a Document) -> impl Iterator<Item = (Handle, DVec3)> + 'a {
-        let controls = control_points(doc.patches()).map(|(r, q)| (Handle::Control(r), q));
+        let controls = doc.patch_handles().map(|(r, q)| (Handle::Control(r), q));
+        let nets = doc.net_handles().map(|(r, q)| (Handle::Net(r), q));
         let lights = doc
             .lights()
             .iter()
             .enumerate()
             .flat_map(|(k, l)| light_handles(k, l))
             .map(move |r| (Handle::Light(r), self.point(doc, Handle::Light(r))));
-        controls.chain(lights)
+        controls.chain(nets).chain(lights)
     }
 
     /// The handle nearest `pointer` within [`PICK_RADIUS`], if any.
@@ -325,11 +342,20 @@ impl Editor {
                 })
                 .collect();
             let geometry = &doc.scene().geometry;
-            let trim = |k: usize| geometry.patch_trim(k).map(|t| (t, geometry.patch_domains()[k]));
+            let patches = doc.patches().enumerate().map(|(k, points)| OverlayPatch {
+                points,
+                weights: geometry.patch_weights(k),
+                trim: geometry.patch_trim(k).map(|t| (t, geometry.patch_domains()[k])),
+                in_net: geometry.patch_net(k).is_some(),
+            });
+            let nets: Vec<(&[DVec3], usize)> = geometry
+                .nets()
+                .iter()
+                .map(|n| (n.net.surface.points.as_slice(), n.net.size().0))
+                .collect();
             self.overlay = Arc::new(overlay_geometry(
-                doc.patches()
-                    .enumerate()
-                    .map(|(k, p)| (p, geometry.patch_weights(k), trim(k))),
+                patches,
+                &nets,
                 &lights,
                 self.hovered,
                 &self.selection,
@@ -351,6 +377,7 @@ impl Editor {
     ) -> (Vec<(Handle, DVec3, DVec3)>, Vec<Change>) {
         let mut changed = Vec::new();
         let mut controls = Vec::new();
+        let mut nets = Vec::new();
         let mut lights: Vec<(usize, Change)> = Vec::new();
         for &(h, p) in moves {
             if !self.exists(doc, h) || !p.is_finite() {
@@ -363,6 +390,10 @@ impl Editor {
             match h {
                 Handle::Control(r) => {
                     controls.push((r, p));
+                    changed.push((h, before, p));
+                }
+                Handle::Net(r) => {
+                    nets.push((r, p));
                     changed.push((h, before, p));
                 }
                 Handle::Light(LightRef { light, part }) => {
@@ -393,6 +424,7 @@ impl Editor {
             }
         }
         let mut changes = doc.move_control_points(&controls);
+        changes.extend(doc.move_net_points(&nets));
         changes.extend(lights.into_iter().map(|(_, c)| c));
         if !changed.is_empty() {
             self.touch();

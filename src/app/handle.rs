@@ -1,4 +1,5 @@
-//! What the view can grab and move: a patch's control point or a light's handle. Hover,
+//! What the view can grab and move: a patch's control point, a point of a B-spline surface's
+//! own net (whose patches follow it), or a light's handle. Hover,
 //! selection, dragging, nudging, the exact x/y/z fields and undo treat both alike; only where
 //! a handle's position lives differs ([`super::editor::Editor::point`]).
 
@@ -12,6 +13,16 @@ pub struct PointRef {
     /// Patch index.
     pub patch: usize,
     /// Control point `4i + j`.
+    pub index: usize,
+}
+
+/// A point of a B-spline or NURBS surface's own control net: the net's index among the
+/// geometry's ([`crate::geometry::SceneGeometry::nets`]) and the point's (`u` fastest).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct NetRef {
+    /// Net index.
+    pub net: usize,
+    /// Point index, `i + nu · j`.
     pub index: usize,
 }
 
@@ -39,6 +50,8 @@ pub struct LightRef {
 pub enum Handle {
     /// A patch's control point.
     Control(PointRef),
+    /// A point of a surface's own net.
+    Net(NetRef),
     /// A light's handle.
     Light(LightRef),
 }
@@ -60,13 +73,19 @@ impl Handle {
     pub fn control(self) -> Option<PointRef> {
         match self {
             Handle::Control(r) => Some(r),
-            Handle::Light(_) => None,
+            Handle::Net(_) | Handle::Light(_) => None,
         }
     }
 
-    /// The patch it belongs to, when it is a control point.
+    /// The patch it belongs to, when it is a patch's control point (a net's point belongs to
+    /// all of its net's patches: [`super::document::Document::handle_patch`]).
     pub fn patch(self) -> Option<usize> {
         self.control().map(|r| r.patch)
+    }
+
+    /// Whether it is a point of a patch or of a net (not a light's).
+    pub fn is_point(self) -> bool {
+        !matches!(self, Handle::Light(_))
     }
 }
 

@@ -13,7 +13,7 @@ use crate::scene::{Material, MaterialKind};
 /// The material of the first selected control point's patch, with its controls.
 pub fn material_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Action>) {
     let doc = &viewer.document;
-    let selected = viewer.editor.selection.iter().find_map(|h| h.patch());
+    let selected = viewer.editor.selection.iter().find_map(|h| doc.handle_patch(*h));
     let Some(index) = selected.and_then(|p| doc.patch_material(p)) else {
         return;
     };

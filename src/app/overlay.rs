@@ -14,7 +14,7 @@ use crate::geometry::{BezierPatch, Window};
 use crate::gpu::wireframe::{Marker, Segment, Uniforms, WireframeGeometry};
 use crate::scene::{Camera, Light};
 
-pub use super::handle::{Handle, LightPart, LightRef, PointRef};
+pub use super::handle::{Handle, LightPart, LightRef, NetRef, PointRef};
 
 /// A handle is picked when the cursor is this close (points).
 pub const PICK_RADIUS: f32 = 8.0;
@@ -154,34 +154,81 @@ const LIGHT: [f32; 4] = [1.0, 0.85, 0.35, 0.95];
 /// Segments of a sphere light's outline circles.
 const CIRCLE_SEGMENTS: usize = 32;
 
-/// One patch as the overlay draws it: its control points, its weights when rational, and its
-/// surface's trim loops with the patch's window in that surface when trimmed.
-pub type OverlayPatch<'a> = (
-    &'a BezierPatch,
-    Option<&'a Weights>,
-    Option<(&'a TrimRegion, Window)>,
-);
+/// One patch as the overlay draws it: its control points, its weights when rational, its
+/// surface's trim loops with the patch's window in that surface when trimmed, and whether it
+/// was derived from a surface's own net (whose points, not the patch's, are then drawn and
+/// grabbed).
+#[derive(Clone, Copy, Debug)]
+pub struct OverlayPatch<'a> {
+    /// Control points.
+    pub points: &'a BezierPatch,
+    /// Weights, when rational.
+    pub weights: Option<&'a Weights>,
+    /// Trim loops and the patch's window in their surface.
+    pub trim: Option<(&'a TrimRegion, Window)>,
+    /// Derived from a net.
+    pub in_net: bool,
+}
 
-/// The overlay for `patches` and `lights` (each with its aim point): each control net (rows
-/// and columns), each patch's four boundary curves and the part of its surface's trim curves
-/// that lies on it, a marker per control point, and the lights' gizmos (`light_gizmos`);
-/// hovered and selected handles, and the nets of patches with a selected point, stand out.
+impl<'a> OverlayPatch<'a> {
+    /// A plain patch: polynomial, untrimmed, its own points the handles.
+    pub fn plain(points: &'a BezierPatch) -> Self {
+        Self {
+            points,
+            weights: None,
+            trim: None,
+            in_net: false,
+        }
+    }
+}
+
+/// The overlay for `patches`, the surfaces' own `nets` (points, `u` fastest, and how many
+/// along `u`) and `lights` (each with its aim point): each control net (rows and columns),
+/// each patch's four boundary curves and the part of its surface's trim curves that lies on
+/// it, a marker per handle, and the lights' gizmos (`light_gizmos`); hovered and selected
+/// handles, and the nets with a selected point, stand out.
 pub fn overlay_geometry<'a>(
     patches: impl IntoIterator<Item = OverlayPatch<'a>>,
+    nets: &[(&[DVec3], usize)],
     lights: &[(Light, DVec3)],
     hovered: Option<Handle>,
     selection: &BTreeSet<Handle>,
 ) -> WireframeGeometry {
     let mut g = WireframeGeometry::default();
-    let segment = |a: DVec3, b: DVec3, color: [f32; 4], width: f32| Segment {
+    for (k, o) in patches.into_iter().enumerate() {
+        patch_overlay(&mut g, k, o, hovered, selection);
+    }
+    for (n, &(points, nu)) in nets.iter().enumerate() {
+        net_overlay(&mut g, n, (points, nu), hovered, selection);
+    }
+    for (k, (light, aim)) in lights.iter().enumerate() {
+        light_gizmos(&mut g, k, light, *aim, hovered, selection);
+    }
+    g
+}
+
+fn segment(a: DVec3, b: DVec3, color: [f32; 4], width: f32) -> Segment {
+    Segment {
         a: f32x3(a),
         b: f32x3(b),
         color,
         width,
-    };
-    for (k, (p, weights, trim)) in patches.into_iter().enumerate() {
-        let rational = weights.map(|w| RationalPatch::new(p, w));
-        let eval = |u: f64, v: f64| rational.as_ref().map_or_else(|| p.eval(u, v), |r| r.eval(u, v));
+    }
+}
+
+/// Patch `k`'s part of the overlay: its boundary curves and trim curves, and unless it came
+/// from a net, its control net and points.
+fn patch_overlay(
+    g: &mut WireframeGeometry,
+    k: usize,
+    o: OverlayPatch,
+    hovered: Option<Handle>,
+    selection: &BTreeSet<Handle>,
+) {
+    let p = o.points;
+    let rational = o.weights.map(|w| RationalPatch::new(p, w));
+    let eval = |u: f64, v: f64| rational.as_ref().map_or_else(|| p.eval(u, v), |r| r.eval(u, v));
+    if !o.in_net {
         let active =
             selection.iter().any(|s| s.patch() == Some(k)) || hovered.is_some_and(|h| h.patch() == Some(k));
         let (net, width) = if active { (NET_SELECTED, 1.6) } else { (NET, 1.0) };
@@ -193,36 +240,56 @@ pub fn overlay_geometry<'a>(
                     .push(segment(p.point(j, i), p.point(j + 1, i), net, width));
             }
         }
-        for edge in 0..4 {
-            let at = |t: f64| match edge {
-                0 => eval(t, 0.0),
-                1 => eval(t, 1.0),
-                2 => eval(0.0, t),
-                _ => eval(1.0, t),
-            };
-            for s in 0..CURVE_SEGMENTS {
-                let (t0, t1) = (
-                    s as f64 / CURVE_SEGMENTS as f64,
-                    (s + 1) as f64 / CURVE_SEGMENTS as f64,
-                );
-                g.segments.push(segment(at(t0), at(t1), BOUNDARY, 1.5));
-            }
-        }
-        if let Some((region, window)) = trim {
-            for (a, b) in trim_pieces(region, &window) {
-                g.segments
-                    .push(segment(eval(a.x, a.y), eval(b.x, b.y), TRIM, 2.0));
-            }
-        }
         for (index, q) in p.points.iter().enumerate() {
             let r = Handle::Control(PointRef { patch: k, index });
             push_handle_marker(&mut g.markers, *q, r, (POINT, 5.0), hovered, selection);
         }
     }
-    for (k, (light, aim)) in lights.iter().enumerate() {
-        light_gizmos(&mut g, k, light, *aim, hovered, selection);
+    for edge in 0..4 {
+        let at = |t: f64| match edge {
+            0 => eval(t, 0.0),
+            1 => eval(t, 1.0),
+            2 => eval(0.0, t),
+            _ => eval(1.0, t),
+        };
+        for s in 0..CURVE_SEGMENTS {
+            let (t0, t1) = (
+                s as f64 / CURVE_SEGMENTS as f64,
+                (s + 1) as f64 / CURVE_SEGMENTS as f64,
+            );
+            g.segments.push(segment(at(t0), at(t1), BOUNDARY, 1.5));
+        }
     }
-    g
+    if let Some((region, window)) = o.trim {
+        for (a, b) in trim_pieces(region, &window) {
+            g.segments
+                .push(segment(eval(a.x, a.y), eval(b.x, b.y), TRIM, 2.0));
+        }
+    }
+}
+
+/// Net `n`'s part of the overlay: its rows and columns of points, and a marker per point.
+fn net_overlay(
+    g: &mut WireframeGeometry,
+    n: usize,
+    (points, nu): (&[DVec3], usize),
+    hovered: Option<Handle>,
+    selection: &BTreeSet<Handle>,
+) {
+    let mine = |h: &Handle| matches!(h, Handle::Net(r) if r.net == n);
+    let active = selection.iter().any(mine) || hovered.as_ref().is_some_and(mine);
+    let (color, width) = if active { (NET_SELECTED, 1.6) } else { (NET, 1.0) };
+    let nu = nu.max(1);
+    for (index, q) in points.iter().enumerate() {
+        if index % nu + 1 < nu {
+            g.segments.push(segment(*q, points[index + 1], color, width));
+        }
+        if let Some(next) = points.get(index + nu) {
+            g.segments.push(segment(*q, *next, color, width));
+        }
+        let r = Handle::Net(NetRef { net: n, index });
+        push_handle_marker(&mut g.markers, *q, r, (POINT, 5.0), hovered, selection);
+    }
 }
 
 /// The pieces of `region`'s trim curves (sampled) that lie on the patch whose window in the
@@ -398,13 +465,15 @@ mod tests {
         });
         let point = Handle::Control(PointRef { patch: 0, index: 5 });
         let plain = overlay_geometry(
-            patches.iter().map(|p| (p, None, None)),
+            patches.iter().map(OverlayPatch::plain),
+            &[],
             &lights,
             None,
             &BTreeSet::new(),
         );
         let chosen = overlay_geometry(
-            patches.iter().map(|p| (p, None, None)),
+            patches.iter().map(OverlayPatch::plain),
+            &[],
             &lights,
             Some(point),
             &BTreeSet::from([light]),
@@ -453,12 +522,11 @@ mod tests {
             ..Window::FULL
         };
         for (window, expected) in [(Window::FULL, 4 * TRIM_SEGMENTS), (beside, 0)] {
-            let g = overlay_geometry(
-                [(&flat, None, Some((&region, window)))],
-                &[],
-                None,
-                &BTreeSet::new(),
-            );
+            let o = OverlayPatch {
+                trim: Some((&region, window)),
+                ..OverlayPatch::plain(&flat)
+            };
+            let g = overlay_geometry([o], &[], &[], None, &BTreeSet::new());
             let trims: Vec<&Segment> = g.segments.iter().filter(|s| s.color == TRIM).collect();
             assert_eq!(trims.len(), expected);
             for s in trims {
@@ -468,5 +536,26 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A patch derived from a net draws no points of its own: the net's points and its rows and
+    /// columns are drawn instead, and grabbed.
+    #[test]
+    fn a_net_is_drawn_in_place_of_its_patches_points() {
+        let flat = BezierPatch::new(std::array::from_fn(|k| {
+            DVec3::new((k / 4) as f64, (k % 4) as f64, 0.0)
+        }));
+        let points: Vec<DVec3> = (0..20)
+            .map(|k| DVec3::new((k % 5) as f64, (k / 5) as f64, 1.0))
+            .collect();
+        let o = OverlayPatch {
+            in_net: true,
+            ..OverlayPatch::plain(&flat)
+        };
+        let g = overlay_geometry([o], &[(&points, 5)], &[], None, &BTreeSet::new());
+        assert_eq!(g.markers.len(), 20);
+        assert!(g.markers.iter().all(|m| m.position[2] == 1.0));
+        let net_lines = g.segments.iter().filter(|s| s.color == NET).count();
+        assert_eq!(net_lines, 4 * 4 + 5 * 3);
     }
 }

@@ -339,7 +339,7 @@ pub fn de_boor(points: &[DVec3], knots: &Knots, t: f64) -> DVec3 {
 /// A B-spline surface of degree 1 to 3 along each axis: control points `points[i + nu * j]` (`i` along `u` varying
 /// fastest, as Wavefront OBJ lists them), knots along `u` and `v`, and the parameter range
 /// to convert.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct BsplineSurface {
     /// Control points, `u` fastest.
     pub points: Vec<DVec3>,

@@ -34,6 +34,7 @@ use glam::{DVec2, DVec3};
 use super::bezier::BezierPatch;
 use super::bspline::{BsplineSurface, Knots, DEGREE};
 use super::freeform_trim::TrimReader;
+use super::net::SurfaceNet;
 use super::patch::Window;
 use super::rational::{weights_error, Weights};
 use super::trim::TrimRegion;
@@ -63,6 +64,9 @@ pub struct DomainPatch {
     /// The surface's trim loops, in the surface's `(u,v)`, shared by its patches
     /// ([`super::trim`]).
     pub trim: Option<Arc<TrimRegion>>,
+    /// The B-spline or NURBS surface it was derived from, shared by its patches: what an
+    /// editor moves ([`super::net`]).
+    pub net: Option<Arc<SurfaceNet>>,
 }
 
 impl DomainPatch {
@@ -73,8 +77,47 @@ impl DomainPatch {
             window: Window::FULL,
             weights: None,
             trim: None,
+            net: None,
         }
     }
+}
+
+/// `pieces` placed by `m`: a plain patch's points transformed; the patches of a surface with
+/// its net derived again from the transformed net (an affine map commutes with knot insertion),
+/// so that an edit of the placed net, which derives them the same way, changes only what it
+/// moves.
+pub fn place_pieces(pieces: Vec<DomainPatch>, m: &glam::DAffine3) -> Vec<DomainPatch> {
+    type Derived = std::vec::IntoIter<(BezierPatch, Window, Option<Weights>)>;
+    let mut current: Option<(Arc<SurfaceNet>, Arc<SurfaceNet>, Derived)> = None;
+    let mut out = Vec::with_capacity(pieces.len());
+    for piece in pieces {
+        let derived = piece.net.as_ref().and_then(|source| {
+            if !current.as_ref().is_some_and(|(s, _, _)| Arc::ptr_eq(s, source)) {
+                let net = Arc::new(source.transformed(m));
+                let patches = net.patches().into_iter();
+                current = Some((source.clone(), net, patches));
+            }
+            let (_, net, patches) = current.as_mut()?;
+            patches
+                .next()
+                .map(|(patch, window, weights)| (patch, window, weights, net.clone()))
+        });
+        out.push(match derived {
+            Some((patch, window, weights, net)) => DomainPatch {
+                patch,
+                window,
+                weights,
+                net: Some(net),
+                ..piece
+            },
+            None => DomainPatch {
+                patch: piece.patch.transformed(m),
+                net: None,
+                ..piece
+            },
+        });
+    }
+    out
 }
 
 /// Reads every free-form surface (degree 1 to 3) of an OBJ file as bicubic Bézier patches, a
@@ -555,30 +598,23 @@ impl Reader<'_> {
     /// weights when `rational`), checked finite.
     fn bezier_pieces(
         &self,
-        surface: &BsplineSurface,
+        surface: BsplineSurface,
         open: &OpenSurface,
         rational: bool,
     ) -> Result<Vec<DomainPatch>, FreeformError> {
-        let piece = |patch, window, weights| DomainPatch {
-            patch,
-            window,
-            weights,
-            trim: None,
-        };
-        let patches: Vec<DomainPatch> = if rational {
-            let weights: Vec<f64> = open.indices.iter().map(|&i| self.vertices[i].weight).collect();
-            surface
-                .to_rational_bezier(&weights)
-                .into_iter()
-                .map(|(p, window, w)| piece(p, window, Some(w)))
-                .collect()
-        } else {
-            surface
-                .to_bezier()
-                .into_iter()
-                .map(|(p, w)| piece(p, w, None))
-                .collect()
-        };
+        let weights = rational.then(|| open.indices.iter().map(|&i| self.vertices[i].weight).collect());
+        let net = Arc::new(SurfaceNet { surface, weights });
+        let patches: Vec<DomainPatch> = net
+            .patches()
+            .into_iter()
+            .map(|(patch, window, weights)| DomainPatch {
+                patch,
+                window,
+                weights,
+                trim: None,
+                net: Some(net.clone()),
+            })
+            .collect();
         let finite = |d: &DomainPatch| {
             let w = &d.window;
             d.patch.points.iter().all(|q| q.is_finite())
@@ -641,7 +677,7 @@ impl Reader<'_> {
                 ),
             ));
         }
-        let patches = self.bezier_pieces(&surface, &open, rational)?;
+        let patches = self.bezier_pieces(surface, &open, rational)?;
         let first = self.patches.len();
         if self.patches.is_empty() {
             self.patches = patches;
@@ -708,6 +744,65 @@ pub fn write_freeform_obj(
             writeln!(out, "end")?;
             next += 16;
         }
+    }
+    Ok(())
+}
+
+/// Writes surfaces as the B-splines they are (their own nets, [`SurfaceNet`]): per surface
+/// its `v` points (with weights when rational, `u` fastest), `cstype [rat] bspline`, its
+/// degrees, range and knots, and its trim loops when it has some, which
+/// [`parse_freeform_obj`] reads back to the same net and patches.
+pub fn write_surfaces_obj(
+    name: &str,
+    surfaces: &[(&SurfaceNet, Option<&Arc<TrimRegion>>)],
+    out: &mut impl std::io::Write,
+) -> std::io::Result<()> {
+    writeln!(
+        out,
+        "# B-spline surfaces written by caustic {}",
+        env!("CARGO_PKG_VERSION")
+    )?;
+    writeln!(out, "g {name}")?;
+    let mut next = 1usize;
+    let mut curves = CurveWriter::default();
+    for (net, trim) in surfaces {
+        let loops = match trim {
+            Some(region) => curves.write(region, out)?,
+            None => Vec::new(),
+        };
+        let s = &net.surface;
+        for (k, p) in s.points.iter().enumerate() {
+            match &net.weights {
+                Some(w) => writeln!(out, "v {} {} {} {}", p.x, p.y, p.z, w[k])?,
+                None => writeln!(out, "v {} {} {}", p.x, p.y, p.z)?,
+            }
+        }
+        let rat = if net.weights.is_some() { "rat " } else { "" };
+        let (du, dv) = (s.u_knots.degree(), s.v_knots.degree());
+        let indices: Vec<String> = (next..next + s.points.len()).map(|i| i.to_string()).collect();
+        let r = &s.range;
+        writeln!(out, "cstype {rat}bspline\ndeg {du} {dv}")?;
+        writeln!(
+            out,
+            "surf {} {} {} {} {}",
+            r.u0,
+            r.u1,
+            r.v0,
+            r.v1,
+            indices.join(" ")
+        )?;
+        let knots = |k: &[f64]| k.iter().map(|x| x.to_string()).collect::<Vec<_>>().join(" ");
+        writeln!(
+            out,
+            "parm u {}\nparm v {}",
+            knots(s.u_knots.values()),
+            knots(s.v_knots.values())
+        )?;
+        for (line, hole) in loops {
+            writeln!(out, "{} {line}", if hole { "hole" } else { "trim" })?;
+        }
+        writeln!(out, "end")?;
+        next += s.points.len();
     }
     Ok(())
 }

@@ -11,6 +11,7 @@ pub mod elevate;
 pub mod freeform;
 pub mod freeform_trim;
 pub mod mesh;
+pub mod net;
 pub mod patch;
 pub mod quad;
 pub mod rational;

@@ -22,6 +22,7 @@ use super::bezier::BezierPatch;
 use super::bvh::{Bvh, FLAT_PRIMITIVES};
 use super::freeform::DomainPatch;
 use super::mesh::TriangleMesh;
+use super::net::PlacedNet;
 use super::patch::{
     intersect_leaf, intersect_per_ray_weighted, intersect_rational_leaf, leaf_occludes,
     rational_leaf_occludes, subdivide_weighted, PatchHit, PatchLeaf, PatchPoint, RayFrame, SubdivisionParams,
@@ -157,6 +158,8 @@ pub struct GeometryBuilder {
     patch_weights: Vec<Option<Box<Weights>>>,
     /// Each patch's surface's trim loops, when it is trimmed.
     patch_trims: Vec<Option<Arc<TrimRegion>>>,
+    /// The B-spline and NURBS surfaces the patches came from, with their patches.
+    nets: Vec<PlacedNet>,
     /// The patch intersector.
     pub patch_method: PatchMethod,
 }
@@ -222,6 +225,7 @@ impl GeometryBuilder {
                 window: domain,
                 weights,
                 trim: None,
+                net: None,
             },
             object,
         )
@@ -234,7 +238,22 @@ impl GeometryBuilder {
         self.patch_domains.push(piece.window);
         self.patch_weights.push(piece.weights.map(Box::new));
         self.patch_trims.push(piece.trim);
-        ShapeRef::Patch(self.patches.len() as u32 - 1)
+        let k = self.patches.len() - 1;
+        if let Some(net) = piece.net {
+            match self.nets.last_mut() {
+                Some(last)
+                    if Arc::ptr_eq(&last.net, &net) && last.patches.end == k && last.object == object =>
+                {
+                    last.patches.end = k + 1
+                }
+                _ => self.nets.push(PlacedNet {
+                    net,
+                    object,
+                    patches: k..k + 1,
+                }),
+            }
+        }
+        ShapeRef::Patch(k as u32)
     }
 
     /// The spheres, quads and mesh triangles as primitives, with their bounds, in that order.
@@ -323,6 +342,7 @@ impl GeometryBuilder {
             patch_domains,
             patch_weights,
             patch_trims,
+            nets: self.nets,
             patch_scales,
             leaves,
             primitives,
@@ -395,6 +415,7 @@ pub struct SceneGeometry {
     patch_domains: Vec<Window>,
     patch_weights: Vec<Option<Box<Weights>>>,
     patch_trims: Vec<Option<Arc<TrimRegion>>>,
+    nets: Vec<PlacedNet>,
     /// With a rational patch, each leaf's weights ([`leaf_weights`]); otherwise empty.
     leaf_weights: Vec<Option<Weights>>,
     /// With a trimmed patch, whether each leaf tests its hits against the trims
@@ -439,6 +460,7 @@ impl SceneGeometry {
             patch_domains: Vec::new(),
             patch_weights: Vec::new(),
             patch_trims: Vec::new(),
+            nets: Vec::new(),
             patch_method: method,
         };
         for (k, ((p, object), domain)) in self.patches.iter().zip(&self.patch_domains).enumerate() {
@@ -460,6 +482,7 @@ impl SceneGeometry {
                         window: *domain,
                         weights: weights.copied(),
                         trim: self.patch_trims[k].clone(),
+                        net: self.patch_net(k).map(|n| self.nets[n].net.clone()),
                     },
                     *object,
                 ),
@@ -510,7 +533,35 @@ impl SceneGeometry {
             window: self.patch_domains[k],
             weights: self.patch_weights(k).copied(),
             trim: self.patch_trims[k].clone(),
+            net: self.patch_net(k).map(|n| self.nets[n].net.clone()),
         }
+    }
+
+    /// The B-spline and NURBS surfaces the patches came from (read from OBJ), each with its
+    /// object and its patches: what an editor shows and moves instead of their Bézier points.
+    pub fn nets(&self) -> &[PlacedNet] {
+        &self.nets
+    }
+
+    /// The net patch `k` was derived from, as an index into [`SceneGeometry::nets`].
+    pub fn patch_net(&self, k: usize) -> Option<usize> {
+        let n = self.nets.partition_point(|n| n.patches.end <= k);
+        self.nets.get(n).filter(|n| n.patches.contains(&k)).map(|_| n)
+    }
+
+    /// Moves points of net `n` (`(index, position)`, `u` fastest) and derives its patches
+    /// again, re-preparing them ([`SceneGeometry::update_patches`]). Returns the patches as
+    /// they now are, with their indices; `None` (changing nothing) for a net or point out of
+    /// range or a position that is not finite.
+    pub fn move_net_points(
+        &mut self,
+        n: usize,
+        moves: &[(usize, DVec3)],
+    ) -> Option<Vec<(usize, BezierPatch)>> {
+        let (net, edits) = self.nets.get(n)?.moved(moves)?;
+        self.update_patches(&edits)?;
+        self.nets[n].net = Arc::new(net);
+        Some(edits)
     }
 
     /// Whether leaf `leaf` tests its hits against trim loops, on a ray's path: a scene without

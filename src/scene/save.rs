@@ -12,6 +12,7 @@ use toml_edit::{Array, DocumentMut, Item, Table, Value};
 
 use super::{Camera, Light, Material, MaterialKind, RenderParams, Scene};
 use crate::files::{write_atomically, WriteError};
+use crate::geometry::freeform::write_surfaces_obj;
 use crate::geometry::rational::Weights;
 use crate::geometry::trim::TrimRegion;
 use crate::geometry::{BezierPatch, Window};
@@ -116,6 +117,22 @@ pub fn scene_toml(
     loaded: &[BezierPatch],
     out_dir: Option<&Path>,
 ) -> Result<String, SaveError> {
+    scene_text(scene, loaded, out_dir, None).map(|(text, _)| text)
+}
+
+/// An edited object whose patches all come from B-spline surfaces' own nets, written as those
+/// surfaces to an OBJ file beside the scene: its index, the file's name and its text.
+type NetFile = (usize, String, String);
+
+/// [`scene_toml`]; with `beside` (the saved scene's file stem), edited objects made of
+/// surfaces' own nets are written as those B-splines to OBJ files beside it
+/// (`STEM.OBJECT.obj`), returned with the text, instead of inline.
+fn scene_text(
+    scene: &Scene,
+    loaded: &[BezierPatch],
+    out_dir: Option<&Path>,
+    beside: Option<&str>,
+) -> Result<(String, Vec<NetFile>), SaveError> {
     let mut doc = parse_text(scene)?;
     // What the file itself says: what did not change stays as the user wrote it.
     let original = Scene::from_str(&scene.text, &scene.source, scene.base_dir.as_deref()).ok();
@@ -126,7 +143,7 @@ pub fn scene_toml(
     if original.as_ref().is_none_or(|o| o.params != scene.params) {
         write_render(&mut doc, scene);
     }
-    write_patches(&mut doc, scene, loaded);
+    let net_files = write_patches(&mut doc, scene, loaded, beside);
     if let Some(o) = &original {
         write_changed_lights(&mut doc, scene, &o.lights);
         write_changed_materials(&mut doc, scene, &o.materials);
@@ -153,7 +170,15 @@ pub fn scene_toml(
             }
         }
     }
-    Ok(doc.to_string())
+    // Written beside the scene: the name needs no rebasing.
+    if let Some(objects) = doc.get_mut("objects").and_then(Item::as_array_of_tables_mut) {
+        for (k, name, _) in &net_files {
+            if let Some(o) = objects.get_mut(*k) {
+                o.insert("file", toml_edit::value(name.as_str()));
+            }
+        }
+    }
+    Ok((doc.to_string(), net_files))
 }
 
 /// The scene's own text with only its render settings (`[render]`) and image size brought up to
@@ -393,11 +418,17 @@ fn params_table(params: &RenderParams) -> toml_edit::Table {
     doc.as_table().clone()
 }
 
-fn write_patches(doc: &mut DocumentMut, scene: &Scene, loaded: &[BezierPatch]) {
+fn write_patches(
+    doc: &mut DocumentMut,
+    scene: &Scene,
+    loaded: &[BezierPatch],
+    beside: Option<&str>,
+) -> Vec<NetFile> {
     let patches = scene.geometry.patches();
     let domains = scene.geometry.patch_domains();
+    let mut net_files = Vec::new();
     let Some(objects) = doc.get_mut("objects").and_then(Item::as_array_of_tables_mut) else {
-        return;
+        return net_files;
     };
     for (k, object) in objects.iter_mut().enumerate() {
         let own: Vec<(usize, &BezierPatch)> = patches
@@ -411,6 +442,21 @@ fn write_patches(doc: &mut DocumentMut, scene: &Scene, loaded: &[BezierPatch]) {
             continue;
         }
         if edit_inline_points(object, &own, loaded) {
+            continue;
+        }
+        if let Some(file) = beside.and_then(|stem| net_file(scene, k, &own, stem)) {
+            for key in [
+                "file",
+                "builtin",
+                "transform",
+                "domains",
+                "weights",
+                "trims",
+                "patches",
+            ] {
+                object.remove(key);
+            }
+            net_files.push(file);
             continue;
         }
         for key in ["file", "builtin", "transform", "domains", "weights", "trims"] {
@@ -443,6 +489,58 @@ fn write_patches(doc: &mut DocumentMut, scene: &Scene, loaded: &[BezierPatch]) {
             object.insert("trims", toml_edit::value(list));
         }
     }
+    net_files
+}
+
+/// Object `k`'s surfaces as an OBJ file named after the scene's `stem` and the object, when
+/// every one of its patches (`own`) comes from a surface's own net.
+fn net_file(scene: &Scene, k: usize, own: &[(usize, &BezierPatch)], stem: &str) -> Option<NetFile> {
+    let geometry = &scene.geometry;
+    let mut nets: Vec<usize> = Vec::new();
+    for (i, _) in own {
+        let n = geometry.patch_net(*i)?;
+        if nets.last() != Some(&n) {
+            nets.push(n);
+        }
+    }
+    // The nets must still give the patches (an edit of a patch's own points, which the viewer
+    // does not offer for them, leaves the patches written inline instead).
+    let derives = |n: usize| {
+        let placed = &geometry.nets()[n];
+        let derived = placed.net.patches();
+        derived.len() == placed.patches.len()
+            && placed
+                .patches
+                .clone()
+                .zip(&derived)
+                .all(|(k, (p, _, _))| geometry.patches()[k].0 == *p)
+    };
+    if !nets.iter().all(|&n| derives(n)) {
+        return None;
+    }
+    let surfaces: Vec<_> = nets
+        .iter()
+        .map(|&n| {
+            let placed = &geometry.nets()[n];
+            let trim = geometry.domain_patch(placed.patches.start).trim;
+            (placed.net.clone(), trim)
+        })
+        .collect();
+    let refs: Vec<_> = surfaces.iter().map(|(n, t)| (n.as_ref(), t.as_ref())).collect();
+    let object = scene.objects.get(k).map_or("object", |o| o.name.as_str());
+    let safe: String = object
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    let mut text = Vec::new();
+    write_surfaces_obj(&safe, &refs, &mut text).ok()?;
+    Some((k, format!("{stem}.{safe}.obj"), String::from_utf8(text).ok()?))
 }
 
 /// The `trims` of an object's patches (`own`: scene patch index and patch), one entry per
@@ -499,14 +597,27 @@ fn trims_array(scene: &Scene, own: &[(usize, &BezierPatch)]) -> Option<Array> {
 }
 
 /// Saves the scene to `path` (temporary name, then rename); an existing file is replaced only
-/// when `overwrite`. Returns the text written.
+/// when `overwrite`. An edited object made of B-spline surfaces' own nets is written as those
+/// surfaces to `STEM.OBJECT.obj` beside it (knots, weights and trims kept), under the same
+/// rule. Returns the scene's text.
 pub fn save_scene(
     scene: &Scene,
     loaded: &[BezierPatch],
     path: &Path,
     overwrite: bool,
 ) -> Result<String, SaveError> {
-    let text = scene_toml(scene, loaded, path.parent())?;
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "scene".into());
+    let (text, net_files) = scene_text(scene, loaded, path.parent(), Some(&stem))?;
+    // The surfaces first: a scene is never left naming a file that was not written.
+    let dir = path.parent().unwrap_or(Path::new("."));
+    for (_, name, obj) in &net_files {
+        write_atomically(&dir.join(name), overwrite, |tmp| {
+            std::fs::write(tmp, obj).map_err(|e| e.to_string())
+        })?;
+    }
     write_atomically(path, overwrite, |tmp| {
         std::fs::write(tmp, &text).map_err(|e| e.to_string())
     })?;

@@ -7,7 +7,7 @@ use glam::{DAffine3, DMat3, DVec3};
 use toml::Spanned;
 
 use super::diagnostics::{v3, Ctx, Result, Table};
-use crate::geometry::freeform::DomainPatch;
+use crate::geometry::freeform::{place_pieces, DomainPatch};
 use crate::geometry::rational::{weights_error, Weights};
 use crate::geometry::{
     load_bpt, load_freeform_obj, BezierPatch, GeometryBuilder, Plane, Quad, Sphere, TriangleMesh, Window,
@@ -165,9 +165,8 @@ fn add_patches(
             builder.patch_count() + list.len()
         )));
     }
-    for piece in list {
-        let patch = piece.patch.transformed(m);
-        builder.add_surface_patch(DomainPatch { patch, ..piece }, id);
+    for piece in place_pieces(list, m) {
+        builder.add_surface_patch(piece, id);
     }
     Ok(())
 }
