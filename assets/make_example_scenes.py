@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
 """Writes the Bézier-patch example scenes: scenes/pool.toml with assets/pool_water.obj (a
-bicubic B-spline water surface, 7×7 control points, so 4×4 Bézier patches), scenes/ring.toml (a
-mirror ring of 4 rational patches), scenes/ring_gold.toml (the ring in rough gold) and scenes/lens.toml (a biconvex lens of 2 patches) and scenes/lens_dispersive.toml (the
-lens in SF11 glass), scenes/prism.toml with assets/prism.obj (a dispersive prism), and scenes/ring_window.toml with
-assets/ring_window.obj (the ring as a trimmed NURBS with a window cut in it).
+bicubic B-spline water surface, 11×11 control points, so 8×8 Bézier patches), scenes/ring.toml
+with assets/ring.obj (a mirror ring: one rational B-spline cylinder), scenes/ring_gold.toml (the
+ring in rough gold), scenes/ring_window.toml with assets/ring_window.obj (the ring trimmed by a
+window), scenes/lens.toml (a biconvex lens of 2 patches), scenes/lens_dispersive.toml (the lens
+in SF11 glass), and scenes/prism.toml with assets/prism.obj (a dispersive prism).
 Run from the project folder: python3 assets/make_example_scenes.py"""
 import math
 
@@ -49,30 +50,6 @@ lines += ["cstype bspline", "deg 3 3",
           "parm u " + " ".join(str(k) for k in range(n + 4)),
           "parm v " + " ".join(str(k) for k in range(n + 4)), "end"]
 open("assets/pool_water.obj", "w").write("\n".join(lines) + "\n")
-
-# --- ring: a mirror cylinder of radius 1, height 0.6, 4 rational patches (one per quarter) ---
-# A quarter circle is exactly the rational quadratic through its ends with the corner of its
-# tangents between them, weighted 1, sqrt(1/2), 1 (Piegl & Tiller, The NURBS Book, 7.3); raised
-# to a cubic in homogeneous coordinates, its points weigh 1, (1 + 2h)/3, (1 + 2h)/3, 1.
-h = math.sqrt(0.5)
-ring = []
-ring_weights = []
-for q in range(4):
-    a0, a1 = q * math.pi / 2, (q + 1) * math.pi / 2
-    c0, s0, c1, s1 = math.cos(a0), math.sin(a0), math.cos(a1), math.sin(a1)
-    corner = (c0 - s0, s0 + c0)
-
-    def inner(end):
-        return tuple((e + 2 * h * c) / (1 + 2 * h) for e, c in zip(end, corner))
-
-    arc = [(c0, s0), inner((c0, s0)), inner((c1, s1)), (c1, s1)]
-    pts = []
-    for i in range(4):              # u: up the wall
-        y = 0.6 * i / 3
-        for (x, z) in arc:          # v: around
-            pts.append((x, y, z))
-    ring.append(pts)
-    ring_weights.append([1, (1 + 2 * h) / 3, (1 + 2 * h) / 3, 1] * 4)
 
 # --- lens: two pillow-shaped patches sharing their square boundary, in the plane x = 0 ---
 def lens_patch(sign):
@@ -175,30 +152,12 @@ edge_v = [4.8, 0, 0]
 material = "wall"
 """)
 
-ring_text = ",\n".join(patch_toml(p, exact) for p in ring)
-ring_weights_text = ",\n".join("    [" + ", ".join(exact(w) for w in ws) + "]" for ws in ring_weights)
 
 
-RING_INLINE = """# Each line is one row of four control points at fixed u (height), running around the ring.
-# The patches are rational (each quarter exactly circular): `weights` holds each point's weight,
-# in the same order.
-[[objects]]
-type = "patches"
-name = "ring"
-material = "%s"
-patches = [
-""" + ring_text + """,
-]
-weights = [
-""" + ring_weights_text + """,
-]
-"""
-
-
-def ring_scene(path, about, name, material, ring_object=None):
-    """The ring on its table under its lamp, with `about` as its comment and the material
-    table `material` of the ring, named `name`; `ring_object` replaces the ring's inline
-    patches."""
+def ring_scene(path, about, name, material, ring_object):
+    """The ring on its table under its lamp, with `about` as its comment, the material table
+    `material` of the ring, named `name`, and the ring's object table `ring_object` (%s: the
+    material's name)."""
     open(path, "w").write(HEADER + about + """
 [camera]
 position = [0.0, 4.0, 1.6]
@@ -230,21 +189,29 @@ point = [0, 0, 0]
 normal = [0, 1, 0]
 material = "table"
 
-""" + (ring_object or RING_INLINE) % name)
+""" + ring_object % name)
 
 
-ring_scene("scenes/ring.toml", """# The coffee-cup caustic: a mirror ring (a cylinder of 4 rational bicubic patches, each exactly
-# a quarter circle) on a table, lit by a point light low and off to one side. Light reflected inside the
-# ring gathers into a cardioid-like cusp on the table. Drag the ring's control points to bend
-# the cusp.
+RING_FILE = """# One rational B-spline surface (u up the wall, v around: exactly round), as CAD programs
+# write a cylinder.
+[[objects]]
+type = "patches"
+name = "ring"
+material = "%s"
+file = "../assets/ring.obj"
+"""
+ring_scene("scenes/ring.toml", """# The coffee-cup caustic: a mirror ring (a cylinder read from assets/ring.obj as one rational
+# B-spline surface, exactly round) on a table, lit by a point light low and off to one side.
+# Light reflected inside the ring gathers into a cardioid-like cusp on the table. Drag the
+# ring's control points (its own NURBS net) to bend the cusp.
 """, "mirror", """type = "mirror"
-color = [0.95, 0.9, 0.8]""")
+color = [0.95, 0.9, 0.8]""", RING_FILE)
 ring_scene("scenes/ring_gold.toml", """# The coffee-cup caustic from a ring of brushed gold: the same ring as ring.toml, its metal
 # rough (GGX roughness 0.08), so that the cusp it casts is soft and golden and the ring itself
 # glossy.
 """, "gold", """type = "metal"
 conductor = "gold"
-roughness = 0.08""")
+roughness = 0.08""", RING_FILE)
 
 def lens_scene(path, about, glass):
     open(path, "w").write(HEADER + about + """
@@ -422,13 +389,18 @@ lines = ["# The mirror ring of ring.toml as one trimmed rational B-spline surfac
 for (x, z, w) in circle:
     for y in (0.0, 0.6):
         lines.append("v %s %s %s %s" % (exact(x), exact(y), exact(z), exact(w)))
+SURFACE = ["cstype rat bspline", "deg 1 2", "surf 0 1 0 4 " + " ".join(str(k) for k in range(1, 19)),
+           "parm u 0 0 1 1", "parm v 0 0 0 1 1 2 2 3 3 4 4 4"]
+open("assets/ring.obj", "w").write("\n".join(
+    ["# The mirror ring of ring.toml: a cylinder of radius 1 and height 0.6 as one rational",
+     "# B-spline surface (u up the wall, degree 1; v around, degree 2). Made by",
+     "# assets/make_example_scenes.py."] + lines[2:] + SURFACE + ["end"]) + "\n")
 centre_u, centre_v, radius_u, radius_v = 0.5, 11 / 90, 0.15 / 0.6, 0.15 / (math.pi / 2)
 for (a, b, w) in circle:
     lines.append("vp %s %s %s" % (exact(centre_u + radius_u * a), exact(centre_v + radius_v * b), exact(w)))
 lines += ["cstype rat bspline", "deg 2", "curv2 " + " ".join(str(k) for k in range(1, 10)),
           "parm u 0 0 0 1 1 2 2 3 3 4 4 4", "end",
-          "cstype rat bspline", "deg 1 2", "surf 0 1 0 4 " + " ".join(str(k) for k in range(1, 19)),
-          "parm u 0 0 1 1", "parm v 0 0 0 1 1 2 2 3 3 4 4 4", "hole 0 4 1", "end"]
+          ] + SURFACE + ["hole 0 4 1", "end"]
 open("assets/ring_window.obj", "w").write("\n".join(lines) + "\n")
 ring_scene("scenes/ring_window.toml", """# The mirror ring with a window: the ring of ring.toml read as one trimmed NURBS surface
 # (assets/ring_window.obj, a rational B-spline with a 'hole' loop), a round window cut through
