@@ -15,18 +15,7 @@ use glam::DVec3;
 /// A unit circle around `z` as a rational quadratic B-spline (9 points, weights 1 and √½), swept
 /// from `z = 0` to `z = 2` (degree 1): the exact cylinder, as CAD programs write it.
 fn cylinder_obj() -> String {
-    let h = std::f64::consts::FRAC_1_SQRT_2;
-    let circle = [
-        (1.0, 0.0, 1.0),
-        (1.0, 1.0, h),
-        (0.0, 1.0, 1.0),
-        (-1.0, 1.0, h),
-        (-1.0, 0.0, 1.0),
-        (-1.0, -1.0, h),
-        (0.0, -1.0, 1.0),
-        (1.0, -1.0, h),
-        (1.0, 0.0, 1.0),
-    ];
+    let circle = common::rational_circle();
     let mut text = String::new();
     for z in [0.0, 2.0] {
         for (x, y, w) in circle {
@@ -368,17 +357,7 @@ fn sphere_obj() -> String {
         (1.0, 1.0, h),
         (0.0, 1.0, 1.0),
     ];
-    let circle = [
-        (1.0, 0.0, 1.0),
-        (1.0, 1.0, h),
-        (0.0, 1.0, 1.0),
-        (-1.0, 1.0, h),
-        (-1.0, 0.0, 1.0),
-        (-1.0, -1.0, h),
-        (0.0, -1.0, 1.0),
-        (1.0, -1.0, h),
-        (1.0, 0.0, 1.0),
-    ];
+    let circle = common::rational_circle();
     let mut text = String::new();
     // u along the profile (fastest), v around.
     for (x, y, c) in circle {

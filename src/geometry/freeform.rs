@@ -437,33 +437,8 @@ impl Reader<'_> {
         Ok(())
     }
 
-    fn parm(&mut self, line: usize, args: &[&str]) -> Result<(), FreeformError> {
-        if self.surface.is_none() {
-            if self.in_curve {
-                return Ok(());
-            }
-            if self.trims.curve_open() {
-                let [axis, values @ ..] = args else {
-                    return Err(self.err(line, "'parm' takes 'u' and its values".to_owned()));
-                };
-                if values.len() > MAX_KNOTS {
-                    return Err(self.err(
-                        line,
-                        format!(
-                            "'parm' gives {} values; at most {MAX_KNOTS} are read",
-                            values.len()
-                        ),
-                    ));
-                }
-                let values = self.numbers(line, "parm", values)?;
-                return self.trims.parm(line, axis, values).map_err(|e| self.line_err(e));
-            }
-            return Err(self.err(line, "'parm' without a 'surf' before it".to_owned()));
-        }
-        let (axis, values) = match args {
-            [axis, "closed", rest @ ..] | [axis, rest @ ..] => (*axis, rest),
-            [] => return Err(self.err(line, "'parm' takes 'u' or 'v' and its values".to_owned())),
-        };
+    /// A `parm` line's values: at most [`MAX_KNOTS`] finite numbers.
+    fn parm_values(&self, line: usize, values: &[&str]) -> Result<Vec<f64>, FreeformError> {
         if values.len() > MAX_KNOTS {
             return Err(self.err(
                 line,
@@ -473,7 +448,28 @@ impl Reader<'_> {
                 ),
             ));
         }
-        let values = self.numbers(line, "parm", values)?;
+        self.numbers(line, "parm", values)
+    }
+
+    fn parm(&mut self, line: usize, args: &[&str]) -> Result<(), FreeformError> {
+        if self.surface.is_none() {
+            if self.in_curve {
+                return Ok(());
+            }
+            if self.trims.curve_open() {
+                let [axis, values @ ..] = args else {
+                    return Err(self.err(line, "'parm' takes 'u' and its values".to_owned()));
+                };
+                let values = self.parm_values(line, values)?;
+                return self.trims.parm(line, axis, values).map_err(|e| self.line_err(e));
+            }
+            return Err(self.err(line, "'parm' without a 'surf' before it".to_owned()));
+        }
+        let (axis, values) = match args {
+            [axis, "closed", rest @ ..] | [axis, rest @ ..] => (*axis, rest),
+            [] => return Err(self.err(line, "'parm' takes 'u' or 'v' and its values".to_owned())),
+        };
+        let values = self.parm_values(line, values)?;
         let Some(open) = self.surface.as_mut() else {
             return Ok(());
         };

@@ -72,8 +72,9 @@ pub struct PlacedNet {
 }
 
 impl PlacedNet {
-    /// The net with point `index` at `position`, and its patches derived again (each with the
-    /// geometry's index); `None` for an index out of range or a position that is not finite.
+    /// The net with its points moved (`(index, position)`, `u` fastest), and its patches
+    /// derived again, each with its index in the geometry; `None` for an index out of range,
+    /// a position that is not finite, or a net whose patches would not be.
     pub fn moved(&self, moves: &[(usize, DVec3)]) -> Option<(SurfaceNet, Vec<(usize, BezierPatch)>)> {
         let mut net = (*self.net).clone();
         for &(index, position) in moves {

@@ -6,6 +6,23 @@ use glam::{DVec2, DVec3};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
+/// The unit circle as a rational quadratic B-spline, as CAD programs write it: 9 points
+/// `(x, y, weight)` (the square's corners weigh √½), knots `0 0 0 1 1 2 2 3 3 4 4 4`.
+pub fn rational_circle() -> [(f64, f64, f64); 9] {
+    let h = std::f64::consts::FRAC_1_SQRT_2;
+    [
+        (1.0, 0.0, 1.0),
+        (1.0, 1.0, h),
+        (0.0, 1.0, 1.0),
+        (-1.0, 1.0, h),
+        (-1.0, 0.0, 1.0),
+        (-1.0, -1.0, h),
+        (0.0, -1.0, 1.0),
+        (1.0, -1.0, h),
+        (1.0, 0.0, 1.0),
+    ]
+}
+
 /// Runs the `caustic` binary with `args` in the project folder.
 pub fn caustic(args: &[&str]) -> std::process::Output {
     std::process::Command::new(env!("CARGO_BIN_EXE_caustic"))
