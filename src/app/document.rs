@@ -236,15 +236,13 @@ impl Document {
         }
         let mut changes = Vec::new();
         for (n, net_moves) in by_net {
-            let before: Vec<BezierPatch> = self.scene.geometry.nets()[n]
-                .patches
-                .clone()
-                .filter_map(|k| self.patch(k).copied())
-                .collect();
+            let range = self.scene.geometry.nets()[n].patches.clone();
+            let before: Vec<BezierPatch> = range.clone().filter_map(|k| self.patch(k).copied()).collect();
             let Some(edits) = self.scene.geometry.move_net_points(n, &net_moves) else {
                 continue;
             };
-            for ((patch, after), old) in edits.into_iter().zip(before) {
+            for (patch, after) in edits {
+                let old = before[patch - range.start];
                 for index in (0..16).filter(|&i| after.points[i] != old.points[i]) {
                     let position = after.points[index];
                     let command = Command::MoveControlPoint {

@@ -550,15 +550,18 @@ impl SceneGeometry {
     }
 
     /// Moves points of net `n` (`(index, position)`, `u` fastest) and derives its patches
-    /// again, re-preparing them ([`SceneGeometry::update_patches`]). Returns the patches as
-    /// they now are, with their indices; `None` (changing nothing) for a net or point out of
-    /// range or a position that is not finite.
+    /// again, re-preparing those that changed ([`SceneGeometry::update_patches`]). Returns the
+    /// changed patches as they now are, with their indices; `None` (changing nothing) for a net
+    /// or point out of range or a position that is not finite.
     pub fn move_net_points(
         &mut self,
         n: usize,
         moves: &[(usize, DVec3)],
     ) -> Option<Vec<(usize, BezierPatch)>> {
-        let (net, edits) = self.nets.get(n)?.moved(moves)?;
+        let (net, mut edits) = self.nets.get(n)?.moved(moves)?;
+        // Only the patches the moved points' basis functions reach changed: the rest keep
+        // their leaves.
+        edits.retain(|(k, p)| self.patches[*k].0 != *p);
         self.update_patches(&edits)?;
         self.nets[n].net = Arc::new(net);
         Some(edits)
