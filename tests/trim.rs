@@ -89,33 +89,42 @@ fn down(p: DVec2) -> Ray {
     Ray::new(p.extend(1.0), -DVec3::Z)
 }
 
-/// A disk cut out of the plane by the circle: rays 1e-9 inside its edge hit it, rays 1e-9
-/// outside pass, at a thousand angles, and shadow rays agree; both intersectors.
+/// The circle as an outer loop (a disk) and as a hole (a square with a round hole): a ray 1e-9
+/// inside the circle hits the disk and passes the hole, a ray 1e-9 outside passes the disk
+/// and hits the square, at a thousand angles; shadow rays agree; both intersectors.
 #[test]
-fn a_disk_trimmed_by_a_rational_circle_is_hit_exactly_inside_it() {
+fn a_rational_circle_trims_exactly_as_outer_loop_and_as_hole() {
     for method in methods() {
-        let disk = geometry(&[plane_obj(0.0, "trim 0 4 1")], method);
-        for k in 0..1000 {
-            let a = k as f64 * 0.00628;
-            let at = |r: f64| CENTRE + r * DVec2::new(a.cos(), a.sin());
-            let (inside, outside) = (down(at(RADIUS - 1e-9)), down(at(RADIUS + 1e-9)));
-            let hit = disk.intersect(&inside, f64::INFINITY);
-            assert!(
-                hit.is_some_and(|h| (h.t - 1.0).abs() < 1e-9),
-                "{method:?}, angle {a}: inside the disk"
-            );
-            assert!(
-                disk.intersect(&outside, f64::INFINITY).is_none(),
-                "{method:?}, angle {a}: outside the disk"
-            );
-            assert!(
-                disk.occluded(&inside, 2.0) && !disk.occluded(&outside, 2.0),
-                "{method:?}, angle {a}"
-            );
+        for (trims, kept_inside) in [("trim 0 4 1", true), ("hole 0 4 1", false)] {
+            let plane = geometry(&[plane_obj(0.0, trims)], method);
+            let hits = |ray: &Ray| {
+                let hit = plane.intersect(ray, f64::INFINITY);
+                assert_eq!(
+                    hit.is_some(),
+                    plane.occluded(ray, 2.0),
+                    "{method:?} {trims}: shadow rays agree"
+                );
+                hit.is_some_and(|h| (h.t - 1.0).abs() < 1e-9)
+            };
+            for k in 0..1000 {
+                let a = k as f64 * 0.00628;
+                let at = |r: f64| CENTRE + r * DVec2::new(a.cos(), a.sin());
+                let (inside, outside) = (down(at(RADIUS - 1e-9)), down(at(RADIUS + 1e-9)));
+                assert_eq!(
+                    hits(&inside),
+                    kept_inside,
+                    "{method:?} {trims}, angle {a}: inside"
+                );
+                assert_eq!(
+                    hits(&outside),
+                    !kept_inside,
+                    "{method:?} {trims}, angle {a}: outside"
+                );
+            }
+            // The circle's middle and the plane's corner.
+            assert_eq!(hits(&down(CENTRE)), kept_inside);
+            assert_eq!(hits(&down(DVec2::splat(0.1))), !kept_inside);
         }
-        // The disk's middle and the plane's corners.
-        assert!(disk.intersect(&down(CENTRE), f64::INFINITY).is_some());
-        assert!(disk.intersect(&down(DVec2::splat(0.1)), f64::INFINITY).is_none());
     }
 }
 
