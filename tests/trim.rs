@@ -489,3 +489,47 @@ fn an_edited_trimmed_net_saves_as_a_trimmed_surface_beside_the_scene() {
     let err = caustic::scene::save::save_scene(&scene, &loaded, &saved, false).expect_err("exists");
     assert!(err.to_string().contains("saved.plane.obj"), "{err}");
 }
+
+/// A surface placed by an object's `transform` is placed with its net: its patches are the
+/// untransformed ones transformed (to rounding), its net's points are transformed, and a move
+/// of a net point derives the same patches from the placed net as from scratch.
+#[test]
+fn a_placed_surface_moves_with_its_net() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = plane_scene(dir.path(), &plane_obj(0.0, "hole 0 4 1"));
+    let plain = Scene::load(&path).expect("loads");
+    let text = std::fs::read_to_string(&path).expect("reads")
+        + "transform = { scale = 2, rotate = [90, 0, 30], translate = [1, -2, 3] }\n";
+    std::fs::write(&path, text).expect("writes");
+    let mut placed = Scene::load(&path).expect("loads placed");
+    let m = glam::DAffine3::from_translation(DVec3::new(1.0, -2.0, 3.0))
+        * glam::DAffine3::from_rotation_z(30f64.to_radians())
+        * glam::DAffine3::from_rotation_y(0.0)
+        * glam::DAffine3::from_rotation_x(90f64.to_radians())
+        * glam::DAffine3::from_scale(DVec3::splat(2.0));
+    let (a, b) = (&plain.geometry.patches()[0].0, &placed.geometry.patches()[0].0);
+    for (p, q) in a.points.iter().zip(&b.points) {
+        assert!(
+            (m.transform_point3(*p) - *q).length() < 1e-12,
+            "{p} placed at {q}"
+        );
+    }
+    let net = &placed.geometry.nets()[0].net;
+    for (p, q) in plain.geometry.nets()[0]
+        .net
+        .surface
+        .points
+        .iter()
+        .zip(&net.surface.points)
+    {
+        assert!((m.transform_point3(*p) - *q).length() < 1e-12);
+    }
+    let target = net.surface.points[5] + DVec3::new(0.0, 0.0, 0.5);
+    assert!(placed.geometry.move_net_points(0, &[(5, target)]).is_some());
+    let expected = placed.geometry.nets()[0].net.patches();
+    assert_eq!(placed.geometry.patches()[0].0, expected[0].0);
+    assert!(
+        placed.geometry.patch_trim(0).is_some(),
+        "the trim stays with the placed surface"
+    );
+}
