@@ -121,8 +121,9 @@ pub fn place_pieces(pieces: Vec<DomainPatch>, m: &glam::DAffine3) -> Vec<DomainP
 }
 
 /// Reads every free-form surface (degree 1 to 3) of an OBJ file as bicubic Bézier patches, a
-/// line at a time: what the reader keeps beyond the patches is the `v` points (40 bytes each)
-/// and the open surface's indices, whatever else the file holds.
+/// line at a time: what the reader keeps beyond the patches is the `v` points (40 bytes each),
+/// the open surface's indices, each surface's own net (its points and weights, shared by its
+/// patches) and the trim curves, whatever else the file holds.
 pub fn load_freeform_obj(path: &Path) -> Result<Vec<DomainPatch>, FreeformError> {
     let file = crate::input_file::open(path).map_err(|why| FreeformError {
         path: path.to_owned(),
@@ -714,11 +715,7 @@ pub fn write_freeform_obj(
             // OBJ lists control points with u varying fastest: point iu + 4 jv.
             for jv in 0..4 {
                 for iu in 0..4 {
-                    let p = patch.point(iu, jv);
-                    match &d.weights {
-                        Some(weights) => writeln!(out, "v {} {} {} {}", p.x, p.y, p.z, weights[4 * iu + jv])?,
-                        None => writeln!(out, "v {} {} {}", p.x, p.y, p.z)?,
-                    }
+                    write_vertex(out, patch.point(iu, jv), d.weights.map(|w| w[4 * iu + jv]))?;
                 }
             }
             let rat = if d.weights.is_some() { "rat " } else { "" };
@@ -734,10 +731,7 @@ pub fn write_freeform_obj(
                 indices.join(" ")
             )?;
             writeln!(out, "parm u {} {}\nparm v {} {}", w.u0, w.u1, w.v0, w.v1)?;
-            for (line, hole) in loops {
-                writeln!(out, "{} {line}", if hole { "hole" } else { "trim" })?;
-            }
-            writeln!(out, "end")?;
+            end_surface(out, loops)?;
             next += 16;
         }
     }
@@ -768,10 +762,7 @@ pub fn write_surfaces_obj(
         };
         let s = &net.surface;
         for (k, p) in s.points.iter().enumerate() {
-            match &net.weights {
-                Some(w) => writeln!(out, "v {} {} {} {}", p.x, p.y, p.z, w[k])?,
-                None => writeln!(out, "v {} {} {}", p.x, p.y, p.z)?,
-            }
+            write_vertex(out, *p, net.weights.as_ref().map(|w| w[k]))?;
         }
         let rat = if net.weights.is_some() { "rat " } else { "" };
         let (du, dv) = (s.u_knots.degree(), s.v_knots.degree());
@@ -794,13 +785,26 @@ pub fn write_surfaces_obj(
             knots(s.u_knots.values()),
             knots(s.v_knots.values())
         )?;
-        for (line, hole) in loops {
-            writeln!(out, "{} {line}", if hole { "hole" } else { "trim" })?;
-        }
-        writeln!(out, "end")?;
+        end_surface(out, loops)?;
         next += s.points.len();
     }
     Ok(())
+}
+
+/// A `v` line: the point, and its weight for a rational surface.
+fn write_vertex(out: &mut impl std::io::Write, p: DVec3, weight: Option<f64>) -> std::io::Result<()> {
+    match weight {
+        Some(w) => writeln!(out, "v {} {} {} {w}", p.x, p.y, p.z),
+        None => writeln!(out, "v {} {} {}", p.x, p.y, p.z),
+    }
+}
+
+/// A surface's `trim` and `hole` lines, then its `end`.
+fn end_surface(out: &mut impl std::io::Write, loops: LoopLines) -> std::io::Result<()> {
+    for (line, hole) in loops {
+        writeln!(out, "{} {line}", if hole { "hole" } else { "trim" })?;
+    }
+    writeln!(out, "end")
 }
 
 /// Each loop's `u0 u1 curv2` list, and whether it is a hole.

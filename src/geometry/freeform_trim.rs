@@ -10,10 +10,10 @@
 use std::ops::Range;
 use std::sync::Arc;
 
-use glam::{DVec2, DVec3};
+use glam::DVec3;
 
 use super::bspline::{bezier_segments, Knots, DEGREE};
-use super::trim::{TrimLoop, TrimRegion, TrimSegment};
+use super::trim::{project, TrimLoop, TrimRegion, TrimSegment};
 use crate::settings::limits::MAX_KNOTS;
 
 /// How many trim segments a file may make in all (each curve's Bézier spans, over every
@@ -360,7 +360,7 @@ impl TrimReader {
                 ));
             }
             if let (Some(last), Some(first)) = (segments.last(), part.first()) {
-                let gap = point(last[3]).distance(point(first[0]));
+                let gap = project(last[3]).distance(project(first[0]));
                 if !closes(gap, size) {
                     return Err((
                         l.line,
@@ -383,7 +383,7 @@ impl TrimReader {
             ));
         }
         if let (Some(last), Some(first)) = (segments.last(), segments.first()) {
-            let gap = point(last[3]).distance(point(first[0]));
+            let gap = project(last[3]).distance(project(first[0]));
             if !closes(gap, size) {
                 return Err((
                     l.line,
@@ -393,9 +393,4 @@ impl TrimReader {
         }
         Ok(segments)
     }
-}
-
-/// The `(u,v)` of a homogeneous point.
-fn point(p: DVec3) -> DVec2 {
-    DVec2::new(p.x / p.z, p.y / p.z)
 }

@@ -219,16 +219,12 @@ impl GeometryBuilder {
         domain: Window,
         object: u32,
     ) -> ShapeRef {
-        self.add_surface_patch(
-            DomainPatch {
-                patch,
-                window: domain,
-                weights,
-                trim: None,
-                net: None,
-            },
-            object,
-        )
+        let piece = DomainPatch {
+            window: domain,
+            weights,
+            ..DomainPatch::whole(patch)
+        };
+        self.add_surface_patch(piece, object)
     }
 
     /// Adds a piece of a surface that may be rational and trimmed
@@ -464,10 +460,9 @@ impl SceneGeometry {
             patch_method: method,
         };
         for (k, ((p, object), domain)) in self.patches.iter().zip(&self.patch_domains).enumerate() {
-            let weights = self.patch_weights(k);
             match tessellate_segments {
                 Some(n) => {
-                    let mut mesh = super::tessellate::tessellate_weighted(p, weights, n);
+                    let mut mesh = super::tessellate::tessellate_weighted(p, self.patch_weights(k), n);
                     if let Some(trim) = self.patch_trim(k) {
                         trim_mesh(&mut mesh, trim, domain);
                     }
@@ -476,16 +471,7 @@ impl SceneGeometry {
                     }
                     builder.add_mesh(mesh, *object)
                 }
-                None => builder.add_surface_patch(
-                    DomainPatch {
-                        patch: *p,
-                        window: *domain,
-                        weights: weights.copied(),
-                        trim: self.patch_trims[k].clone(),
-                        net: self.patch_net(k).map(|n| self.nets[n].net.clone()),
-                    },
-                    *object,
-                ),
+                None => builder.add_surface_patch(self.domain_patch(k), *object),
             };
         }
         builder.build()
@@ -574,22 +560,28 @@ impl SceneGeometry {
         self.leaf_trimmed.get(leaf as usize).copied().unwrap_or(false)
     }
 
+    /// The nearest hit on leaf `i` in `t_range`, polynomial or rational.
+    #[inline(always)]
+    fn leaf_hit(
+        &self,
+        i: u32,
+        frame: &RayFrame,
+        span: (f64, f64),
+        (t_min, t_max): (f64, f64),
+    ) -> Option<PatchHit> {
+        let leaf = &self.leaves[i as usize];
+        match self.rational_weights(i) {
+            None => intersect_leaf(leaf, frame, span, t_min, t_max),
+            Some(w) => intersect_rational_leaf(leaf, w, frame, span, (t_min, t_max)),
+        }
+    }
+
     /// The nearest hit on leaf `i`, a trim curve crossing it, that the trim keeps.
     #[inline(never)]
     fn trimmed_leaf_hit(&self, i: u32, frame: &RayFrame, span: (f64, f64), t_max: f64) -> Option<PatchHit> {
-        let leaf = &self.leaves[i as usize];
-        let weights = self.rational_weights(i);
-        let (trim, domain) = (
-            self.patch_trim(leaf.patch as usize)?,
-            &self.patch_domains[leaf.patch as usize],
-        );
-        first_kept(
-            |t_min| match weights {
-                None => intersect_leaf(leaf, frame, span, t_min, t_max),
-                Some(w) => intersect_rational_leaf(leaf, w, frame, span, (t_min, t_max)),
-            },
-            |uv| trim.contains(domain.map(uv.x, uv.y)),
-        )
+        let k = self.leaves[i as usize].patch as usize;
+        let trim = (self.patch_trim(k)?, &self.patch_domains[k]);
+        first_kept(|t_min| self.leaf_hit(i, frame, span, (t_min, t_max)), trim)
     }
 
     /// Leaf `leaf`'s weights when its patch is rational, on a ray's path: a scene without
@@ -832,12 +824,7 @@ impl SceneGeometry {
                 if self.trimmed_leaf(i) {
                     return self.trimmed_leaf_hit(i, frame, span, t_max).map(patch_hit);
                 }
-                let leaf = &self.leaves[i as usize];
-                match self.rational_weights(i) {
-                    None => intersect_leaf(leaf, frame, span, 0.0, t_max),
-                    Some(w) => intersect_rational_leaf(leaf, w, frame, span, (0.0, t_max)),
-                }
-                .map(patch_hit)
+                self.leaf_hit(i, frame, span, (0.0, t_max)).map(patch_hit)
             }
             Primitive::Patch(i) => {
                 let depth = match self.patch_method {
@@ -857,9 +844,7 @@ impl SceneGeometry {
                 };
                 match self.patch_trim(k) {
                     None => search(0.0),
-                    Some(trim) => {
-                        first_kept(search, |uv| trim.contains(self.patch_domains[k].map(uv.x, uv.y)))
-                    }
+                    Some(trim) => first_kept(search, (trim, &self.patch_domains[k])),
                 }
                 .map(patch_hit)
             }

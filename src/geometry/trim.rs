@@ -151,7 +151,7 @@ impl TrimRegion {
 
 /// The point `(u,v)` of a homogeneous control point.
 #[inline]
-fn project(p: DVec3) -> DVec2 {
+pub fn project(p: DVec3) -> DVec2 {
     DVec2::new(p.x / p.z, p.y / p.z)
 }
 

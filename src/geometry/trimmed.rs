@@ -59,16 +59,17 @@ fn surface_window(domain: &Window, window: &Window) -> Window {
     }
 }
 
-/// The nearest hit that the trim keeps: `search(t_min)` finds the nearest hit beyond `t_min`,
-/// `keep` tells whether a hit's patch `(u,v)` is kept.
+/// The nearest hit that the trim keeps: `search(t_min)` finds the nearest hit on a patch
+/// beyond `t_min`; `trim` is the patch's surface's loops and `domain` the patch's window in
+/// that surface, which a hit's patch `(u,v)` is mapped through.
 pub fn first_kept(
     mut search: impl FnMut(f64) -> Option<PatchHit>,
-    keep: impl Fn(DVec2) -> bool,
+    (trim, domain): (&TrimRegion, &Window),
 ) -> Option<PatchHit> {
     let mut t_min = 0.0;
     for _ in 0..MAX_CROSSINGS {
         let hit = search(t_min)?;
-        if keep(hit.uv) {
+        if trim.contains(domain.map(hit.uv.x, hit.uv.y)) {
             return Some(hit);
         }
         // Past this crossing: the next root lies beyond it by more than the solver's rounding.
