@@ -3,7 +3,8 @@
 bicubic B-spline water surface, 11×11 control points, so 8×8 Bézier patches), scenes/ring.toml
 with assets/ring.obj (a mirror ring: one rational B-spline cylinder), scenes/ring_gold.toml (the
 ring in rough gold), scenes/ring_window.toml with assets/ring_window.obj (the ring trimmed by a
-window), scenes/lens.toml (a biconvex lens of 2 patches), scenes/lens_dispersive.toml (the lens
+window), scenes/ring_usd.toml with assets/ring_window.usda (the same trimmed ring as an OpenUSD
+NurbsPatch, with a Mesh tile and a Sphere marble), scenes/lens.toml (a biconvex lens of 2 patches), scenes/lens_dispersive.toml (the lens
 in SF11 glass), and scenes/prism.toml with assets/prism.obj (a dispersive prism).
 Run from the project folder: python3 assets/make_example_scenes.py"""
 import math
@@ -413,4 +414,86 @@ type = "patches"
 name = "ring"
 material = "%s"
 file = "../assets/ring_window.obj"
+""")
+
+# --- ring_usd: the trimmed ring as OpenUSD writes it, with a Mesh and a Sphere beside it ---
+# A NurbsPatch lists its points with u fastest (as OBJ does), its weights apart (not
+# pre-weighted), orders (degree + 1) and full knot vectors. Its trim curves are homogeneous
+# (u w, v w, w); USD has no hole flag, so the outer boundary of the domain is a loop of its own
+# and the window, inside it, is a hole by the odd winding rule.
+def usd_list(items):
+    return "[" + ", ".join(items) + "]"
+
+
+def usd_tuple(values):
+    return "(" + ", ".join(exact(v) for v in values) + ")"
+
+
+ring_points = [(x, y, z) for (x, z, w) in circle for y in (0.0, 0.6)]
+ring_weights = [w for (x, z, w) in circle for y in (0.0, 0.6)]
+window = [(centre_u + radius_u * a, centre_v + radius_v * b, w) for (a, b, w) in circle]
+boundary = [(0, 0, 1), (1, 0, 1), (1, 4, 1), (0, 4, 1), (0, 0, 1)]
+trim_points = boundary + [(u * w, v * w, w) for (u, v, w) in window]
+open("assets/ring_window.usda", "w").write("""#usda 1.0
+(
+    doc = "The mirror ring of ring_window.obj as an OpenUSD NurbsPatch with its window as a trim
+curve, a tile (Mesh) and a marble (Sphere) with display colours. Made by
+assets/make_example_scenes.py."
+    upAxis = "Y"
+    metersPerUnit = 1
+)
+
+def Xform "World"
+{
+    def NurbsPatch "Ring"
+    {
+        int uVertexCount = 2
+        int vVertexCount = 9
+        int uOrder = 2
+        int vOrder = 3
+        double[] uKnots = [0, 0, 1, 1]
+        double[] vKnots = [0, 0, 0, 1, 1, 2, 2, 3, 3, 4, 4, 4]
+        double2 uRange = (0, 1)
+        double2 vRange = (0, 4)
+        point3f[] points = """ + usd_list(usd_tuple(p) for p in ring_points) + """
+        double[] pointWeights = """ + usd_list(exact(w) for w in ring_weights) + """
+        int[] trimCurve:counts = [1, 1]
+        int[] trimCurve:orders = [2, 3]
+        int[] trimCurve:vertexCounts = [5, 9]
+        double[] trimCurve:knots = [0, 0, 1, 2, 3, 4, 4, 0, 0, 0, 1, 1, 2, 2, 3, 3, 4, 4, 4]
+        double2[] trimCurve:ranges = [(0, 4), (0, 4)]
+        double3[] trimCurve:points = """ + usd_list(usd_tuple(p) for p in trim_points) + """
+    }
+
+    def Mesh "Tile"
+    {
+        int[] faceVertexCounts = [4]
+        int[] faceVertexIndices = [0, 1, 2, 3]
+        point3f[] points = [(1.05, 0.002, -0.75), (1.05, 0.002, -0.35), (1.45, 0.002, -0.35), (1.45, 0.002, -0.75)]
+        color3f[] primvars:displayColor = [(0.15, 0.3, 0.7)]
+        uniform token subdivisionScheme = "none"
+    }
+
+    def Sphere "Marble"
+    {
+        double radius = 0.15
+        color3f[] primvars:displayColor = [(0.75, 0.12, 0.08)]
+        double3 xformOp:translate = (1.3, 0.15, 1.0)
+        uniform token[] xformOpOrder = ["xformOp:translate"]
+    }
+}
+""")
+ring_scene("scenes/ring_usd.toml", """# The mirror ring with a window, read from OpenUSD: assets/ring_window.usda holds the ring as a
+# NurbsPatch prim (the rational B-spline of ring_window.obj, its window a trim curve), a blue
+# tile (a Mesh prim) and a red marble (a Sphere prim), their colours from displayColor. The
+# object below reads the whole file: the ring as its surface, the tile and the marble as
+# objects of their own.
+""", "mirror", """type = "mirror"
+color = [0.95, 0.9, 0.8]""", """# The USD file's NurbsPatch surfaces take this object's material; its Mesh and Sphere prims
+# become objects with their displayColor.
+[[objects]]
+type = "patches"
+name = "ring"
+material = "%s"
+file = "../assets/ring_window.usda"
 """)

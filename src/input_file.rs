@@ -36,18 +36,21 @@ pub fn open(path: &Path) -> Result<std::fs::File, String> {
 
 /// Reads the regular file `path` as UTF-8 text of at most `max_bytes`.
 pub fn read_text(path: &Path, max_bytes: u64) -> Result<String, String> {
+    String::from_utf8(read_bytes(path, max_bytes)?).map_err(|_| "is not UTF-8 text".into())
+}
+
+/// Reads the regular file `path` whole, at most `max_bytes`.
+pub fn read_bytes(path: &Path, max_bytes: u64) -> Result<Vec<u8>, String> {
     let meta = regular_file(path)?;
     if meta.len() > max_bytes {
         return Err(format!("is {} bytes; at most {max_bytes} are read", meta.len()));
     }
     let file = std::fs::File::open(path).map_err(|e| format!("cannot be opened ({e})"))?;
-    let mut text = String::with_capacity(meta.len() as usize);
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
     // The size checked above may grow while the file is read: take no more than the bound.
-    let read = file.take(max_bytes + 1).read_to_string(&mut text);
-    match read {
+    match file.take(max_bytes + 1).read_to_end(&mut bytes) {
         Ok(n) if n as u64 > max_bytes => Err(format!("grew past {max_bytes} bytes while being read")),
-        Ok(_) => Ok(text),
-        Err(e) if e.kind() == std::io::ErrorKind::InvalidData => Err("is not UTF-8 text".into()),
+        Ok(_) => Ok(bytes),
         Err(e) => Err(format!("cannot be read ({e})")),
     }
 }

@@ -68,3 +68,8 @@ fn kept_pass_list_inputs_parse_or_fail_cleanly() {
 fn kept_farm_names_quote_and_stay_values() {
     assert!(replay("farm_quote", inputs::farm_quote) >= 5);
 }
+
+#[test]
+fn kept_usd_inputs_load_or_fail_cleanly() {
+    assert!(replay("usd", inputs::usd) >= 4);
+}

@@ -40,6 +40,7 @@ fn every_shipped_scene_loads_and_renders() {
         "prism",
         "ring",
         "ring_gold",
+        "ring_usd",
         "ring_window",
         "scroll",
         "showcase",

@@ -108,7 +108,12 @@ pub fn run(scene_path: Option<PathBuf>, mut launch: LaunchOptions) -> anyhow::Re
     let (scene, error) = match &scene_path {
         None => (Scene::builtin(), None),
         Some(p) => match Scene::load(p) {
-            Ok(s) => (s, None),
+            Ok(s) => {
+                for warning in &s.warnings {
+                    eprintln!("caustic view: warning: {warning}");
+                }
+                (s, None)
+            }
             Err(e) => {
                 eprintln!("caustic view: {e}");
                 (Scene::builtin(), Some(e.to_string()))

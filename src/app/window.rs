@@ -46,9 +46,14 @@ impl Viewer {
                 match result {
                     Ok(scene) => {
                         self.remember_folder_of(&path);
+                        let mut message = format!("Opened {}", path.display());
+                        for warning in &scene.warnings {
+                            eprintln!("caustic view: warning: {warning}");
+                            message.push_str(&format!(" (warning: {warning})"));
+                        }
                         self.replace_scene(scene);
                         self.scene_error = None;
-                        self.status = Some(Status::Info(format!("Opened {}", path.display())));
+                        self.status = Some(Status::Info(message));
                     }
                     Err(e) => {
                         self.status = Some(Status::Error(format!("Could not open {}", path.display())));

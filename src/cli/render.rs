@@ -225,6 +225,9 @@ fn scene_to_render(args: &RenderArgs, report: &mut Report) -> Result<(Scene, Opt
         }
         None => (load_scene(args.scene.as_deref())?, None),
     };
+    for warning in &scene.warnings {
+        report.warn(warning.clone());
+    }
     let exposure = args
         .exposure
         .or(recorded.as_ref().and_then(|r| r.exposure))

@@ -22,6 +22,9 @@ pub mod sphere_batch;
 pub mod tessellate;
 pub mod trim;
 pub mod trimmed;
+pub mod usd;
+pub mod usd_layer;
+pub mod usd_nurbs;
 
 pub use aabb::Aabb;
 pub use bezier::BezierPatch;

@@ -243,8 +243,13 @@ pub struct ObjectDesc {
     pub edge_u: Option<Vec3>,
     /// Quad: second edge.
     pub edge_v: Option<Vec3>,
-    /// Mesh (`.obj`) or patches (`.bpt`) file, relative to the scene file.
+    /// Mesh (`.obj`) or patches (`.bpt`, free-form `.obj`, USD `.usda`/`.usdz`/`.usd`; `.usdc` is refused)
+    /// file, relative to the scene file.
     pub file: Option<String>,
+    /// With a USD `file`: `false` reads only its `Mesh` and `Sphere` prims, not its
+    /// `NurbsPatch` surfaces (Save scene writes it when those surfaces were edited and saved
+    /// as an OBJ file). Default `true`.
+    pub nurbs: Option<bool>,
     /// Patches built into the program instead of a file: `"teapot"`.
     pub builtin: Option<String>,
     /// Patches written inline: each a list of 16 points `[x, y, z]`, row by row.

@@ -65,6 +65,9 @@ pub struct Scene {
     pub text: std::sync::Arc<str>,
     /// The folder relative file names in `text` resolve against (`None`: built-in data only).
     pub base_dir: Option<PathBuf>,
+    /// What loading noticed but did not refuse (a USD file's prims that were not read), one
+    /// message each, for the user to see.
+    pub warnings: Vec<String>,
 }
 
 /// The scene the program shows when started without a file: a glass Utah teapot and a mirror

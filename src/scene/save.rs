@@ -15,6 +15,7 @@ use crate::files::{write_atomically, WriteError};
 use crate::geometry::freeform::write_surfaces_obj;
 use crate::geometry::rational::Weights;
 use crate::geometry::trim::TrimRegion;
+use crate::geometry::usd::is_usd_file;
 use crate::geometry::{BezierPatch, Window};
 
 /// Why a scene could not be saved.
@@ -430,6 +431,7 @@ fn write_patches(
     let Some(objects) = doc.get_mut("objects").and_then(Item::as_array_of_tables_mut) else {
         return net_files;
     };
+    let mut usd_rest = Vec::new();
     for (k, object) in objects.iter_mut().enumerate() {
         let own: Vec<(usize, &BezierPatch)> = patches
             .iter()
@@ -443,6 +445,9 @@ fn write_patches(
         }
         if edit_inline_points(object, &own, loaded) {
             continue;
+        }
+        if let Some(rest) = usd_meshes_and_spheres(scene, k, object) {
+            usd_rest.push(rest);
         }
         if let Some(file) = beside.and_then(|stem| net_file(scene, k, &own, stem)) {
             for key in [
@@ -489,7 +494,26 @@ fn write_patches(
             object.insert("trims", toml_edit::value(list));
         }
     }
+    for rest in usd_rest {
+        objects.push(rest);
+    }
     net_files
+}
+
+/// When object `k` (its table `object`) read its surfaces from a USD file that also gave the
+/// scene meshes or spheres, a copy of its table that reads only those (`nurbs = false`): the
+/// edited surfaces are saved elsewhere, and the rest of the file must stay in the scene.
+fn usd_meshes_and_spheres(scene: &Scene, k: usize, object: &toml_edit::Table) -> Option<toml_edit::Table> {
+    let file = object.get("file")?.as_str()?;
+    let owner = &scene.objects.get(k)?.name;
+    let prefix = format!("{owner} /");
+    let gave_more = scene.objects.iter().any(|o| o.name.starts_with(&prefix));
+    if !is_usd_file(file) || !gave_more {
+        return None;
+    }
+    let mut rest = object.clone();
+    rest.insert("nurbs", toml_edit::value(false));
+    Some(rest)
 }
 
 /// Object `k`'s surfaces as an OBJ file named after the scene's `stem` and the object, when

@@ -99,6 +99,39 @@ pub fn freeform(data: &[u8]) {
     shoot_at(&patches);
 }
 
+/// A USD file (text, binary or package): parse it; what it accepts has increasing windows,
+/// positive weights, finite meshes with indices in range and finite spheres, and up to 8 of
+/// its patches intersect to finite hits.
+pub fn usd(data: &[u8]) {
+    let Ok(contents) = caustic::geometry::usd::parse_usd(data.to_vec(), Path::new("fuzz.usda")) else {
+        return;
+    };
+    assert!(
+        contents.patches.iter().all(|d| d.window.u0 < d.window.u1
+            && d.window.v0 < d.window.v1
+            && d.patch.points.iter().all(|p| p.is_finite())
+            && d.weights
+                .is_none_or(|w| w.iter().all(|&x| x > 0.0 && x.is_finite()))),
+        "{:?}",
+        contents.patches
+    );
+    for mesh in &contents.meshes {
+        let m = &mesh.shape;
+        assert!(m.positions.iter().all(|p| p.is_finite()));
+        assert!(m
+            .indices
+            .iter()
+            .flatten()
+            .all(|&i| (i as usize) < m.positions.len()));
+    }
+    for sphere in &contents.spheres {
+        assert!(
+            sphere.shape.center.is_finite() && sphere.shape.radius > 0.0 && sphere.shape.radius.is_finite()
+        );
+    }
+    shoot_at(&contents.patches);
+}
+
 /// Prepares up to 8 patches and shoots rays through their bounds: every hit must be finite,
 /// its (u,v) too.
 fn shoot_at(patches: &[DomainPatch]) {

@@ -2,7 +2,8 @@
 //! concerns, the table (`objects[2] (sphere)`) and the field, and says what was expected.
 //!
 //! Files: `diagnostics` (errors and the checks tables share), `camera`, `materials` (and
-//! textures), `objects` (and their transforms) and `lights` (and the surfaces of area lights).
+//! textures), `objects` (and their transforms), `trims` (inline trim loops), `usd_objects`
+//! (what a USD file adds beside its surfaces) and `lights` (and the surfaces of area lights).
 
 mod camera;
 mod diagnostics;
@@ -10,6 +11,7 @@ mod lights;
 mod materials;
 mod objects;
 mod trims;
+mod usd_objects;
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -66,9 +68,18 @@ pub(super) fn load_str(text: &str, path: &Path, base_dir: Option<&Path>) -> Resu
 
     let mut builder = GeometryBuilder::default();
     let mut objects = Vec::new();
-    for (k, desc) in file.objects.iter().enumerate() {
-        objects::object(&ctx, k, desc, &material_index, &mut builder, &mut objects)?;
+    let mut extras = Vec::new();
+    for object in file.objects.iter().enumerate() {
+        objects::object(
+            &ctx,
+            object,
+            &material_index,
+            &mut builder,
+            &mut objects,
+            &mut extras,
+        )?;
     }
+    let warnings = usd_objects::add_extras(extras, &mut builder, &mut materials, &mut objects);
 
     let (lights, light_objects) =
         lights::add_lights(&ctx, &file.lights, &mut builder, &mut materials, &mut objects)?;
@@ -92,6 +103,7 @@ pub(super) fn load_str(text: &str, path: &Path, base_dir: Option<&Path>) -> Resu
         geometry: builder.build(),
         text: text.into(),
         base_dir: base_dir.map(Path::to_path_buf),
+        warnings,
     })
 }
 

@@ -7,8 +7,10 @@ use glam::{DAffine3, DMat3, DVec3};
 use toml::Spanned;
 
 use super::diagnostics::{v3, Ctx, Result, Table};
+use super::usd_objects::UsdExtras;
 use crate::geometry::freeform::{place_pieces, DomainPatch};
 use crate::geometry::rational::{weights_error, Weights};
+use crate::geometry::usd::{is_usd_file, load_usd, UsdContents};
 use crate::geometry::{
     load_bpt, load_freeform_obj, BezierPatch, GeometryBuilder, Plane, Quad, Sphere, TriangleMesh, Window,
 };
@@ -40,13 +42,15 @@ pub(super) fn transform(t: &Table, d: Option<&TransformDesc>) -> Result<(DAffine
     Ok((m, uniform))
 }
 
+/// Adds object `k` to the builder and the list; a USD file's meshes and spheres go to
+/// `extras`, to be added after the scene's own objects.
 pub(super) fn object(
     ctx: &Ctx,
-    k: usize,
-    desc: &Spanned<ObjectDesc>,
+    (k, desc): (usize, &Spanned<ObjectDesc>),
     materials: &BTreeMap<String, usize>,
     builder: &mut GeometryBuilder,
     objects: &mut Vec<SceneObject>,
+    extras: &mut Vec<UsdExtras>,
 ) -> Result<()> {
     let d = desc.get_ref();
     let label = match &d.name {
@@ -60,17 +64,27 @@ pub(super) fn object(
     };
     let material = material_index(&t, &d.material, materials)?;
     let id = objects.len() as u32;
-    add_shape(&t, d, &label, builder, id)?;
+    let name = d.name.clone().unwrap_or_else(|| format!("{} {k}", d.kind));
+    if let Some(usd) = add_shape(&t, d, &label, builder, id)? {
+        extras.push(UsdExtras::new(&t, usd, (&name, material), d.transform.as_ref())?);
+    }
     objects.push(SceneObject {
-        name: d.name.clone().unwrap_or_else(|| format!("{} {k}", d.kind)),
+        name,
         material,
         emission: None,
     });
     Ok(())
 }
 
-/// Adds the shape of object `id` (its `type`'s keys checked, placed by its transform).
-fn add_shape(t: &Table, d: &ObjectDesc, label: &str, builder: &mut GeometryBuilder, id: u32) -> Result<()> {
+/// Adds the shape of object `id` (its `type`'s keys checked, placed by its transform); a USD
+/// file's contents beside its surfaces are returned.
+fn add_shape(
+    t: &Table,
+    d: &ObjectDesc,
+    label: &str,
+    builder: &mut GeometryBuilder,
+    id: u32,
+) -> Result<Option<UsdContents>> {
     let given = given_keys(d);
     let (m, uniform_scale) = transform(t, d.transform.as_ref())?;
     match d.kind.as_str() {
@@ -124,24 +138,25 @@ fn add_shape(t: &Table, d: &ObjectDesc, label: &str, builder: &mut GeometryBuild
             let path = t.ctx.resolve(&t.span, &format!("{label}: 'file'"), file)?;
             builder.add_mesh(placed_mesh(t, &path, &m)?, id);
         }
-        "patches" => add_patches(t, (d, label), builder, &m, id)?,
+        "patches" => return add_patches(t, (d, label), builder, &m, id),
         other => {
             return Err(t.err(format!(
                 "unknown object type '{other}' (expected sphere, plane, quad, mesh or patches)"
             )))
         }
     }
-    Ok(())
+    Ok(None)
 }
 
-/// A `patches` object's patches, placed by `m`, into the builder.
+/// A `patches` object's patches, placed by `m`, into the builder; what a USD file holds
+/// besides is returned.
 fn add_patches(
     t: &Table,
     (d, label): (&ObjectDesc, &str),
     builder: &mut GeometryBuilder,
     m: &DAffine3,
     id: u32,
-) -> Result<()> {
+) -> Result<Option<UsdContents>> {
     let given = given_keys(d);
     t.only(
         "patches",
@@ -154,9 +169,10 @@ fn add_patches(
             "weights",
             "trims",
             "transform",
+            "nurbs",
         ],
     )?;
-    let list = patch_list(t, d, label)?;
+    let (list, usd) = patch_list(t, d, label)?;
     let limit = crate::settings::limits::MAX_PATCHES;
     if builder.patch_count() + list.len() > limit {
         return Err(t.err(format!(
@@ -168,7 +184,7 @@ fn add_patches(
     for piece in place_pieces(list, m) {
         builder.add_surface_patch(piece, id);
     }
-    Ok(())
+    Ok(usd)
 }
 
 /// Applies inline `domains` (one `[u0, u1, v0, v1]` per patch, each range increasing).
@@ -232,7 +248,7 @@ fn material_index(t: &Table, name: &str, materials: &BTreeMap<String, usize>) ->
 }
 
 /// The keys an `[[objects]]` table gave, for [`Table::only`].
-fn given_keys(d: &ObjectDesc) -> [(&'static str, bool); 14] {
+fn given_keys(d: &ObjectDesc) -> [(&'static str, bool); 15] {
     [
         ("center", d.center.is_some()),
         ("radius", d.radius.is_some()),
@@ -248,12 +264,19 @@ fn given_keys(d: &ObjectDesc) -> [(&'static str, bool); 14] {
         ("weights", d.weights.is_some()),
         ("trims", d.trims.is_some()),
         ("transform", d.transform.is_some()),
+        ("nurbs", d.nurbs.is_some()),
     ]
 }
 
-/// A triangle mesh read from `path`, placed by `m` (normals by its inverse transpose).
+/// A triangle mesh read from `path`, placed by `m`.
 fn placed_mesh(t: &Table, path: &std::path::Path, m: &DAffine3) -> Result<TriangleMesh> {
     let mut mesh = TriangleMesh::load_obj(path).map_err(|e| t.err(e))?;
+    place_mesh(&mut mesh, m);
+    Ok(mesh)
+}
+
+/// A mesh's points (and normals, by the inverse transpose) placed by `m`.
+pub(super) fn place_mesh(mesh: &mut TriangleMesh, m: &DAffine3) {
     let normal_matrix = m.matrix3.inverse().transpose();
     for p in &mut mesh.positions {
         *p = m.transform_point3(*p);
@@ -261,12 +284,12 @@ fn placed_mesh(t: &Table, path: &std::path::Path, m: &DAffine3) -> Result<Triang
     for n in &mut mesh.normals {
         *n = (normal_matrix * *n).normalize_or_zero();
     }
-    Ok(mesh)
 }
 
-/// The patches of a `patches` object, each with its `(u,v)` window: from a `.bpt` or a
-/// free-form `.obj` file, built in, or written inline (with optional `domains`).
-fn patch_list(t: &Table, d: &ObjectDesc, label: &str) -> Result<Vec<DomainPatch>> {
+/// The patches of a `patches` object, each with its `(u,v)` window: from a `.bpt`, a
+/// free-form `.obj` or a USD file (with what else the USD file holds), built in, or written
+/// inline (with optional `domains`).
+fn patch_list(t: &Table, d: &ObjectDesc, label: &str) -> Result<(Vec<DomainPatch>, Option<UsdContents>)> {
     if d.domains.is_some() && d.patches.is_none() {
         return Err(t.err("'domains' applies only to inline 'patches'"));
     }
@@ -280,10 +303,24 @@ fn patch_list(t: &Table, d: &ObjectDesc, label: &str) -> Result<Vec<DomainPatch>
             "'weights' applies only to inline 'patches' (an OBJ file's rational surfaces carry their own)",
         ));
     }
+    let usd_file = d.file.as_deref().is_some_and(is_usd_file);
+    if d.nurbs.is_some() && !usd_file {
+        return Err(t.err("'nurbs' applies only to a USD 'file' (.usda, .usdc, .usdz, .usd)"));
+    }
     let whole = |patches: Vec<BezierPatch>| patches.into_iter().map(DomainPatch::whole).collect();
-    match (d.file.as_deref(), d.builtin.as_deref(), &d.patches) {
+    let list = match (d.file.as_deref(), d.builtin.as_deref(), &d.patches) {
         (Some(file), None, None) => {
             let path = t.ctx.resolve(&t.span, &format!("{label}: 'file'"), file)?;
+            if usd_file {
+                let mut usd = load_usd(&path).map_err(|e| t.err(e))?;
+                let patches = std::mem::take(&mut usd.patches);
+                let patches = if d.nurbs == Some(false) {
+                    Vec::new()
+                } else {
+                    patches
+                };
+                return Ok((patches, Some(usd)));
+            }
             if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj")) {
                 load_freeform_obj(&path).map_err(|e| t.err(e))
             } else {
@@ -322,5 +359,6 @@ fn patch_list(t: &Table, d: &ObjectDesc, label: &str) -> Result<Vec<DomainPatch>
             Ok(out)
         }
         _ => Err(t.err("needs exactly one of 'file', 'builtin' or 'patches'")),
-    }
+    };
+    Ok((list?, None))
 }
