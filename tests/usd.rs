@@ -273,14 +273,15 @@ fn ranges_weights_and_trims_are_read() {
     assert!(hit(&scene, 0.2, 0.5) && hit(&scene, 0.8, 0.9), "the rest is kept");
 }
 
-/// Bad files are errors naming the scene's object, the USD file, the prim and the attribute.
+/// Bad files are errors naming the scene's object, the USD file and line, the prim and the
+/// attribute.
 #[test]
 fn bad_usd_is_an_error_naming_file_prim_and_attribute() {
     let dir = tempfile::tempdir().expect("temp dir");
     let cases: Vec<(String, &str)> = vec![
-        (flat_patch("").replace("int uOrder = 2", "int uOrder = 5"), "'uOrder' is 5 (degree 4)"),
+        (flat_patch("").replace("int uOrder = 2", "int uOrder = 5"), "bad.usda:7: prim /Flat: 'uOrder' is 5 (degree 4)"),
         (flat_patch("").replace("[0, 0, 1, 1]\n    double[] vKnots", "[0, 1, 1]\n    double[] vKnots"), "'uKnots' has 3 values"),
-        (flat_patch("    double[] pointWeights = [1, 0, 1, 1]\n"), "'pointWeights[1]' is 0"),
+        (flat_patch("    double[] pointWeights = [1, 0, 1, 1]\n"), "bad.usda:12: prim /Flat: 'pointWeights[1]' is 0"),
         (flat_patch("").replace("(1, 0, 1)]", "(1, 0, 1), (2, 0, 2)]"), "'points' has 5 points"),
         (flat_patch("    double2 uRange = (0, 3)\n"), "'uRange'"),
         (
@@ -299,7 +300,7 @@ fn bad_usd_is_an_error_naming_file_prim_and_attribute() {
             "#usda 1.0\ndef Mesh \"M\"\n{\n    int[] faceVertexCounts = [3]\n    int[] faceVertexIndices = [0, 1, 7]\n    point3f[] points = [(0, 0, 0), (1, 0, 0), (0, 0, 1)]\n}\n".to_owned(),
             "'faceVertexIndices' holds 7",
         ),
-        ("#usda 1.0\ndef Sphere \"S\" {\n".to_owned(), "not a readable USD text file"),
+        ("#usda 1.0\ndef Sphere \"S\" {\n    double radius = \n}\n".to_owned(), "not a readable USD text file: line 4, column"),
     ];
     for (usd, expected) in cases {
         let err = Scene::load(&usd_scene(dir.path(), "bad.usda", &usd, "")).expect_err(expected);

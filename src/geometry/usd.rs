@@ -19,7 +19,7 @@ use openusd::sdf::{self, Value};
 use super::freeform::{place_pieces, DomainPatch};
 use super::mesh::TriangleMesh;
 use super::sphere::Sphere;
-use super::usd_layer::{layer_from_bytes, open_layer, Layer};
+use super::usd_layer::{layer_from_bytes, line_of, open_layer, Layer};
 use super::usd_nurbs::{islands, nurbs_patches, Budget, NurbsFields, TrimFields};
 
 /// Triangles a file's meshes may make in all; beyond, the file is refused.
@@ -29,12 +29,14 @@ pub const MAX_USD_TRIANGLES: usize = 20_000_000;
 /// the reader's own recursion).
 const MAX_NESTING: usize = 256;
 
-/// A USD file that cannot be read: which file, which prim, what was wrong.
+/// A USD file that cannot be read: which file, which line and prim, what was wrong.
 #[derive(Debug, thiserror::Error)]
-#[error("{}: {}{message}", path.display(), prim.as_ref().map(|p| format!("prim {p}: ")).unwrap_or_default())]
+#[error("{}{}: {}{message}", path.display(), line.map(|l| format!(":{l}")).unwrap_or_default(), prim.as_ref().map(|p| format!("prim {p}: ")).unwrap_or_default())]
 pub struct UsdError {
     /// The file (as given).
     pub path: PathBuf,
+    /// The line of the prim or attribute concerned, when known.
+    pub line: Option<usize>,
     /// The prim concerned, when one is.
     pub prim: Option<String>,
     /// What was wrong.
@@ -79,6 +81,7 @@ pub fn is_usd_file(name: &str) -> bool {
 pub fn load_usd(path: &Path) -> Result<UsdContents, UsdError> {
     let layer = open_layer(path).map_err(|message| UsdError {
         path: path.to_owned(),
+        line: None,
         prim: None,
         message,
     })?;
@@ -89,6 +92,7 @@ pub fn load_usd(path: &Path) -> Result<UsdContents, UsdError> {
 pub fn parse_usd(bytes: Vec<u8>, path: &Path) -> Result<UsdContents, UsdError> {
     let layer = layer_from_bytes(bytes).map_err(|message| UsdError {
         path: path.to_owned(),
+        line: None,
         prim: None,
         message,
     })?;
@@ -141,9 +145,16 @@ struct Reader<'a> {
 }
 
 impl Reader<'_> {
+    /// An error about `prim`, at the line of the attribute its message names first (`'uOrder'
+    /// is 5 …`), else of the prim.
     fn err(&self, prim: &sdf::Path, message: String) -> UsdError {
+        let attr = message
+            .strip_prefix('\'')
+            .and_then(|m| m.split('\'').next())
+            .map(|a| a.split('[').next().unwrap_or(a));
         UsdError {
             path: self.path.to_owned(),
+            line: line_of(&self.layer.text, prim.as_str(), attr),
             prim: Some(prim.to_string()),
             message,
         }
@@ -199,6 +210,7 @@ impl Reader<'_> {
             let top: Vec<&str> = parent.as_str().split('/').take(4).collect();
             return Err(UsdError {
                 path: self.path.to_owned(),
+                line: None,
                 prim: None,
                 message: format!(
                     "prims nest deeper than {MAX_NESTING} levels (below {}/…)",

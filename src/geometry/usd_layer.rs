@@ -26,10 +26,12 @@ const PARSER_STACK: usize = 64 << 20;
 /// The largest layer read: 256 MiB, as for scene files.
 const MAX_LAYER_BYTES: u64 = crate::input_file::MAX_TEXT_BYTES;
 
-/// A parsed layer.
+/// A parsed layer, with its text.
 pub struct Layer {
     /// The layer's specs and fields.
     pub data: sdf::Data,
+    /// The text it was parsed from (for the lines of errors).
+    pub text: String,
 }
 
 impl Layer {
@@ -115,13 +117,49 @@ fn text_layer(bytes: Vec<u8>) -> Result<Layer, String> {
     let parse = std::thread::Builder::new()
         .name("caustic-usda".into())
         .stack_size(PARSER_STACK)
-        .spawn(move || openusd::usda::parse(&text).map_err(|e| format!("{e:#}")))
+        .spawn(move || {
+            let mut parser = openusd::usda::parser::Parser::new(&text);
+            let specs = parser.parse().map_err(|e| match parser.last_error_highlight() {
+                Some(h) => format!("line {}, column {}: {e:#}", h.line, h.column),
+                None => format!("{e:#}"),
+            });
+            drop(parser);
+            specs.map(|specs| (sdf::Data::from_specs(specs), text))
+        })
         .map_err(|e| format!("cannot start the USD parser: {e}"))?;
-    let data = parse
+    let (data, text) = parse
         .join()
         .map_err(|_| "the USD text parser failed on this file".to_owned())?
         .map_err(|e| format!("not a readable USD text file: {e}"))?;
-    Ok(Layer { data })
+    Ok(Layer { data, text })
+}
+
+/// The line (1-based) of `prim`'s definition in `text`, or of its attribute `attr` when given
+/// and found after it: for errors, found by the names alone (the parsed layer keeps no lines).
+pub fn line_of(text: &str, prim: &str, attr: Option<&str>) -> Option<usize> {
+    let mut pos = 0;
+    for name in prim.split('/').filter(|n| !n.is_empty()) {
+        let quoted = format!("\"{name}\"");
+        pos += text[pos..].find(&quoted)?;
+        pos += quoted.len();
+    }
+    if let Some(attr) = attr {
+        let bytes = text.as_bytes();
+        let mut from = pos;
+        while let Some(k) = text[from..].find(attr) {
+            let (start, end) = (from + k, from + k + attr.len());
+            let before = start.checked_sub(1).map(|i| bytes[i]);
+            let after = bytes.get(end).copied();
+            if before.is_some_and(|b| b.is_ascii_whitespace())
+                && after.is_some_and(|b| b.is_ascii_whitespace() || b == b'=')
+            {
+                pos = start;
+                break;
+            }
+            from = end;
+        }
+    }
+    Some(text[..pos].matches('\n').count() + 1)
 }
 
 /// The deepest nesting of `{`, `[` and `(` in USD text, outside strings, asset paths and

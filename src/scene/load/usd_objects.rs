@@ -106,7 +106,7 @@ pub(super) fn add_extras(
         }
         if !extra.unread.is_empty() {
             warnings.push(format!(
-                "{}: the USD file's {} not read",
+                "{}: not read from the USD file: {}",
                 extra.label,
                 extra.unread.join("; ")
             ));
