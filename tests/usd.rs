@@ -169,8 +169,8 @@ def Xform "Parent"
     assert!((top(20.0, 14.0).expect("hits").1 - 14.0).abs() < 1e-9);
 }
 
-/// What is not read (other prim types, composition arcs, a Z-up stage) is listed in one
-/// warning naming the object, and the rest is read.
+/// What is not read (other prim types, composition arcs, a Z-up stage, guides) is listed in
+/// one warning naming the object, and the rest is read; an invisible prim hides its children.
 #[test]
 fn what_is_not_read_is_one_warning() {
     let dir = tempfile::tempdir().expect("temp dir");
@@ -199,6 +199,20 @@ def Xform "Group" (
         double radius = 2
     }
 }
+def Xform "Hidden"
+{
+    token visibility = "invisible"
+    def Sphere "Inside"
+    {
+    }
+}
+def Xform "Helpers"
+{
+    uniform token purpose = "guide"
+    def Sphere "Handle"
+    {
+    }
+}
 "#;
     let path = usd_scene(dir.path(), "w.usda", usd, "");
     let scene = Scene::load(&path).expect("loads");
@@ -211,6 +225,7 @@ def Xform "Group" (
         "1 × 'over' prims (not composed)",
         "references (not composed)",
         "upAxis \"Z\"",
+        "1 × prims of purpose \"guide\" (not rendered)",
     ] {
         assert!(w.contains(part), "{part:?} missing from {w}");
     }

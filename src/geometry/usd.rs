@@ -273,17 +273,26 @@ impl Reader<'_> {
         };
         let (local, reset) = self.local_transform(path)?;
         let m = if reset { local } else { parent_m * local };
-        let invisible = matches!(
+        // Visibility and purpose are inherited: an invisible prim hides its children, and
+        // guide and proxy prims (with theirs) are not rendered.
+        if matches!(
             self.attr(path, "visibility").as_deref().and_then(Value::as_str),
             Some("invisible")
-        );
-        if !invisible {
-            match kind {
-                Kind::Nurbs => self.nurbs(path, &m)?,
-                Kind::Mesh => self.mesh(path, &m)?,
-                Kind::Sphere => self.sphere(path, &m)?,
-                Kind::Group => {}
-            }
+        ) {
+            return Ok(());
+        }
+        if let Some(purpose @ ("guide" | "proxy")) =
+            self.attr(path, "purpose").as_deref().and_then(Value::as_str)
+        {
+            let what = format!("prims of purpose \"{purpose}\" (not rendered)");
+            self.note(what);
+            return Ok(());
+        }
+        match kind {
+            Kind::Nurbs => self.nurbs(path, &m)?,
+            Kind::Mesh => self.mesh(path, &m)?,
+            Kind::Sphere => self.sphere(path, &m)?,
+            Kind::Group => {}
         }
         self.children(path, m, depth + 1)
     }
