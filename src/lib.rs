@@ -31,6 +31,7 @@ pub mod args;
 pub mod assets;
 pub mod bench;
 pub mod color;
+pub mod design;
 pub mod farm;
 pub mod files;
 pub mod geometry;

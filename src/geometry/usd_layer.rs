@@ -123,7 +123,6 @@ fn text_layer(bytes: Vec<u8>) -> Result<Layer, String> {
                 Some(h) => format!("line {}, column {}: {e:#}", h.line, h.column),
                 None => format!("{e:#}"),
             });
-            drop(parser);
             specs.map(|specs| (sdf::Data::from_specs(specs), text))
         })
         .map_err(|e| format!("cannot start the USD parser: {e}"))?;
