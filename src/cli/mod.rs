@@ -2,6 +2,7 @@
 //! its own ([`view`], [`render`], [`shard`], [`farm`], [`export`]). `caustic bench`'s
 //! subcommands are the library's ([`caustic::bench::command`]), parsed here and run there.
 
+mod design;
 mod export;
 mod farm;
 mod render;
@@ -37,6 +38,8 @@ enum Command {
     Farm(farm::FarmArgs),
     /// Write a scene's Bézier patches, tessellated, as a Wavefront OBJ file.
     ExportObj(export::ExportArgs),
+    /// Shape a glass or mirror surface until the light it sends draws a target image.
+    Design(design::DesignArgs),
     /// Measure performance; prints figures (nothing is asserted).
     Bench {
         /// Print the figures as one JSON document on stdout (the text goes to stderr).
@@ -57,13 +60,14 @@ pub fn run() -> Result<()> {
     use_threads(match &command {
         Command::View(a) => a.threads.threads,
         Command::Render(a) => a.threads.threads,
-        Command::ExportObj(_) | Command::Merge(_) | Command::Farm(_) => None,
+        Command::ExportObj(_) | Command::Merge(_) | Command::Farm(_) | Command::Design(_) => None,
         Command::Bench { what, .. } => what.threads(),
     })?;
     match command {
         Command::View(args) => view::view(args, launched),
         Command::Render(args) => render::render(args),
         Command::ExportObj(args) => export::export_obj(args),
+        Command::Design(args) => design::design_command(args),
         Command::Merge(args) => shard::merge(args),
         Command::Farm(args) => farm::farm(args),
         Command::Bench { what, json } => caustic::bench::command::run(what, json),

@@ -68,7 +68,8 @@ pub struct DesignParams {
 }
 
 impl DesignParams {
-    /// The control points of `object`'s patches in `scene`, each moving along `dir`.
+    /// The control points of `object`'s patches in `scene`, each moving along `dir`, points
+    /// that coincide (to a billionth of the object's size) welded.
     /// Rational surfaces are refused: their weights change the derivatives, which are not
     /// written here.
     pub fn of_object(scene: &Scene, object: u32, dir: DVec3) -> Result<Self, String> {
@@ -77,7 +78,17 @@ impl DesignParams {
             .ok_or("the direction the points move along is zero")?;
         let geometry = &scene.geometry;
         let mut out = Self::default();
-        let mut welded: HashMap<[u64; 3], Param> = HashMap::new();
+        // Points closer than a billionth of the object's size are one point: subdivided
+        // neighbours' shared edges agree to rounding, not always bit for bit.
+        let size = geometry
+            .patches()
+            .iter()
+            .filter(|(_, id)| *id == object)
+            .map(|(p, _)| p.bounds())
+            .reduce(|a, b| a.union(b))
+            .map_or(1.0, |b| (b.max - b.min).length().max(1e-300));
+        let quantum = 1e-9 * size;
+        let mut welded: HashMap<[i64; 3], Param> = HashMap::new();
         let mut seen_nets = Vec::new();
         for (k, (patch, id)) in geometry.patches().iter().enumerate() {
             if *id != object {
@@ -98,7 +109,7 @@ impl DesignParams {
             let mut own = Vec::with_capacity(16);
             let mut ids = [0 as Param; 16];
             for (i, p) in patch.points.iter().enumerate() {
-                let key = p.to_array().map(f64::to_bits);
+                let key = p.to_array().map(|c| (c / quantum).round() as i64);
                 let param = *welded.entry(key).or_insert_with(|| {
                     out.dirs.push(dir);
                     out.handles.push(Handle::Points(Vec::new()));
@@ -189,18 +200,28 @@ impl DesignParams {
     /// the geometry refuses a move (a point that is not finite).
     pub fn apply(&self, scene: &mut Scene, theta: &[f64]) -> bool {
         let mut net_moves: HashMap<usize, Vec<(usize, DVec3)>> = HashMap::new();
+        let mut edited: HashMap<usize, BezierPatch> = HashMap::new();
         for (q, handle) in self.handles.iter().enumerate() {
             let position = self.origins[q] + theta[q] * self.dirs[q];
             match handle {
                 Handle::Points(points) => {
                     for &(k, i) in points {
-                        if !scene.geometry.set_control_point(k, i, position) {
-                            return false;
-                        }
+                        edited
+                            .entry(k)
+                            .or_insert_with(|| scene.geometry.patches()[k].0)
+                            .points[i] = position;
                     }
                 }
                 Handle::Net { net, index } => net_moves.entry(*net).or_default().push((*index, position)),
             }
+        }
+        let mut edits: Vec<(usize, BezierPatch)> = edited
+            .into_iter()
+            .filter(|(k, p)| scene.geometry.patches()[*k].0 != *p)
+            .collect();
+        edits.sort_by_key(|(k, _)| *k);
+        if !edits.is_empty() && scene.geometry.update_patches(&edits).is_none() {
+            return false;
         }
         let mut nets: Vec<_> = net_moves.into_iter().collect();
         nets.sort_by_key(|(n, _)| *n);

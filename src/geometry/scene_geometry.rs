@@ -619,6 +619,11 @@ impl SceneGeometry {
         true
     }
 
+    /// The quad of object `object`, placed (its first, when it has several).
+    pub fn quad_of(&self, object: u32) -> Option<Quad> {
+        self.quads.iter().find(|(_, o)| *o == object).map(|(q, _)| *q)
+    }
+
     /// Puts the quad of object `object` (an area light's surface) at `quad` and refits the
     /// BVH; `false` when no quad belongs to that object.
     pub fn move_quad(&mut self, object: u32, quad: Quad) -> bool {
