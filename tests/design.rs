@@ -338,8 +338,8 @@ fn the_design_command_writes_the_scene_and_the_surface() {
     );
 }
 
-/// Bad names, a receiver that is not a quad, a black target and a scene without a point or
-/// spot light are errors that say so.
+/// Bad names, a receiver that is not a quad, a surface that is not smooth glass or mirror, a
+/// black target and a scene without a point or spot light are errors that say so.
 #[test]
 fn bad_design_input_is_a_clear_error() {
     let dir = tempfile::tempdir().expect("temp dir");
@@ -350,7 +350,7 @@ fn bad_design_input_is_a_clear_error() {
     .expect("writes");
     let black = dir.path().join("black.pfm");
     let out = dir.path().join("out.toml");
-    let cases: [(&str, &str, &str, &str, &str); 5] = [
+    let cases: [(&str, &str, &str, &str, &str); 6] = [
         (
             "scenes/design_pool.toml",
             "sea",
@@ -382,6 +382,13 @@ fn bad_design_input_is_a_clear_error() {
         (
             "scenes/cornell.toml",
             "teapot",
+            "floor",
+            "assets/design_target.png",
+            "'teapot' is not smooth glass or a smooth mirror",
+        ),
+        (
+            "scenes/pool.toml",
+            "water",
             "floor",
             "assets/design_target.png",
             "no point or spot light",

@@ -15,6 +15,7 @@ use caustic::design::target::load_target;
 use caustic::files::write_atomically;
 use caustic::geometry::freeform::write_freeform_obj;
 use caustic::scene::light::Light;
+use caustic::scene::material::MaterialKind;
 use caustic::scene::Scene;
 
 /// `caustic design`'s flags.
@@ -164,6 +165,16 @@ fn prepare(args: &DesignArgs) -> Result<Prepared> {
     if !scene.geometry.patches().iter().any(|(_, id)| *id == surface) {
         bail!(
             "--surface: '{}' has no patches (it must be a `patches` object)",
+            args.surface
+        );
+    }
+    let smooth_specular = match &scene.materials[scene.objects[surface as usize].material].kind {
+        MaterialKind::Glass { roughness, .. } | MaterialKind::Mirror { roughness } => *roughness == 0.0,
+        _ => false,
+    };
+    if !smooth_specular {
+        bail!(
+            "--surface: '{}' is not smooth glass or a smooth mirror: the light it sends has no shape to design",
             args.surface
         );
     }
