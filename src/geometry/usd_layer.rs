@@ -3,7 +3,7 @@
 //! `openusd` crate's text reader, guarded where it recurses on what the file says: it recurses
 //! once per nesting level of prims, dictionaries and lists, so a scan counts the nesting first
 //! (strings and comments skipped) and refuses a file deeper than [`MAX_TEXT_NESTING`], and the
-//! parse runs on a thread of its own with a stack of [`PARSER_STACK`], so the limit holds
+//! parse runs on a thread of its own with a stack of 64 MiB, so the limit holds
 //! whatever thread loads the scene.
 //!
 //! Binary ("crate") layers are refused with a message that says how to convert them. The
