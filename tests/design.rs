@@ -69,6 +69,48 @@ fn rays(scene: &Scene, lens: u32) -> Vec<Ray> {
     out
 }
 
+/// Checks every landing point's derivative with respect to every parameter against central
+/// finite differences (step 1e-5) to 1e-7; returns how many were checked and how many moved
+/// by more than `moving`.
+fn agree_with_finite_differences(
+    scene: &mut Scene,
+    (params, receiver): (&DesignParams, &Receiver),
+    rays: &[Ray],
+    moving: f64,
+) -> (usize, usize) {
+    let analytic: Vec<_> = rays
+        .iter()
+        .map(|r| land(scene, params, receiver, *r, 8).expect("lands"))
+        .collect();
+    let (h, mut checked, mut moved) = (1e-5, 0, 0);
+    for q in 0..params.len() {
+        let mut at = |offset: f64| -> Vec<Option<[f64; 2]>> {
+            let mut theta = vec![0.0; params.len()];
+            theta[q] = offset;
+            assert!(params.apply(scene, &theta));
+            rays.iter()
+                .map(|r| land(scene, params, receiver, *r, 8).map(|[s, t]| [s.v, t.v]))
+                .collect()
+        };
+        let (plus, minus) = (at(h), at(-h));
+        at(0.0);
+        for (r, (a, (p, m))) in analytic.iter().zip(plus.iter().zip(&minus)).enumerate() {
+            let (Some(p), Some(m)) = (p, m) else { continue };
+            for axis in 0..2 {
+                let fd = (p[axis] - m[axis]) / (2.0 * h);
+                let exact = a[axis].g.iter().find(|e| e.0 == q as u32).map_or(0.0, |e| e.1);
+                assert!(
+                    (fd - exact).abs() <= 1e-7 * (1.0 + exact.abs()),
+                    "ray {r}, parameter {q}, axis {axis}: analytic {exact}, finite differences {fd}"
+                );
+                checked += 1;
+                moved += usize::from(exact.abs() > moving);
+            }
+        }
+    }
+    (checked, moved)
+}
+
 /// The analytic derivative of each landing point with respect to every control point agrees
 /// with central finite differences (step 1e-5) to 1e-7 (they agree to about 1e-10): 240
 /// derivatives over six photons and the lens's 20 welded control points, 158 of them moving.
@@ -87,38 +129,7 @@ fn landing_derivatives_match_finite_differences() {
         params.len()
     );
     let rays = rays(&scene, lens);
-    let analytic: Vec<_> = rays
-        .iter()
-        .map(|r| land(&scene, &params, &receiver, *r, 8).expect("lands"))
-        .collect();
-    let h = 1e-5;
-    let mut checked = 0;
-    let mut moved = 0;
-    for q in 0..params.len() {
-        let mut at = |offset: f64| -> Vec<Option<[f64; 2]>> {
-            let mut theta = vec![0.0; params.len()];
-            theta[q] = offset;
-            assert!(params.apply(&mut scene, &theta));
-            rays.iter()
-                .map(|r| land(&scene, &params, &receiver, *r, 8).map(|[s, t]| [s.v, t.v]))
-                .collect()
-        };
-        let (plus, minus) = (at(h), at(-h));
-        at(0.0);
-        for (r, (a, (p, m))) in analytic.iter().zip(plus.iter().zip(&minus)).enumerate() {
-            let (Some(p), Some(m)) = (p, m) else { continue };
-            for axis in 0..2 {
-                let fd = (p[axis] - m[axis]) / (2.0 * h);
-                let exact = a[axis].g.iter().find(|e| e.0 == q as u32).map_or(0.0, |e| e.1);
-                assert!(
-                    (fd - exact).abs() <= 1e-7 * (1.0 + exact.abs()),
-                    "ray {r}, parameter {q}, axis {axis}: analytic {exact}, finite differences {fd}"
-                );
-                checked += 1;
-                moved += usize::from(exact.abs() > 1e-3);
-            }
-        }
-    }
+    let (checked, moved) = agree_with_finite_differences(&mut scene, (&params, &receiver), &rays, 1e-3);
     assert!(
         checked > 100 && moved > 20,
         "{checked} derivatives checked, {moved} of them moving"
@@ -156,36 +167,7 @@ fn net_derivatives_match_finite_differences() {
         .iter()
         .map(|&(x, z)| Ray::new(light, (DVec3::new(x, 0.0, z) - light).normalize()))
         .collect();
-    let analytic: Vec<_> = rays
-        .iter()
-        .map(|r| land(&scene, &params, &receiver, *r, 8).expect("lands"))
-        .collect();
-    let (h, mut checked, mut moved) = (1e-5, 0, 0);
-    for q in 0..params.len() {
-        let mut at = |offset: f64| -> Vec<Option<[f64; 2]>> {
-            let mut theta = vec![0.0; params.len()];
-            theta[q] = offset;
-            assert!(params.apply(&mut scene, &theta));
-            rays.iter()
-                .map(|r| land(&scene, &params, &receiver, *r, 8).map(|[s, t]| [s.v, t.v]))
-                .collect()
-        };
-        let (plus, minus) = (at(h), at(-h));
-        at(0.0);
-        for (a, (p, m)) in analytic.iter().zip(plus.iter().zip(&minus)) {
-            let (Some(p), Some(m)) = (p, m) else { continue };
-            for axis in 0..2 {
-                let fd = (p[axis] - m[axis]) / (2.0 * h);
-                let exact = a[axis].g.iter().find(|e| e.0 == q as u32).map_or(0.0, |e| e.1);
-                assert!(
-                    (fd - exact).abs() <= 1e-7 * (1.0 + exact.abs()),
-                    "parameter {q}, axis {axis}: analytic {exact}, finite differences {fd}"
-                );
-                checked += 1;
-                moved += usize::from(exact.abs() > 1e-4);
-            }
-        }
-    }
+    let (checked, moved) = agree_with_finite_differences(&mut scene, (&params, &receiver), &rays, 1e-4);
     assert!(checked > 1000 && moved > 30, "{checked} checked, {moved} moving");
 }
 

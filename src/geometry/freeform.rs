@@ -82,6 +82,34 @@ impl DomainPatch {
     }
 }
 
+/// The Bézier patches of a B-spline or NURBS surface, each sharing the surface's net and
+/// `trim`; an error when the knots or points are too large for them to be finite.
+pub fn net_pieces(net: SurfaceNet, trim: Option<Arc<TrimRegion>>) -> Result<Vec<DomainPatch>, &'static str> {
+    let net = Arc::new(net);
+    let patches: Vec<DomainPatch> = net
+        .patches()
+        .into_iter()
+        .map(|(patch, window, weights)| DomainPatch {
+            patch,
+            window,
+            weights,
+            trim: trim.clone(),
+            net: Some(net.clone()),
+        })
+        .collect();
+    let finite = |d: &DomainPatch| {
+        let w = &d.window;
+        d.patch.points.iter().all(|q| q.is_finite())
+            && (w.u1 - w.u0).is_finite()
+            && (w.v1 - w.v0).is_finite()
+            && d.weights.as_ref().is_none_or(|w| weights_error(w).is_none())
+    };
+    if !patches.iter().all(finite) {
+        return Err("the surface's knots or points are too large to convert (the result is not finite)");
+    }
+    Ok(patches)
+}
+
 /// `pieces` placed by `m`: a plain patch's points transformed; the patches of a surface with
 /// its net derived again from the transformed net (an affine map commutes with knot insertion),
 /// so that an edit of the placed net, which derives them the same way, changes only what it
@@ -600,33 +628,7 @@ impl Reader<'_> {
         rational: bool,
     ) -> Result<Vec<DomainPatch>, FreeformError> {
         let weights = rational.then(|| open.indices.iter().map(|&i| self.vertices[i].weight).collect());
-        let net = Arc::new(SurfaceNet { surface, weights });
-        let patches: Vec<DomainPatch> = net
-            .patches()
-            .into_iter()
-            .map(|(patch, window, weights)| DomainPatch {
-                patch,
-                window,
-                weights,
-                trim: None,
-                net: Some(net.clone()),
-            })
-            .collect();
-        let finite = |d: &DomainPatch| {
-            let w = &d.window;
-            d.patch.points.iter().all(|q| q.is_finite())
-                && (w.u1 - w.u0).is_finite()
-                && (w.v1 - w.v0).is_finite()
-                && d.weights.as_ref().is_none_or(|w| weights_error(w).is_none())
-        };
-        if !patches.iter().all(finite) {
-            return Err(self.err(
-                open.line,
-                "the surface's knots or points are too large to convert (the result is not finite)"
-                    .to_owned(),
-            ));
-        }
-        Ok(patches)
+        net_pieces(SurfaceNet { surface, weights }, None).map_err(|why| self.err(open.line, why.to_owned()))
     }
 
     fn close_surface(&mut self, end_line: usize) -> Result<(), FreeformError> {

@@ -79,30 +79,24 @@ pub fn is_usd_file(name: &str) -> bool {
 
 /// Reads the USD file at `path` (`.usda` text, `.usdz` package, or `.usd`; [`super::usd_layer`]).
 pub fn load_usd(path: &Path) -> Result<UsdContents, UsdError> {
-    let layer = open_layer(path).map_err(|message| UsdError {
-        path: path.to_owned(),
-        line: None,
-        prim: None,
-        message,
-    })?;
-    read_layer(&layer, path)
+    read_layer(open_layer(path), path)
 }
 
 /// [`load_usd`] for a file's bytes already read (`path` names it in errors).
 pub fn parse_usd(bytes: Vec<u8>, path: &Path) -> Result<UsdContents, UsdError> {
-    let layer = layer_from_bytes(bytes).map_err(|message| UsdError {
+    read_layer(layer_from_bytes(bytes), path)
+}
+
+/// The prims of `layer`, or why it could not be read.
+fn read_layer(layer: Result<Layer, String>, path: &Path) -> Result<UsdContents, UsdError> {
+    let layer = layer.map_err(|message| UsdError {
         path: path.to_owned(),
         line: None,
         prim: None,
         message,
     })?;
-    read_layer(&layer, path)
-}
-
-/// The prims of `layer`.
-fn read_layer(layer: &Layer, path: &Path) -> Result<UsdContents, UsdError> {
     let mut reader = Reader {
-        layer,
+        layer: &layer,
         path,
         contents: UsdContents::default(),
         budget: Budget {

@@ -18,11 +18,10 @@ use std::sync::Arc;
 use glam::{DVec2, DVec3};
 
 use super::bspline::{bezier_segments, BsplineSurface, Knots, DEGREE};
-use super::freeform::DomainPatch;
+use super::freeform::{net_pieces, DomainPatch};
 use super::freeform_trim::{closes, MAX_TRIM_SEGMENTS};
 use super::net::SurfaceNet;
 use super::patch::Window;
-use super::rational::weights_error;
 use super::trim::{project, TrimLoop, TrimRegion, TrimSegment};
 use crate::settings::limits::{MAX_KNOTS, MAX_PATCHES};
 
@@ -182,28 +181,7 @@ pub fn nurbs_patches(f: &NurbsFields, budget: &mut Budget) -> Result<Vec<DomainP
     };
     let size = DVec2::new(u1 - u0, v1 - v0).length();
     let trim = trim_region(&f.trim, size, budget)?.map(Arc::new);
-    let net = Arc::new(SurfaceNet { surface, weights });
-    let patches: Vec<DomainPatch> = net
-        .patches()
-        .into_iter()
-        .map(|(patch, window, weights)| DomainPatch {
-            patch,
-            window,
-            weights,
-            trim: trim.clone(),
-            net: Some(net.clone()),
-        })
-        .collect();
-    let finite = |d: &DomainPatch| {
-        d.patch.points.iter().all(|q| q.is_finite())
-            && d.weights.as_ref().is_none_or(|w| weights_error(w).is_none())
-    };
-    if !patches.iter().all(finite) {
-        return Err(
-            "the surface's knots or points are too large to convert (the result is not finite)".into(),
-        );
-    }
-    Ok(patches)
+    net_pieces(SurfaceNet { surface, weights }, trim).map_err(str::to_owned)
 }
 
 /// The trim loops of `t` (none when `trimCurve:counts` is unauthored or empty), over a
