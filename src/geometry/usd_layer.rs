@@ -8,7 +8,7 @@
 //!
 //! Binary ("crate") layers are refused with a message that says how to convert them. The
 //! crate's binary reader (0.6; later ones need a newer Rust) allocates whatever sizes a file
-//! declares and follows its offsets without a bound: fuzzing found a 600-byte file that makes
+//! declares and follows its offsets without a bound: fuzzing found a 3 KB file that makes
 //! it ask for 5.8 × 10¹⁷ bytes, which aborts the program — no error can report that.
 
 use std::io::{Cursor, Read};
