@@ -5,7 +5,7 @@
 
 mod common;
 
-use caustic::design::landing::{land, DesignParams, Receiver};
+use caustic::design::landing::{land, surface_bounds, DesignParams, Receiver};
 use caustic::design::optimize::{design, DesignSettings};
 use caustic::design::photons::design_photons;
 use caustic::design::refine::refined;
@@ -43,14 +43,7 @@ fn lens_scene() -> (Scene, Receiver) {
 
 /// Rays from the spot light through points spread over the lens.
 fn rays(scene: &Scene, lens: u32) -> Vec<Ray> {
-    let bounds = scene
-        .geometry
-        .patches()
-        .iter()
-        .filter(|(_, id)| *id == lens)
-        .map(|(p, _)| p.bounds())
-        .reduce(|a, b| a.union(b))
-        .expect("lens patches");
+    let bounds = surface_bounds(scene, lens).expect("lens patches");
     let centre = (bounds.min + bounds.max) * 0.5;
     let size = bounds.max - bounds.min;
     let light = DVec3::new(-4.0, 1.6, 0.0);

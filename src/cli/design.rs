@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 
 use caustic::args::Overwrite;
-use caustic::design::landing::{DesignParams, Handle, Receiver};
+use caustic::design::landing::{surface_bounds, DesignParams, Handle, Receiver};
 use caustic::design::optimize::{design, drawn, DesignSettings};
 use caustic::design::photons::design_photons;
 use caustic::design::refine::refined;
@@ -16,6 +16,7 @@ use caustic::files::write_atomically;
 use caustic::geometry::freeform::write_freeform_obj;
 use caustic::scene::light::Light;
 use caustic::scene::material::MaterialKind;
+use caustic::scene::save::surface_file_name;
 use caustic::scene::Scene;
 
 /// `caustic design`'s flags.
@@ -125,20 +126,19 @@ fn check_numbers(args: &DesignArgs) -> Result<()> {
     Ok(())
 }
 
-/// The surface's centre and size (its patches' bounds).
-fn surface_bounds(scene: &Scene, object: u32) -> (glam::DVec3, f64) {
-    let bounds = scene
-        .geometry
-        .patches()
-        .iter()
-        .filter(|(_, id)| *id == object)
-        .map(|(p, _)| p.bounds())
-        .reduce(|a, b| a.union(b))
-        .expect("the surface has patches");
-    (
-        (bounds.min + bounds.max) * 0.5,
-        (bounds.max - bounds.min).length(),
-    )
+/// Checks that object `surface` (named `name`) is patches of smooth glass or mirror.
+fn check_surface(scene: &Scene, surface: u32, name: &str) -> Result<()> {
+    if !scene.geometry.patches().iter().any(|(_, id)| *id == surface) {
+        bail!("--surface: '{name}' has no patches (it must be a `patches` object)");
+    }
+    let smooth_specular = match &scene.materials[scene.objects[surface as usize].material].kind {
+        MaterialKind::Glass { roughness, .. } | MaterialKind::Mirror { roughness } => *roughness == 0.0,
+        _ => false,
+    };
+    if !smooth_specular {
+        bail!("--surface: '{name}' is not smooth glass or a smooth mirror: the light it sends has no shape to design");
+    }
+    Ok(())
 }
 
 /// A design ready to run: the scene (refined), what moves, the photons and the settings.
@@ -162,22 +162,7 @@ fn prepare(args: &DesignArgs) -> Result<Prepared> {
     let Some(quad) = scene.geometry.quad_of(receiver) else {
         bail!("--receiver: '{}' is not a quad", args.receiver);
     };
-    if !scene.geometry.patches().iter().any(|(_, id)| *id == surface) {
-        bail!(
-            "--surface: '{}' has no patches (it must be a `patches` object)",
-            args.surface
-        );
-    }
-    let smooth_specular = match &scene.materials[scene.objects[surface as usize].material].kind {
-        MaterialKind::Glass { roughness, .. } | MaterialKind::Mirror { roughness } => *roughness == 0.0,
-        _ => false,
-    };
-    if !smooth_specular {
-        bail!(
-            "--surface: '{}' is not smooth glass or a smooth mirror: the light it sends has no shape to design",
-            args.surface
-        );
-    }
+    check_surface(&scene, surface, &args.surface)?;
     if let Some(refined) = refined(&scene, (surface, &args.surface), args.refine)
         .map_err(|e| anyhow::anyhow!("--refine: {e}"))?
     {
@@ -188,16 +173,17 @@ fn prepare(args: &DesignArgs) -> Result<Prepared> {
         .out
         .file_stem()
         .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
-    let surface_obj = args.out.with_file_name(format!(
-        "{stem}.{}.obj",
-        args.surface.replace(char::is_whitespace, "_")
-    ));
+    let surface_obj = args.out.with_file_name(surface_file_name(&stem, &args.surface));
     args.overwrite.check(
         [args.out.as_path(), surface_obj.as_path()]
             .into_iter()
             .chain(args.preview.as_deref()),
     )?;
-    let (centre, size) = surface_bounds(&scene, surface);
+    let bounds = surface_bounds(&scene, surface).expect("checked: the surface has patches");
+    let (centre, size) = (
+        (bounds.min + bounds.max) * 0.5,
+        (bounds.max - bounds.min).length(),
+    );
     let light = scene.lights.iter().find_map(|l| match l {
         Light::Point { position, .. } | Light::Spot { position, .. } => Some(*position),
         _ => None,
@@ -324,16 +310,9 @@ fn write_surface(scene: &Scene, surface: u32, (name, path): (&str, &Path), force
         .filter(|&k| scene.geometry.patches()[k].1 == surface)
         .map(|k| scene.geometry.domain_patch(k))
         .collect();
-    let write = |tmp: &Path| -> Result<(), String> {
-        let mut file = std::io::BufWriter::new(std::fs::File::create(tmp).map_err(|e| e.to_string())?);
-        write_freeform_obj(
-            &[(name.replace(char::is_whitespace, "_"), patches.clone())],
-            &mut file,
-        )
-        .map_err(|e| e.to_string())?;
-        std::io::Write::flush(&mut file).map_err(|e| e.to_string())
-    };
-    write_atomically(path, force, write).with_context(|| format!("cannot write {}", path.display()))
+    let group = name.replace(char::is_whitespace, "_");
+    super::export::write_obj_file(path, force, |file| write_freeform_obj(&[(group, patches)], file))
+        .with_context(|| format!("cannot write {}", path.display()))
 }
 
 /// Writes the target and the picture the design's photons draw side by side, as a grey PNG

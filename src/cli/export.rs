@@ -82,7 +82,7 @@ pub fn export_obj(args: ExportArgs) -> Result<()> {
 
 /// Writes `out` through a buffer filled by `fill` (temporary name, then rename; an existing
 /// file only replaced when `force`).
-fn write_obj_file(
+pub(super) fn write_obj_file(
     out: &Path,
     force: bool,
     fill: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> std::io::Result<()>,

@@ -28,9 +28,20 @@ use glam::{DMat3, DVec2, DVec3};
 
 use super::dual::{Param, D1, D3};
 use crate::geometry::bezier::BezierPatch;
-use crate::geometry::{Quad, Ray, ShapeRef};
+use crate::geometry::{Aabb, Quad, Ray, ShapeRef};
 use crate::scene::material::MaterialKind;
 use crate::scene::Scene;
+
+/// The bounds of object `object`'s patches (`None` when it has none).
+pub fn surface_bounds(scene: &Scene, object: u32) -> Option<Aabb> {
+    scene
+        .geometry
+        .patches()
+        .iter()
+        .filter(|(_, id)| *id == object)
+        .map(|(p, _)| p.bounds())
+        .reduce(|a, b| a.union(b))
+}
 
 /// What one parameter moves.
 #[derive(Clone, Debug)]
@@ -80,13 +91,7 @@ impl DesignParams {
         let mut out = Self::default();
         // Points closer than a billionth of the object's size are one point: subdivided
         // neighbours' shared edges agree to rounding, not always bit for bit.
-        let size = geometry
-            .patches()
-            .iter()
-            .filter(|(_, id)| *id == object)
-            .map(|(p, _)| p.bounds())
-            .reduce(|a, b| a.union(b))
-            .map_or(1.0, |b| (b.max - b.min).length().max(1e-300));
+        let size = surface_bounds(scene, object).map_or(1.0, |b| (b.max - b.min).length().max(1e-300));
         let quantum = 1e-9 * size;
         let mut welded: HashMap<[i64; 3], Param> = HashMap::new();
         let mut seen_nets = Vec::new();

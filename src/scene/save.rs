@@ -552,8 +552,16 @@ fn net_file(scene: &Scene, k: usize, own: &[(usize, &BezierPatch)], stem: &str) 
         .collect();
     let refs: Vec<_> = surfaces.iter().map(|(n, t)| (n.as_ref(), t.as_ref())).collect();
     let object = scene.objects.get(k).map_or("object", |o| o.name.as_str());
-    let safe: String = object
-        .chars()
+    let safe = safe_name(object);
+    let mut text = Vec::new();
+    write_surfaces_obj(&safe, &refs, &mut text).ok()?;
+    Some((k, surface_file_name(stem, object), String::from_utf8(text).ok()?))
+}
+
+/// `name` with every character but ASCII letters, digits, `-` and `_` made `_`: a file name
+/// part and an OBJ group name.
+fn safe_name(name: &str) -> String {
+    name.chars()
         .map(|c| {
             if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
                 c
@@ -561,10 +569,13 @@ fn net_file(scene: &Scene, k: usize, own: &[(usize, &BezierPatch)], stem: &str) 
                 '_'
             }
         })
-        .collect();
-    let mut text = Vec::new();
-    write_surfaces_obj(&safe, &refs, &mut text).ok()?;
-    Some((k, format!("{stem}.{safe}.obj"), String::from_utf8(text).ok()?))
+        .collect()
+}
+
+/// The file an object's surfaces are written to beside a scene saved as `STEM.toml`:
+/// `STEM.OBJECT.obj`, the object's name made safe for a file name.
+pub fn surface_file_name(stem: &str, object: &str) -> String {
+    format!("{stem}.{}.obj", safe_name(object))
 }
 
 /// The `trims` of an object's patches (`own`: scene patch index and patch), one entry per
