@@ -497,3 +497,107 @@ name = "ring"
 material = "%s"
 file = "../assets/ring_window.usda"
 """)
+
+
+# --- design: a glass slab whose flat top (4 x 4 bicubic patches, 13 x 13 control points once
+# their shared edges are welded) `caustic design` shapes until the light draws a target below
+def flat_patches(y):
+    """4 x 4 flat patches over [-1.2, 1.2] in x and z at height y, facing +y (u along z, v
+    along x: S_u x S_v = +z x +x = +y, out of the glass or water below)."""
+    return [[((-12 + 6 * pj + 2 * j) / 10, y, (-12 + 6 * pi + 2 * i) / 10)
+             for i in range(4) for j in range(4)] for pi in range(4) for pj in range(4)]
+
+
+bottom = [(-1.2 + 0.8 * i, -0.15, -1.2 + 0.8 * j) for i in range(4) for j in range(4)]
+open("scenes/design.toml", "w").write(HEADER + """# Designing a caustic: a glass slab under a point light, its top (`lens`: 4 x 4 flat bicubic
+# patches, 13 x 13 control points once their shared edges are welded) shaped by `caustic design`
+# or the viewer's Design panel until the light draws a target on the floor (`screen`). The
+# camera looks straight down at the screen from between the slab and the screen, and its square
+# image is exactly the screen's rectangle: a render compares with the target pixel for pixel
+# (the target's top-left pixel is the screen's corner + edge_v). As it is, the flat slab lights
+# the screen evenly. (The camera does not see the slab: Frame, in the Edit section, shows it.)
+#   caustic design scenes/design.toml --surface lens --receiver screen \\
+#     --target assets/design_smooth.png --refine 0 --out designed.toml
+
+[camera]
+position = [0.0, -0.3, 0.0]
+look_at = [0.0, -1.5, 0.0]
+up = [0, 0, -1]
+fov = 90
+width = 256
+height = 256
+
+[render]
+renderer = "ppm"
+photons_per_pass = 200000
+# The ray tracer sees no caustics: a little ambient light shows it the screen.
+ambient = [0.03, 0.03, 0.03]
+
+[materials.glass]
+type = "glass"
+ior = 1.5
+
+[materials.screen]
+type = "diffuse"
+color = [0.8, 0.8, 0.8]
+
+[[lights]]
+type = "point"
+position = [0.0, 6.0, 0.0]
+power = 600
+
+[[objects]]
+type = "patches"
+name = "lens"
+material = "glass"
+patches = [""" + ", ".join(patch_toml(q) for q in flat_patches(0.0)) + """]
+
+# The slab's flat bottom, 0.15 below, facing down (out of the glass).
+[[objects]]
+type = "patches"
+name = "slab bottom"
+material = "glass"
+patches = [""" + patch_toml(bottom) + """]
+
+[[objects]]
+type = "quad"
+name = "screen"
+corner = [-1.2, -1.5, 1.2]
+edge_u = [2.4, 0, 0]
+edge_v = [0, 0, -2.4]
+material = "screen"
+""")
+
+
+def write_grey_png(path, width, height, value):
+    """An 8-bit grey PNG of `value(x, y)` in [0, 1], row 0 at the top."""
+    import struct
+    import zlib
+    rows = b"".join(b"\0" + bytes(max(0, min(255, round(255 * value(x, y)))) for x in range(width))
+                    for y in range(height))
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+    header = struct.pack(">IIBBBBB", width, height, 8, 0, 0, 0, 0)
+    open(path, "wb").write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header)
+                           + chunk(b"IDAT", zlib.compress(rows, 9)) + chunk(b"IEND", b""))
+
+
+def smooth_target(x, y):
+    """Two soft spots and a faint floor: a smooth target for the designer."""
+    u, v = (x + 0.5) / 64, (y + 0.5) / 64
+    spot = lambda cu, cv, r: math.exp(-((u - cu) ** 2 + (v - cv) ** 2) / (2 * r * r))
+    return 0.12 + 0.85 * spot(0.33, 0.36, 0.12) + 0.55 * spot(0.68, 0.66, 0.09)
+
+
+write_grey_png("assets/design_smooth.png", 64, 64, smooth_target)
+
+
+# --- design_pool: still water of 4 x 4 flat patches (13 x 13 welded points) over a floor ---
+water = flat_patches(0.0)
+open("scenes/design_pool.toml", "w").write(HEADER + '# A still pool for `caustic design`: a flat water surface (4 x 4 bicubic patches, 13 x 13\n# control points once their shared edges are welded) over a floor named "screen", lit by a\n# point light above. Flat, the water lights the floor evenly; the README\'s command shapes it\n# until the light draws assets/design_target.png (a "C"), as does the viewer\'s Design panel:\n#   caustic design scenes/design_pool.toml --surface water --receiver screen \\\n#     --target assets/design_target.png --refine 0 --out designed.toml\n\n[camera]\nposition = [0.0, -0.45, 2.3]\nlook_at = [0.0, -1.5, -0.1]\nfov = 55\nwidth = 480\nheight = 360\n\n[render]\nrenderer = "ppm"\nphotons_per_pass = 300000\n# The ray tracer sees no caustics: a little ambient light shows it the floor.\nambient = [0.03, 0.03, 0.03]\n\n[materials.water]\ntype = "glass"\nior = 1.33\n\n[materials.floor]\ntype = "diffuse"\ncolor = [0.8, 0.8, 0.8]\n\n[[lights]]\ntype = "point"\nposition = [0.0, 6.0, 0.0]\npower = 600\n\n' + """[[objects]]
+type = "patches"
+name = "water"
+material = "water"
+patches = [""" + ", ".join(patch_toml(q) for q in water) + """]
+
+""" + '[[objects]]\ntype = "quad"\nname = "screen"\ncorner = [-1.2, -1.5, 1.2]\nedge_u = [2.4, 0, 0]\nedge_v = [0, 0, -2.4]\nmaterial = "floor"\n')

@@ -30,6 +30,7 @@ fn every_shipped_scene_loads_and_renders() {
     let expected = [
         "builtin",
         "cornell",
+        "design",
         "design_pool",
         "glass_teapot",
         "hairpin",

@@ -7,15 +7,12 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 
 use caustic::args::Overwrite;
-use caustic::design::landing::{surface_bounds, DesignParams, Handle, Receiver};
-use caustic::design::optimize::{design, drawn, DesignSettings};
-use caustic::design::photons::design_photons;
-use caustic::design::refine::refined;
-use caustic::design::target::load_target;
+use caustic::design::landing::Handle;
+use caustic::design::optimize::drawn;
+use caustic::design::setup::{prepare_design, DesignOptions, PreparedDesign};
+use caustic::design::target::{correlation, load_target};
 use caustic::files::write_atomically;
 use caustic::geometry::freeform::write_freeform_obj;
-use caustic::scene::light::Light;
-use caustic::scene::material::MaterialKind;
 use caustic::scene::save::surface_file_name;
 use caustic::scene::Scene;
 
@@ -75,160 +72,65 @@ pub struct DesignArgs {
     overwrite: Overwrite,
 }
 
-/// The object named `name`, or an error listing the names.
-fn object_named(scene: &Scene, name: &str, flag: &str) -> Result<u32> {
-    match scene.objects.iter().position(|o| o.name == name) {
-        Some(k) => Ok(k as u32),
-        None => {
-            let names: Vec<&str> = scene.objects.iter().map(|o| o.name.as_str()).collect();
-            bail!(
-                "{flag}: the scene has no object named '{name}' (it has: {})",
-                names.join(", ")
-            )
+impl DesignArgs {
+    /// The options as the library takes them.
+    fn options(&self) -> DesignOptions {
+        DesignOptions {
+            seconds: self.seconds,
+            steps: self.steps,
+            photons: self.photons,
+            max_height: self.max_height,
+            smoothness: self.smoothness,
+            refine: self.refine,
+            grid: self.grid,
         }
     }
 }
 
-/// Checks the flags' numbers.
-fn check_numbers(args: &DesignArgs) -> Result<()> {
-    if !(args.seconds.is_finite() && args.seconds > 0.0 && args.seconds <= 86_400.0) {
-        bail!(
-            "--seconds must be above 0 and at most a day, got {}",
-            args.seconds
-        );
-    }
-    if !(1..=1_000_000).contains(&args.steps) {
-        bail!("--steps must be between 1 and 1,000,000, got {}", args.steps);
-    }
-    if !(100..=10_000_000).contains(&args.photons) {
-        bail!(
-            "--photons must be between 100 and 10,000,000, got {}",
-            args.photons
-        );
-    }
-    if args.refine > 4 {
-        bail!("--refine must be between 0 and 4, got {}", args.refine);
-    }
-    if !(4..=512).contains(&args.grid) {
-        bail!("--grid must be between 4 and 512, got {}", args.grid);
-    }
-    if !(args.smoothness.is_finite() && args.smoothness >= 0.0) {
-        bail!(
-            "--smoothness must be a number of 0 or more, got {}",
-            args.smoothness
-        );
-    }
-    if let Some(h) = args.max_height {
-        if !(h.is_finite() && h > 0.0) {
-            bail!("--max-height must be a positive number, got {h}");
-        }
-    }
-    Ok(())
-}
-
-/// Checks that object `surface` (named `name`) is patches of smooth glass or mirror.
-fn check_surface(scene: &Scene, surface: u32, name: &str) -> Result<()> {
-    if !scene.geometry.patches().iter().any(|(_, id)| *id == surface) {
-        bail!("--surface: '{name}' has no patches (it must be a `patches` object)");
-    }
-    let smooth_specular = match &scene.materials[scene.objects[surface as usize].material].kind {
-        MaterialKind::Glass { roughness, .. } | MaterialKind::Mirror { roughness } => *roughness == 0.0,
-        _ => false,
-    };
-    if !smooth_specular {
-        bail!("--surface: '{name}' is not smooth glass or a smooth mirror: the light it sends has no shape to design");
-    }
-    Ok(())
-}
-
-/// A design ready to run: the scene (refined), what moves, the photons and the settings.
+/// A design ready to run, and where its surface is written.
 struct Prepared {
-    scene: Scene,
-    surface: u32,
-    receiver: Receiver,
-    params: DesignParams,
-    photons: Vec<caustic::design::photons::DesignPhoton>,
-    settings: DesignSettings,
-    target_grid: Vec<f64>,
+    design: PreparedDesign,
     surface_obj: PathBuf,
 }
 
-/// Reads and checks everything a design needs, before any work.
+/// Reads and checks everything a design needs, and that its outputs may be written, before
+/// any work.
 fn prepare(args: &DesignArgs) -> Result<Prepared> {
-    check_numbers(args)?;
-    let mut scene = Scene::load(&args.scene)?;
-    let surface = object_named(&scene, &args.surface, "--surface")?;
-    let receiver = object_named(&scene, &args.receiver, "--receiver")?;
-    let Some(quad) = scene.geometry.quad_of(receiver) else {
-        bail!("--receiver: '{}' is not a quad", args.receiver);
-    };
-    check_surface(&scene, surface, &args.surface)?;
-    if let Some(refined) = refined(&scene, (surface, &args.surface), args.refine)
-        .map_err(|e| anyhow::anyhow!("--refine: {e}"))?
-    {
-        scene = refined;
-    }
-    let target = load_target(&args.target).map_err(|e| anyhow::anyhow!("{}: {e}", args.target.display()))?;
+    let options = args.options();
+    options.check().map_err(anyhow::Error::msg)?;
+    let scene = Scene::load(&args.scene)?;
     let stem = args
         .out
         .file_stem()
         .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
     let surface_obj = args.out.with_file_name(surface_file_name(&stem, &args.surface));
+    let folder = match args.out.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    if !folder.is_dir() {
+        bail!(
+            "--out: the folder {} does not exist (nothing was designed or written)",
+            folder.display()
+        );
+    }
     args.overwrite.check(
         [args.out.as_path(), surface_obj.as_path()]
             .into_iter()
             .chain(args.preview.as_deref()),
     )?;
-    let bounds = surface_bounds(&scene, surface).expect("checked: the surface has patches");
-    let (centre, size) = (
-        (bounds.min + bounds.max) * 0.5,
-        (bounds.max - bounds.min).length(),
-    );
-    let light = scene.lights.iter().find_map(|l| match l {
-        Light::Point { position, .. } | Light::Spot { position, .. } => Some(*position),
-        _ => None,
-    });
-    let Some(light) = light else {
-        bail!("the scene has no point or spot light: a design traces photons from those");
-    };
-    let params = DesignParams::of_object(&scene, surface, centre - light)
-        .map_err(|e| anyhow::anyhow!("--surface '{}': {e}", args.surface))?;
-    let photons = design_photons(&scene, surface, 8 * args.photons).map_err(|e| anyhow::anyhow!("{e}"))?;
-    let (eu, ev) = (quad.edge_u.length(), quad.edge_v.length());
-    let grid = if eu >= ev {
-        (args.grid, ((args.grid as f64 * ev / eu).round() as usize).max(4))
-    } else {
-        (((args.grid as f64 * eu / ev).round() as usize).max(4), args.grid)
-    };
-    let max_height = args.max_height.unwrap_or(0.1 * size);
-    Ok(Prepared {
-        target_grid: target.resampled(grid.0, grid.1),
-        settings: DesignSettings {
-            grid,
-            sigma: 0.75,
-            smoothness: args.smoothness,
-            max_height,
-            step: max_height / 40.0,
-            subsets: 8,
-            seconds: args.seconds,
-            max_steps: args.steps,
-            bounces: 16,
-        },
-        scene,
-        surface,
-        receiver: Receiver {
-            object: receiver,
-            quad,
-        },
-        params,
-        photons,
-        surface_obj,
-    })
+    let target = load_target(&args.target).map_err(|e| anyhow::anyhow!("{}: {e}", args.target.display()))?;
+    let design = prepare_design(scene, (&args.surface, &args.receiver), &target, &options)
+        .map_err(anyhow::Error::msg)?;
+    Ok(Prepared { design, surface_obj })
 }
 
 /// Runs `caustic design`.
 pub fn design_command(args: DesignArgs) -> Result<()> {
-    let mut p = prepare(&args)?;
+    let Prepared {
+        design: mut p,
+        surface_obj,
+    } = prepare(&args)?;
     let loaded: Vec<_> = p.scene.geometry.patches().iter().map(|(q, _)| *q).collect();
     let (grid, max_height) = (p.settings.grid, p.settings.max_height);
     eprintln!(
@@ -241,46 +143,43 @@ pub fn design_command(args: DesignArgs) -> Result<()> {
         p.photons.len() / p.settings.subsets
     );
     let mut last_print = -1.0;
-    let outcome = design(
-        &mut p.scene,
-        (&p.params, &p.receiver),
-        &p.photons,
-        &p.target_grid,
-        &p.settings,
-        |s| {
-            if s.elapsed - last_print >= 1.0 || s.step == 0 {
-                last_print = s.elapsed;
-                eprintln!(
-                    "step {:>5}  loss {:.5}  landed {:>5.1} %  {:.1} s",
-                    s.step,
-                    s.loss,
-                    100.0 * s.landed,
-                    s.elapsed
-                );
-            }
-        },
-    );
-    write_outputs(&args, &p, &loaded)?;
+    let outcome = p.run(|s, _| {
+        if s.elapsed - last_print >= 1.0 || s.step == 0 {
+            last_print = s.elapsed;
+            eprintln!(
+                "step {:>5}  loss {:.5}  landed {:>5.1} %  {:.1} s",
+                s.step,
+                s.loss,
+                100.0 * s.landed,
+                s.elapsed
+            );
+        }
+        std::ops::ControlFlow::Continue(())
+    });
+    let picture = drawn(&p.scene, (&p.params, &p.receiver), &p.photons, &p.settings);
+    write_outputs(&args, (&p, &surface_obj), (&loaded, &picture))?;
     let first = outcome.initial_loss;
+    let correlation = correlation(&picture, &p.target_grid);
     eprintln!(
-        "loss {first:.5} → {:.5} ({:.1} % of the start) in {} steps; wrote {} and {}",
+        "loss {first:.5} → {:.5} ({:.1} % of the start) in {} steps, correlation with the target {correlation:.3}; wrote {} and {}",
         outcome.final_loss,
         100.0 * outcome.final_loss / first,
         outcome.steps.len(),
         args.out.display(),
-        p.surface_obj.display()
+        surface_obj.display()
     );
     if args.json {
         let json = serde_json::json!({
             "scene": args.scene,
             "out": args.out,
-            "surface_obj": p.surface_obj,
+            "surface_obj": surface_obj,
             "parameters": p.params.len(),
             "photons_per_step": p.photons.len() / p.settings.subsets,
             "grid": [grid.0, grid.1],
             "max_height": max_height,
             "initial_loss": first,
             "final_loss": outcome.final_loss,
+            "correlation": correlation,
             "steps": outcome.steps,
         });
         println!("{}", serde_json::to_string_pretty(&json)?);
@@ -289,17 +188,21 @@ pub fn design_command(args: DesignArgs) -> Result<()> {
 }
 
 /// Writes the designed scene (only the surface changed), the surface beside it (a net surface
-/// is written by the scene's save itself) and the preview.
-fn write_outputs(args: &DesignArgs, p: &Prepared, loaded: &[caustic::geometry::BezierPatch]) -> Result<()> {
+/// is written by the scene's save itself) and the preview (the target beside `picture`, what
+/// the design's photons draw).
+fn write_outputs(
+    args: &DesignArgs,
+    (p, surface_obj): (&PreparedDesign, &Path),
+    (loaded, picture): (&[caustic::geometry::BezierPatch], &[f64]),
+) -> Result<()> {
     let force = args.overwrite.force;
     caustic::scene::save::save_scene(&p.scene, loaded, &args.out, force)
         .with_context(|| format!("cannot write {}", args.out.display()))?;
     if !p.params.handles.iter().any(|h| matches!(h, Handle::Net { .. })) {
-        write_surface(&p.scene, p.surface, (&args.surface, &p.surface_obj), force)?;
+        write_surface(&p.scene, p.surface, (&args.surface, surface_obj), force)?;
     }
     if let Some(preview) = &args.preview {
-        let picture = drawn(&p.scene, (&p.params, &p.receiver), &p.photons, &p.settings);
-        write_preview(preview, p.settings.grid, &p.target_grid, &picture, force)?;
+        write_preview(preview, p.settings.grid, &p.target_grid, picture, force)?;
     }
     Ok(())
 }

@@ -10,4 +10,5 @@ pub mod landing;
 pub mod optimize;
 pub mod photons;
 pub mod refine;
+pub mod setup;
 pub mod target;

@@ -6,8 +6,10 @@
 //! `±max_height` of where it started, so that the surface can be made.
 //!
 //! The loss is `N Σ_c (I_c / ΣI − T_c)²` over the `N` cells, `I_c` the splatted power and `T`
-//! the target scaled to sum to 1: 0 when the light draws the target exactly, whatever its
-//! brightness.
+//! the target blurred by the same kernel and scaled to sum to 1: 0 when the light draws the
+//! target exactly, whatever its brightness. (Against the sharp target, even a surface that
+//! draws it exactly would be pushed to sharpen its blurred splat — to over-focus — and the
+//! cells along the receiver's edges, whose kernels reach past it, would read as too dark.)
 
 use rayon::prelude::*;
 
@@ -15,6 +17,11 @@ use super::dual::D1;
 use super::landing::{land, DesignParams, Receiver};
 use super::photons::DesignPhoton;
 use crate::scene::Scene;
+
+/// The splat kernel starts this many times wider than `DesignSettings::sigma` and narrows to
+/// it over the steps (quadratically): blurred early, the loss sees where light is missing from
+/// afar, and a surface does not fold into sharp caustics before the coarse shape is there.
+const BLUR_START: f64 = 4.0;
 
 /// How a design runs.
 #[derive(Clone, Debug)]
@@ -66,16 +73,46 @@ pub struct DesignOutcome {
     pub steps: Vec<StepReport>,
 }
 
-/// The loss of `landings` against `target` on the grid, and its derivative with respect to
+/// `target` (an `nx × ny` grid) blurred by the splat kernel of width `sigma` (cut off where the
+/// splat's is, and at the grid's edges, as the splat is), scaled to sum to 1: what a surface
+/// drawing the target exactly splats.
+fn blurred(target: &[f64], (nx, ny): (usize, usize), sigma: f64) -> Vec<f64> {
+    let reach = (3.0 * sigma).ceil() as i64;
+    let kernel: Vec<f64> = (-reach..=reach)
+        .map(|d| (-((d * d) as f64) / (2.0 * sigma * sigma)).exp())
+        .collect();
+    let pass = |source: &[f64], along_x: bool| -> Vec<f64> {
+        let mut out = vec![0.0; nx * ny];
+        for y in 0..ny as i64 {
+            for x in 0..nx as i64 {
+                let value = source[(y * nx as i64 + x) as usize];
+                for (k, w) in (-reach..=reach).zip(&kernel) {
+                    let (tx, ty) = if along_x { (x + k, y) } else { (x, y + k) };
+                    if (0..nx as i64).contains(&tx) && (0..ny as i64).contains(&ty) {
+                        out[(ty * nx as i64 + tx) as usize] += value * w;
+                    }
+                }
+            }
+        }
+        out
+    };
+    let mut out = pass(&pass(target, true), false);
+    let sum: f64 = out.iter().sum();
+    if sum > 0.0 {
+        out.iter_mut().for_each(|v| *v /= sum);
+    }
+    out
+}
+
+/// The loss of `landings` against `target` (blurred as the splat is) on the grid, and its derivative with respect to
 /// each landing point `(s, t)`.
 fn loss_and_slopes(
     landings: &[Option<[D1; 2]>],
     photons: &[DesignPhoton],
     target: &[f64],
-    settings: &DesignSettings,
+    (grid, sigma): ((usize, usize), f64),
 ) -> (f64, Vec<[f64; 2]>) {
-    let (nx, ny) = settings.grid;
-    let sigma = settings.sigma;
+    let (nx, ny) = grid;
     let reach = (3.0 * sigma).ceil() as i64;
     let cells = |x: f64, y: f64| {
         let (x0, y0) = (x.round() as i64, y.round() as i64);
@@ -198,18 +235,20 @@ fn full_loss(
         .par_iter()
         .map(|p| land(scene, params, receiver, p.ray, settings.bounces))
         .collect();
-    loss_and_slopes(&landings, photons, target, settings).0
+    let target = blurred(target, settings.grid, settings.sigma);
+    loss_and_slopes(&landings, photons, &target, (settings.grid, settings.sigma)).0
 }
 
 /// Runs the design on `scene` (its surface moved to the design's last moves when it returns),
-/// calling `report` after every step.
+/// calling `report` after every step with its figures and the moves so far (`θ`); the design
+/// ends early when `report` breaks.
 pub fn design(
     scene: &mut Scene,
     (params, receiver): (&DesignParams, &Receiver),
     photons: &[DesignPhoton],
     target: &[f64],
     settings: &DesignSettings,
-    mut report: impl FnMut(&StepReport),
+    mut report: impl FnMut(&StepReport, &[f64]) -> std::ops::ControlFlow<()>,
 ) -> DesignOutcome {
     let started = std::time::Instant::now();
     let count = params.len();
@@ -233,7 +272,11 @@ pub fn design(
             .par_iter()
             .map(|p| land(scene, params, receiver, p.ray, settings.bounces))
             .collect();
-        let (loss, slopes) = loss_and_slopes(&landings, &subset, target, settings);
+        // By steps, not time, so that a design with the same steps is the same on any machine.
+        let progress = step as f64 / settings.max_steps as f64;
+        let sigma = settings.sigma * (1.0 + (BLUR_START - 1.0) * (1.0 - progress).powi(2));
+        let aim = blurred(target, settings.grid, sigma);
+        let (loss, slopes) = loss_and_slopes(&landings, &subset, &aim, (settings.grid, sigma));
         let landed = landings.iter().filter(|l| l.is_some()).count() as f64 / subset.len().max(1) as f64;
         let elapsed = started.elapsed().as_secs_f64();
         let figures = StepReport {
@@ -242,14 +285,11 @@ pub fn design(
             elapsed,
             landed,
         };
-        report(&figures);
         steps.push(figures);
-        if elapsed >= settings.seconds {
+        if report(&figures, &theta).is_break() || elapsed >= settings.seconds {
             break;
         }
         let gradient = gradient(&landings, &slopes, (params, &theta), settings);
-        // By steps, not time, so that a design with the same steps is the same on any machine.
-        let progress = step as f64 / settings.max_steps as f64;
         let rate = settings.step * 0.5 * (1.0 + (std::f64::consts::PI * progress).cos());
         let t = (step + 1) as i32;
         for q in 0..count {
