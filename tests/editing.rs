@@ -1124,3 +1124,95 @@ fn a_b_spline_surface_is_edited_by_its_own_net_and_saved_as_one() {
         *viewer(&h).scene().geometry.nets()[0].net
     );
 }
+
+/// The Design panel: on `scenes/design.toml` it offers `lens` and `screen`; Start (the
+/// button) runs a short design whose moves reach the scene and the render while it runs,
+/// edits are refused meanwhile, the loss is plotted step by step, and Undo puts the whole
+/// surface back in one step (Redo brings the design back).
+#[test]
+fn a_design_in_the_viewer_moves_the_lens_and_undoes_in_one_step() {
+    use caustic::app::action::Action;
+    use egui_kittest::kittest::Queryable;
+    let mut scene = Scene::load(Path::new("scenes/design.toml")).expect("loads");
+    (scene.camera.width, scene.camera.height) = (64, 64);
+    scene.params.photons_per_pass = 20_000;
+    // Tall enough that the side panel's sections all show.
+    let mut h = harness(Harness::builder());
+    h.set_size(Vec2::new(1100.0, 1600.0));
+    let mut v = Viewer::with_pause(&h.ctx, scene, ViewerSettings::default(), true);
+    v.show_frame(flat_frame());
+    *h.state_mut() = Some(v);
+    h.run_steps(2);
+    // Every control point of the scene (the lens's 16 patches and the slab's bottom).
+    let points = |h: &App<'_>| -> Vec<DVec3> { viewer(h).patches().flat_map(|p| p.points).collect() };
+    let start = points(&h);
+    h.get_by_label("Design").click();
+    h.run_steps(2);
+    for l in ["Surface", "Receiver", "Target", "Choose...", "Start", "Stop"] {
+        assert!(h.query_by_label(l).is_some(), "the Design section shows {l}");
+    }
+    let v = viewer(&h);
+    let (surface, receiver) = v.design().choice(v.scene(), None);
+    assert_eq!(
+        (surface.as_deref(), receiver.as_deref()),
+        (Some("lens"), Some("screen"))
+    );
+    let v = h.state_mut().as_mut().expect("viewer");
+    v.apply(Action::SetDesignTarget("assets/design_smooth.png".into()));
+    v.apply(Action::SetDesignSteps(60));
+    h.run_steps(2);
+    h.get_by_label("Start").click();
+    h.run_steps(2);
+    assert!(
+        viewer(&h).design().running(),
+        "{:?}",
+        viewer(&h).design().message()
+    );
+    let started = std::time::Instant::now();
+    let mut moved_while_running = false;
+    while viewer(&h).design().running() {
+        assert!(started.elapsed().as_secs() < 300, "the design ends");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+        h.step();
+        if viewer(&h).design().running() && points(&h) != start && !moved_while_running {
+            moved_while_running = true;
+            // Edits wait for the design.
+            h.state_mut().as_mut().expect("viewer").apply(Action::Undo);
+            assert_ne!(points(&h), start, "undo is refused while designing");
+            assert!(
+                matches!(viewer(&h).status(), Some(Status::Error(e)) if e.contains("design")),
+                "{:?}",
+                viewer(&h).status()
+            );
+        }
+    }
+    let design = viewer(&h).design();
+    assert!(
+        matches!(design.message(), Some(Ok(m)) if m.starts_with("Designed in 60 steps")),
+        "{:?}",
+        design.message()
+    );
+    assert!(
+        moved_while_running,
+        "the lens moved on screen while the design ran"
+    );
+    assert_eq!(design.losses().len(), 60);
+    assert!(
+        design.losses()[59][1] < design.losses()[0][1],
+        "{:?}",
+        design.losses()
+    );
+    let designed = points(&h);
+    assert_ne!(designed, start);
+    let moves = sent(&h)
+        .iter()
+        .filter(|c| matches!(c, Command::MoveControlPoint { .. }))
+        .count();
+    assert!(moves > 0, "the render session heard of the moves");
+    let v = h.state_mut().as_mut().expect("viewer");
+    v.apply(Action::Undo);
+    assert_eq!(points(&h), start, "one undo puts the whole surface back");
+    let v = h.state_mut().as_mut().expect("viewer");
+    v.apply(Action::Redo);
+    assert_eq!(points(&h), designed);
+}

@@ -158,4 +158,49 @@ pub enum Action {
     Undo,
     /// Redo the last undone edit.
     Redo,
+    /// Show the open dialog for a design's target image.
+    PickDesignTarget,
+    /// Design for this target image.
+    SetDesignTarget(PathBuf),
+    /// Design this object (a `patches` object of smooth glass or mirror).
+    SetDesignSurface(String),
+    /// Draw on this object (a quad).
+    SetDesignReceiver(String),
+    /// Take this many steps of the descent.
+    SetDesignSteps(usize),
+    /// Start designing the surface for the target.
+    StartDesign,
+    /// Stop the running design, keeping its moves so far.
+    StopDesign,
+}
+
+impl Action {
+    /// Whether the action is the Design panel's (its choices, Start, Stop).
+    pub fn is_design(&self) -> bool {
+        matches!(
+            self,
+            Action::PickDesignTarget
+                | Action::SetDesignTarget(_)
+                | Action::SetDesignSurface(_)
+                | Action::SetDesignReceiver(_)
+                | Action::SetDesignSteps(_)
+                | Action::StartDesign
+                | Action::StopDesign
+        )
+    }
+
+    /// Whether the action edits the scene's geometry, lights or materials, or undoes or redoes
+    /// such an edit: what a running design refuses, since it is shaping the scene.
+    pub fn edits_the_scene(&self) -> bool {
+        matches!(
+            self,
+            Action::BeginPointDrag { .. }
+                | Action::DragPoints { .. }
+                | Action::SetPoint(..)
+                | Action::Nudge(_)
+                | Action::SetMaterial { .. }
+                | Action::Undo
+                | Action::Redo
+        )
+    }
 }

@@ -16,6 +16,9 @@ use crate::scene::Camera;
 impl Viewer {
     /// Carries out an action.
     pub fn apply(&mut self, action: Action) {
+        if self.refused_while_designing(&action) {
+            return;
+        }
         match action {
             Action::PickScene => self.unless_unsaved(AfterDiscard::Pick),
             Action::OpenScene(path) => self.unless_unsaved(AfterDiscard::Open(path)),
@@ -53,6 +56,7 @@ impl Viewer {
                 }
             }
             Action::RestartRenderer => self.restart_renderer(),
+            a if a.is_design() => self.apply_design(a),
             Action::DismissSceneError => self.scene_error = None,
             Action::SetExposure(stops) => {
                 self.settings.exposure_stops = stops.clamp(-EXPOSURE_LIMIT, EXPOSURE_LIMIT);
@@ -82,6 +86,33 @@ impl Viewer {
             | Action::DragCamera(_)
             | Action::EndGesture) => self.apply_gesture(a),
             edit => self.apply_edit(edit),
+        }
+    }
+
+    /// Whether `action` must wait for the running design (it edits the scene the design is
+    /// shaping); says so in the status bar.
+    fn refused_while_designing(&mut self, action: &Action) -> bool {
+        let refused = self.design_run.is_some() && action.edits_the_scene();
+        if refused {
+            self.status = Some(Status::Error(
+                "a design is shaping the surface: stop it (Design panel) before editing".into(),
+            ));
+        }
+        refused
+    }
+
+    /// The Design panel's choices, Start and Stop.
+    fn apply_design(&mut self, action: Action) {
+        let design = &mut self.state.design;
+        match action {
+            Action::SetDesignTarget(path) => design.target = Some(path),
+            Action::SetDesignSurface(name) => design.surface = Some(name),
+            Action::SetDesignReceiver(name) => design.receiver = Some(name),
+            Action::SetDesignSteps(steps) => design.steps = Some(steps.clamp(1, 1_000_000)),
+            Action::PickDesignTarget => self.pick_design_target(),
+            Action::StartDesign => self.start_design(),
+            Action::StopDesign => self.stop_design(),
+            other => unreachable!("not a design action: {other:?}"),
         }
     }
 
@@ -273,7 +304,7 @@ impl Viewer {
     }
 
     /// Records an edit unless it changed nothing.
-    fn record(&mut self, edit: Edit) {
+    pub(super) fn record(&mut self, edit: Edit) {
         let empty = match &edit {
             Edit::Points(moves) => moves.is_empty(),
             Edit::Camera { before, after } => before == after,
@@ -321,7 +352,7 @@ impl Viewer {
 
     /// Moves handles (control points, lights) in the document and sends the render session
     /// the changes; returns what moved.
-    fn move_points(&mut self, moves: &[(Handle, DVec3)]) -> Vec<(Handle, DVec3, DVec3)> {
+    pub(super) fn move_points(&mut self, moves: &[(Handle, DVec3)]) -> Vec<(Handle, DVec3, DVec3)> {
         let state = &mut self.state;
         let (changed, changes) = state.editor.set_points(&mut state.document, moves);
         for change in changes {

@@ -145,6 +145,13 @@ pub fn side_panel_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Acti
             super::edit_panel::edit_panel_ui(viewer, ui, out)
         });
     }
+    // Designing needs a surface to shape: a scene without patches has no Design section.
+    if viewer.watching().is_none() && viewer.patches().len() > 0 {
+        ui.separator();
+        section(ui, "Design", false, |ui| {
+            super::design_panel::design_panel_ui(viewer, ui, out)
+        });
+    }
 }
 
 /// A section of the side panel under a heading that folds it (open at first if `open`).

@@ -83,6 +83,8 @@ pub struct ViewerState {
     pub(super) reference: ReferenceState,
     /// The render folder being watched, where it stands (`None`: not watching).
     pub(super) watching: Option<super::watch::WatchSummary>,
+    /// The Design panel's choices and the design's progress.
+    pub(super) design: super::design::DesignState,
 }
 
 impl ViewerState {
@@ -133,8 +135,14 @@ impl ViewerState {
             confirm_restart: false,
             reference: ReferenceState::default(),
             watching: None,
+            design: Default::default(),
             document: Document::new(scene),
         }
+    }
+
+    /// The Design panel's choices and the design's progress.
+    pub fn design(&self) -> &super::design::DesignState {
+        &self.design
     }
 
     /// The scene as edited: parameters, lens and camera, control points and lights.

@@ -60,6 +60,8 @@ pub struct Viewer {
     pub(super) watch_epoch_base: u64,
     /// Whether the side panel has been drawn (its first frame starts at the top).
     pub(super) side_panel_shown: bool,
+    /// The design running (the Design panel's).
+    pub(super) design_run: Option<super::design::DesignRun>,
 }
 
 impl std::ops::Deref for Viewer {
@@ -128,6 +130,7 @@ impl Viewer {
             watch_scene_from: None,
             watch_epoch_base: 0,
             side_panel_shown: false,
+            design_run: None,
         }
     }
 
@@ -164,6 +167,8 @@ impl Viewer {
             || self.scene_dialog.is_some()
             || self.reference.busy()
             || self.tev.busy()
+            || self.design_run.is_some()
+            || self.design.picking.is_some()
     }
 
     /// Sends a command to the render session, remembering it (and when a restart was asked).
@@ -256,6 +261,7 @@ impl Viewer {
     }
 
     fn replace_scene_with(&mut self, scene: Scene, paused: bool) {
+        self.abandon_design();
         let scene = photon_mapped(scene);
         self.panel = PanelChoices {
             paused,

@@ -67,6 +67,7 @@ impl Viewer {
         }
         self.poll_scene_dialog();
         self.poll_reference();
+        self.poll_design();
         self.poll_watch();
         if let Some(status) = self.tev.poll() {
             self.status = Some(status);
@@ -150,6 +151,7 @@ impl Viewer {
             self.scene_dialog.as_ref(),
             self.reference.picking.as_ref(),
             self.watch_picking.as_ref(),
+            self.design.picking.as_ref(),
             self.save.file_dialog(),
         ]
         .into_iter()
