@@ -1,4 +1,13 @@
-//! Colour encodings shared by textures (read) and the film (written): the sRGB transfer pair.
+//! Colour encodings shared by textures (read) and the film (written): the sRGB transfer pair,
+//! and the luminance of a linear colour.
+
+use glam::DVec3;
+
+/// Rec. 709 luminance of a linear RGB colour (the error estimate's measure of a pixel, the
+/// designer's of a target and a light).
+pub fn luminance(c: DVec3) -> f64 {
+    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+}
 
 /// The sRGB transfer pair (IEC 61966-2-1): the encoded value of a linear one in [0, 1]...
 pub fn linear_to_srgb(v: f32) -> f32 {

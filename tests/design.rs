@@ -34,12 +34,8 @@ fn lens_scene() -> (Scene, Receiver) {
         Some(std::path::Path::new("scenes")),
     )
     .expect("loads");
-    let object = scene
-        .objects
-        .iter()
-        .position(|o| o.name == "wall")
-        .expect("a wall") as u32;
-    (scene, Receiver { object, quad })
+    let wall = object(&scene, "wall");
+    (scene, Receiver { object: wall, quad })
 }
 
 /// Rays from the spot light through points spread over the lens.
@@ -111,11 +107,7 @@ fn agree_with_finite_differences(
 #[test]
 fn landing_derivatives_match_finite_differences() {
     let (mut scene, receiver) = lens_scene();
-    let lens = scene
-        .objects
-        .iter()
-        .position(|o| o.name == "lens")
-        .expect("a lens") as u32;
+    let lens = object(&scene, "lens");
     let params = DesignParams::of_object(&scene, lens, DVec3::X).expect("params");
     assert!(
         params.len() > 16 && params.len() < 32,
@@ -136,16 +128,8 @@ fn landing_derivatives_match_finite_differences() {
 #[test]
 fn net_derivatives_match_finite_differences() {
     let mut scene = Scene::load(std::path::Path::new("scenes/pool.toml")).expect("loads");
-    let water = scene
-        .objects
-        .iter()
-        .position(|o| o.name == "water")
-        .expect("water") as u32;
-    let floor = scene
-        .objects
-        .iter()
-        .position(|o| o.name == "floor")
-        .expect("floor") as u32;
+    let water = object(&scene, "water");
+    let floor = object(&scene, "floor");
     let receiver = Receiver {
         object: floor,
         quad: Quad {
@@ -562,7 +546,7 @@ fn a_designed_slab_renders_its_smooth_target() {
     let luminance: Vec<f64> = ppm
         .radiance()
         .iter()
-        .map(|c| 0.2126 * f64::from(c[0]) + 0.7152 * f64::from(c[1]) + 0.0722 * f64::from(c[2]))
+        .map(|&c| caustic::color::luminance(glam::Vec3::from(c).as_dvec3()))
         .collect();
     let r = correlation(&luminance, &target.resampled(32, 32));
     eprintln!("correlation {r}");

@@ -37,29 +37,29 @@ pub struct DesignArgs {
     out: PathBuf,
     /// Stop after this many seconds, even before the last step (the steps' length decays over
     /// `--steps`, so a design cut short is coarser).
-    #[arg(long, default_value_t = 110.0)]
+    #[arg(long, default_value_t = DesignOptions::default().seconds)]
     seconds: f64,
     /// Steps of the descent: the same steps give the same surface on any machine and thread
     /// count.
-    #[arg(long, default_value_t = 1500)]
+    #[arg(long, default_value_t = DesignOptions::default().steps)]
     steps: usize,
     /// Photons traced at every step (eight times as many are prepared, used in turn).
-    #[arg(long, default_value_t = 20_000)]
+    #[arg(long, default_value_t = DesignOptions::default().photons)]
     photons: usize,
     /// How far a control point may move, in scene units (default: a tenth of the surface's
     /// size).
     #[arg(long)]
     max_height: Option<f64>,
     /// Weight of the smoothness term (0: none).
-    #[arg(long, default_value_t = 0.01)]
+    #[arg(long, default_value_t = DesignOptions::default().smoothness)]
     smoothness: f64,
     /// Split a surface of Bézier patches this many times first (each time into four patches a
     /// patch, the same surface with four times the control points); a surface with its own
     /// B-spline net is designed through that net's points instead.
-    #[arg(long, default_value_t = 2)]
+    #[arg(long, default_value_t = DesignOptions::default().refine)]
     refine: u32,
     /// Cells of the receiver grid along its longer edge.
-    #[arg(long, default_value_t = 48)]
+    #[arg(long, default_value_t = DesignOptions::default().grid)]
     grid: usize,
     /// Also write the target beside the picture the design's photons draw (a grey PNG, each
     /// half scaled to its brightest cell).

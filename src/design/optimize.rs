@@ -73,11 +73,17 @@ pub struct DesignOutcome {
     pub steps: Vec<StepReport>,
 }
 
+/// How many cells from its centre the splat kernel of width `sigma` reaches (three standard
+/// deviations): the splat and the target's blur are cut off alike.
+fn kernel_reach(sigma: f64) -> i64 {
+    (3.0 * sigma).ceil() as i64
+}
+
 /// `target` (an `nx × ny` grid) blurred by the splat kernel of width `sigma` (cut off where the
 /// splat's is, and at the grid's edges, as the splat is), scaled to sum to 1: what a surface
 /// drawing the target exactly splats.
 fn blurred(target: &[f64], (nx, ny): (usize, usize), sigma: f64) -> Vec<f64> {
-    let reach = (3.0 * sigma).ceil() as i64;
+    let reach = kernel_reach(sigma);
     let kernel: Vec<f64> = (-reach..=reach)
         .map(|d| (-((d * d) as f64) / (2.0 * sigma * sigma)).exp())
         .collect();
@@ -104,8 +110,8 @@ fn blurred(target: &[f64], (nx, ny): (usize, usize), sigma: f64) -> Vec<f64> {
     out
 }
 
-/// The loss of `landings` against `target` (blurred as the splat is) on the grid, and its derivative with respect to
-/// each landing point `(s, t)`.
+/// The loss of `landings` against `target` (blurred as the splat is) on the grid, and its
+/// derivative with respect to each landing point `(s, t)`.
 fn loss_and_slopes(
     landings: &[Option<[D1; 2]>],
     photons: &[DesignPhoton],
@@ -113,7 +119,7 @@ fn loss_and_slopes(
     (grid, sigma): ((usize, usize), f64),
 ) -> (f64, Vec<[f64; 2]>) {
     let (nx, ny) = grid;
-    let reach = (3.0 * sigma).ceil() as i64;
+    let reach = kernel_reach(sigma);
     let cells = |x: f64, y: f64| {
         let (x0, y0) = (x.round() as i64, y.round() as i64);
         ((y0 - reach).max(0)..=(y0 + reach).min(ny as i64 - 1)).flat_map(move |cy| {

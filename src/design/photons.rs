@@ -6,6 +6,7 @@
 
 use glam::DVec3;
 
+use crate::color::luminance;
 use crate::geometry::Ray;
 use crate::scene::light::{spot_falloff, Light};
 use crate::scene::Scene;
@@ -17,11 +18,6 @@ pub struct DesignPhoton {
     pub ray: Ray,
     /// Its share of the light's power.
     pub weight: f64,
-}
-
-/// Rec. 709 luminance.
-fn luminance(c: DVec3) -> f64 {
-    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
 }
 
 /// The luminance a point or spot light sends towards `d` (0 for other lights).
@@ -39,11 +35,9 @@ fn intensity(light: &Light, d: DVec3) -> f64 {
     }
 }
 
-/// About `count` photons from every point and spot light through `object`'s patches.
-pub fn design_photons(scene: &Scene, object: u32, count: usize) -> Result<Vec<DesignPhoton>, String> {
-    let patches: Vec<usize> = (0..scene.geometry.patches().len())
-        .filter(|&k| scene.geometry.patches()[k].1 == object)
-        .collect();
+/// The lights a design traces photons from, with their positions: the scene's point and spot
+/// lights (an error when it has none).
+pub fn design_lights(scene: &Scene) -> Result<Vec<(DVec3, &Light)>, String> {
     let lights: Vec<(DVec3, &Light)> = scene
         .lights
         .iter()
@@ -55,6 +49,15 @@ pub fn design_photons(scene: &Scene, object: u32, count: usize) -> Result<Vec<De
     if lights.is_empty() {
         return Err("the scene has no point or spot light: a design traces photons from those".into());
     }
+    Ok(lights)
+}
+
+/// About `count` photons from every point and spot light through `object`'s patches.
+pub fn design_photons(scene: &Scene, object: u32, count: usize) -> Result<Vec<DesignPhoton>, String> {
+    let patches: Vec<usize> = (0..scene.geometry.patches().len())
+        .filter(|&k| scene.geometry.patches()[k].1 == object)
+        .collect();
+    let lights = design_lights(scene)?;
     let per_patch = (count / (patches.len() * lights.len()).max(1)).max(1);
     let n = (per_patch as f64).sqrt().ceil() as usize;
     let mut out = Vec::with_capacity(n * n * patches.len() * lights.len());

@@ -5,10 +5,9 @@
 
 use super::landing::{surface_bounds, DesignParams, Receiver};
 use super::optimize::{design, DesignOutcome, DesignSettings, StepReport};
-use super::photons::{design_photons, DesignPhoton};
+use super::photons::{design_lights, design_photons, DesignPhoton};
 use super::refine::refined;
 use super::target::Target;
-use crate::scene::light::Light;
 use crate::scene::material::MaterialKind;
 use crate::scene::Scene;
 
@@ -179,18 +178,6 @@ pub fn design_candidates(scene: &Scene) -> (Vec<String>, Vec<String>) {
     (surfaces, receivers)
 }
 
-/// The point or spot light photons are traced from.
-fn design_light(scene: &Scene) -> Result<glam::DVec3, String> {
-    scene
-        .lights
-        .iter()
-        .find_map(|l| match l {
-            Light::Point { position, .. } | Light::Spot { position, .. } => Some(*position),
-            _ => None,
-        })
-        .ok_or_else(|| "the scene has no point or spot light: a design traces photons from those".into())
-}
-
 /// Gets a design of object `surface` drawing `target` on object `receiver` of `scene` ready:
 /// checks the options and objects, refines the surface (`options.refine`), finds the
 /// parameters and traces the photons. Errors name the option or object at fault.
@@ -219,7 +206,8 @@ pub fn prepare_design(
         (bounds.min + bounds.max) * 0.5,
         (bounds.max - bounds.min).length(),
     );
-    let light = design_light(&scene)?;
+    // The points move along the direction from the first light to the surface.
+    let light = design_lights(&scene)?[0].0;
     let params = DesignParams::of_object(&scene, surface, centre - light)
         .map_err(|e| format!("--surface '{surface_name}': {e}"))?;
     let photons = design_photons(&scene, surface, SUBSETS * options.photons)?;

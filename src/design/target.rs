@@ -20,9 +20,9 @@ pub struct Target {
     pub values: Vec<f64>,
 }
 
-/// Rec. 709 luminance of linear RGB.
+/// The luminance of a linear RGB pixel.
 fn luminance(rgb: [f32; 3]) -> f64 {
-    0.2126 * f64::from(rgb[0]) + 0.7152 * f64::from(rgb[1]) + 0.0722 * f64::from(rgb[2])
+    crate::color::luminance(glam::Vec3::from(rgb).as_dvec3())
 }
 
 /// Reads the target at `path`: a `.pfm` or `.exr` is linear already; other images (PNG,

@@ -10,6 +10,8 @@
 
 use glam::DVec3;
 
+use crate::color::luminance;
+
 /// Bits after the binary point of the fixed-point sums.
 pub const FRACTION_BITS: u32 = 40;
 
@@ -28,11 +30,6 @@ fn fixed(v: f64) -> i128 {
 /// A fixed-point sum as a number.
 fn real(x: i128) -> f64 {
     x as f64 / (1u64 << FRACTION_BITS) as f64
-}
-
-/// Rec. 709 luminance (the error estimate's measure of a pixel).
-pub fn luminance(c: DVec3) -> f64 {
-    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
 }
 
 /// The sums of a set of passes of one render.
