@@ -150,6 +150,27 @@ pub fn frame_image(frame: &Frame) -> Image {
     }
 }
 
+/// The parts of `view` outside `covered`: up to four bands (above, below, left, right).
+fn uncovered(view: Rect, covered: Rect) -> Vec<Rect> {
+    let inner = view.intersect(covered);
+    if !inner.is_positive() {
+        return vec![view];
+    }
+    let bands = [
+        Rect::from_min_max(view.min, Pos2::new(view.max.x, inner.min.y)),
+        Rect::from_min_max(Pos2::new(view.min.x, inner.max.y), view.max),
+        Rect::from_min_max(
+            Pos2::new(view.min.x, inner.min.y),
+            Pos2::new(inner.min.x, inner.max.y),
+        ),
+        Rect::from_min_max(
+            Pos2::new(inner.max.x, inner.min.y),
+            Pos2::new(view.max.x, inner.max.y),
+        ),
+    ];
+    bands.into_iter().filter(|b| b.is_positive()).collect()
+}
+
 impl ImageView {
     /// Marks the texture stale (a new frame, another exposure or display mode).
     pub fn invalidate(&mut self) {
@@ -197,7 +218,6 @@ impl ImageView {
     pub fn ui(&mut self, ui: &mut egui::Ui, zoom: Zoom, size: [u32; 2], pan_enabled: bool) -> ImageResponse {
         let mut zoom = zoom;
         let (rect, response) = ui.allocate_exact_size(ui.available_size(), Sense::click_and_drag());
-        ui.painter().rect_filled(rect, 0.0, Color32::from_gray(24));
         let size_px = Vec2::new(size[0] as f32, size[1] as f32);
         let ppp = ui.ctx().pixels_per_point();
         let mut scale = Self::scale(zoom, rect.size(), size_px, ppp);
@@ -229,6 +249,18 @@ impl ImageView {
         let centre = rect.center() + self.pan_for(zoom);
         let image_rect =
             Rect::from_center_size(centre, size_px * Self::scale(zoom, rect.size(), size_px, ppp));
+        // The backdrop only where the image leaves the view bare: a software rasteriser
+        // pays for every covered pixel, and a full backdrop under the image cost as much as
+        // the image itself.
+        let painter = ui.painter_at(rect);
+        let covered = if self.texture.is_some() {
+            image_rect
+        } else {
+            Rect::NOTHING
+        };
+        for bare in uncovered(rect, covered) {
+            painter.rect_filled(bare, 0.0, Color32::from_gray(24));
+        }
         if let Some(texture) = &self.texture {
             let uv = Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0));
             ui.painter_at(rect)
@@ -263,5 +295,43 @@ impl ImageView {
     /// Centres the image (used by "Fit" and "1:1").
     pub fn recentre(&mut self) {
         self.pan = Vec2::ZERO;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn area(r: Rect) -> f32 {
+        r.width() * r.height()
+    }
+
+    #[test]
+    fn the_backdrop_covers_exactly_what_the_image_leaves_bare() {
+        let view = Rect::from_min_max(Pos2::new(10.0, 20.0), Pos2::new(810.0, 620.0));
+        for image in [
+            // Inside, letterboxed, overhanging one side, larger than the view, elsewhere.
+            Rect::from_min_max(Pos2::new(100.0, 100.0), Pos2::new(500.0, 400.0)),
+            Rect::from_min_max(Pos2::new(10.0, 80.0), Pos2::new(810.0, 560.0)),
+            Rect::from_min_max(Pos2::new(600.0, -50.0), Pos2::new(1000.0, 300.0)),
+            Rect::from_min_max(Pos2::new(-100.0, -100.0), Pos2::new(2000.0, 2000.0)),
+            Rect::from_min_max(Pos2::new(900.0, 0.0), Pos2::new(1000.0, 50.0)),
+        ] {
+            let bands = uncovered(view, image);
+            let shown = view.intersect(image);
+            let shown_area = if shown.is_positive() { area(shown) } else { 0.0 };
+            let total: f32 = bands.iter().map(|b| area(*b)).sum();
+            assert!(
+                (total + shown_area - area(view)).abs() < 1e-2,
+                "{image:?}: {bands:?}"
+            );
+            for (k, b) in bands.iter().enumerate() {
+                assert!(view.contains_rect(*b));
+                assert!(!b.intersect(image).is_positive(), "{b:?} overlaps the image");
+                for c in &bands[k + 1..] {
+                    assert!(!b.intersect(*c).is_positive());
+                }
+            }
+        }
     }
 }

@@ -48,9 +48,8 @@ use super::estimate::{Estimate, Slot};
 use super::guide::EmissionGuide;
 use super::hash_grid::HashGrid;
 use super::light::PriorLight;
-use super::points::VisiblePoints;
+use super::points::{SearchSphere, VisiblePoints};
 use super::radius::{IndirectScale, RadiusPolicy, DENSE_PHOTONS, INDIRECT_PHOTONS};
-use super::visible::VisiblePoint;
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
@@ -390,7 +389,13 @@ impl WarmStart {
     /// For each slot of a moved pixel whose new visible point lies within the radius of a
     /// previous one (any pixel's, facing the same way): that estimate as its prior, the flux
     /// scaled by the ratio of the two points' weights (the estimate's density of arriving
-    /// light is the same there, up to PPM's own blur). Returns the pixels so warmed.
+    /// light is the same there, up to PPM's own blur). Of several, the nearest; of equally
+    /// near ones, the first slot's. Returns the pixels so warmed.
+    ///
+    /// The points left after a small edit are few and the previous ones many, so the grid is
+    /// built over the points left and each previous point near them looks for those within
+    /// its own radius: a grid over the previous points cost more than the rest of the warm
+    /// start together.
     fn carry_nearby(
         &self,
         slots: &mut [Slot],
@@ -398,65 +403,93 @@ impl WarmStart {
         carried: &[bool],
         reopen: &Reopen,
     ) -> usize {
-        // Only previous points near the points left to warm are looked among.
-        let left = now
+        let left: Vec<Left> = now
             .iter()
             .zip(carried)
-            .filter(|(r, &c)| !c && r.carries_nearby())
-            .fold(Aabb::EMPTY, |b, (r, _)| b.grow(r.position.as_dvec3()));
+            .enumerate()
+            .filter(|(_, (r, &c))| !c && r.carries_nearby())
+            .map(|(to, (r, _))| Left {
+                to: to as u32,
+                position: r.position.as_dvec3(),
+                normal: r.normal.as_dvec3(),
+                reach2: 0.0,
+            })
+            .collect();
         if left.is_empty() {
             return 0;
         }
-        let near = left.padded(self.initial_radius2.sqrt());
-        let old: Vec<VisiblePoint> = self
-            .points
-            .par_iter()
-            .enumerate()
-            .filter(|(_, r)| r.carries_nearby() && near.contains(r.position.as_dvec3()))
-            .map(|(k, r)| VisiblePoint {
-                slot: k as u32,
-                position: r.position.as_dvec3(),
-                normal: r.normal.as_dvec3(),
-                weight: r.weight.as_dvec3(),
-                radius2: self.slots[k].primary.radius2(),
-                glossy: None,
+        // Only previous points near the points left can hold one.
+        let near = left
+            .iter()
+            .fold(Aabb::EMPTY, |b, l| b.grow(l.position))
+            .padded(self.initial_radius2.sqrt());
+        let old: Vec<u32> = (0..self.points.len() as u32)
+            .into_par_iter()
+            .filter(|&k| {
+                let r = &self.points[k as usize];
+                r.carries_nearby() && near.contains(r.position.as_dvec3())
             })
             .collect();
-        let (grid, order) = HashGrid::build(&old);
-        let old: Vec<VisiblePoint> = order.iter().map(|&k| old[k as usize]).collect();
-        // Each slot left: the nearest previous point whose radius holds it, found in parallel.
-        let found: Vec<(usize, u32, DVec3)> = now
+        let reach2 = old
+            .iter()
+            .map(|&k| self.slots[k as usize].primary.radius2())
+            .fold(0.0, f64::max);
+        let left: Vec<Left> = left.into_iter().map(|l| Left { reach2, ..l }).collect();
+        let (grid, order) = HashGrid::build(&left);
+        let left: Vec<Left> = order.iter().map(|&k| left[k as usize]).collect();
+        // Every (point left, previous point) pair within the previous point's radius, then
+        // the nearest for each point left.
+        let mut pairs: Vec<(u32, f64, u32)> = old
             .par_iter()
-            .enumerate()
-            .filter(|(to, new)| !carried[*to] && new.carries_nearby())
-            .filter_map(|(to, new)| {
-                let (p, normal) = (new.position.as_dvec3(), new.normal.as_dvec3());
-                // The nearest; of equally near ones, the first pixel's.
-                let mut nearest: Option<(&VisiblePoint, f64)> = None;
-                grid.for_candidates(p, f64::INFINITY, &mut |k| {
-                    let o = &old[k as usize];
-                    let d2 = (o.position - p).length_squared();
-                    let nearer = nearest.is_none_or(|(n, nd2)| (d2, o.slot) < (nd2, n.slot));
-                    if o.normal.dot(normal) >= 0.9 && d2 <= o.radius2 && nearer {
-                        nearest = Some((o, d2));
+            .flat_map_iter(|&from| {
+                let o = &self.points[from as usize];
+                let (p, normal) = (o.position.as_dvec3(), o.normal.as_dvec3());
+                let radius2 = self.slots[from as usize].primary.radius2();
+                let mut found = Vec::new();
+                grid.for_candidates(p, radius2.sqrt(), &mut |k| {
+                    let l = &left[k as usize];
+                    let d2 = (p - l.position).length_squared();
+                    if normal.dot(l.normal) >= 0.9 && d2 <= radius2 {
+                        found.push((l.to, d2, from));
                     }
                 });
-                let (o, _) = nearest?;
-                Some((
-                    to,
-                    o.slot,
-                    new.weight.as_dvec3() / o.weight.max(DVec3::splat(1e-30)),
-                ))
+                found
             })
             .collect();
+        pairs.par_sort_unstable_by(|a, b| (a.0, a.1, a.2).partial_cmp(&(b.0, b.1, b.2)).expect("finite"));
+        pairs.dedup_by_key(|p| p.0);
         let mut warmed = std::collections::BTreeSet::new();
-        for (to, from, factor) in found {
-            let mut slot = reopen.prior(self.slots[from as usize], factor);
+        for (to, _, from) in pairs {
+            let (to, from) = (to as usize, from as usize);
+            let factor =
+                now[to].weight.as_dvec3() / self.points[from].weight.as_dvec3().max(DVec3::splat(1e-30));
+            let mut slot = reopen.prior(self.slots[from], factor);
             slot.pixel = slots[to].pixel;
             slots[to] = slot;
             warmed.insert(slot.pixel);
         }
         warmed.len()
+    }
+}
+
+/// A point left to warm by [`WarmStart::carry_nearby`], as the grid holds it: a sphere as
+/// wide as the widest previous estimate near, so that every previous point finds the points
+/// within its own radius.
+#[derive(Clone, Copy)]
+struct Left {
+    to: u32,
+    position: DVec3,
+    normal: DVec3,
+    reach2: f64,
+}
+
+impl SearchSphere for Left {
+    fn centre(&self) -> DVec3 {
+        self.position
+    }
+
+    fn reach2(&self) -> f64 {
+        self.reach2
     }
 }
 
@@ -483,6 +516,90 @@ mod tests {
 
     fn close(a: DVec3, b: DVec3) -> bool {
         (a - b).abs().max_element() <= 1e-5 * b.abs().max_element()
+    }
+
+    /// The nearest previous point by brute force, as `carry_nearby` defines it.
+    fn nearest_by_brute_force(warm: &WarmStart, new: &PointRecord) -> Option<usize> {
+        let p = new.position.as_dvec3();
+        (0..warm.points.len())
+            .filter(|&k| {
+                let o = &warm.points[k];
+                let d2 = (o.position.as_dvec3() - p).length_squared();
+                o.carries_nearby()
+                    && o.normal.as_dvec3().dot(new.normal.as_dvec3()) >= 0.9
+                    && d2 <= warm.slots[k].primary.radius2()
+            })
+            .map(|k| ((warm.points[k].position.as_dvec3() - p).length_squared(), k))
+            .min_by(|a, b| a.partial_cmp(b).expect("finite"))
+            .map(|(_, k)| k)
+    }
+
+    #[test]
+    fn a_moved_point_takes_the_nearest_previous_estimate_whose_radius_holds_it() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(5);
+        let record = |rng: &mut rand_pcg::Pcg64Mcg| {
+            let flip = rng.random::<f32>() < 0.1;
+            PointRecord {
+                // Some on a grid, so that equally near points occur.
+                position: if rng.random::<f32>() < 0.3 {
+                    Vec3::new(
+                        rng.random_range(0..20) as f32 * 0.05,
+                        rng.random_range(0..20) as f32 * 0.05,
+                        0.0,
+                    )
+                } else {
+                    Vec3::new(rng.random(), rng.random(), rng.random::<f32>() * 0.05)
+                },
+                normal: if flip { -Vec3::Z } else { Vec3::Z },
+                weight: Vec3::new(0.5, rng.random::<f32>() + 0.1, 0.25),
+                glossy: rng.random::<f32>() < 0.05,
+            }
+        };
+        let old: Vec<PointRecord> = (0..3000).map(|_| record(&mut rng)).collect();
+        let slots: Vec<Slot> = (0..3000)
+            .map(|k| Slot {
+                primary: Estimate::new(rng.random::<f64>() * 0.004, 50.0, DVec3::splat(k as f64)),
+                prior: 1e5,
+                ..Slot::new(k as u32)
+            })
+            .collect();
+        let warm = WarmStart {
+            size: (3000, 1),
+            stochastic: true,
+            slots,
+            points: old,
+            light: Vec::new(),
+            initial_radius2: 0.004,
+            indirect_scale: IndirectScale::Fixed(1.0),
+            guide: None,
+            moved_lights: Vec::new(),
+            next: StreamOffset::default(),
+        };
+        let now: Vec<PointRecord> = (0..3000).map(|_| record(&mut rng)).collect();
+        let carried: Vec<bool> = (0..3000).map(|k| k % 3 == 0).collect();
+        let mut new_slots: Vec<Slot> = (0..3000).map(|k| Slot::new(k as u32)).collect();
+        let warmed = warm.carry_nearby(&mut new_slots, &now, &carried, &REOPEN);
+        let mut expected_warmed = 0;
+        for (to, new) in now.iter().enumerate() {
+            let from = (!carried[to] && new.carries_nearby())
+                .then(|| nearest_by_brute_force(&warm, new))
+                .flatten();
+            let expected = match from {
+                Some(from) => {
+                    expected_warmed += 1;
+                    let factor = new.weight.as_dvec3() / warm.points[from].weight.as_dvec3();
+                    Slot {
+                        pixel: to as u32,
+                        ..REOPEN.prior(warm.slots[from], factor)
+                    }
+                }
+                None => Slot::new(to as u32),
+            };
+            assert_eq!(new_slots[to], expected, "point {to}");
+        }
+        assert_eq!(warmed, expected_warmed);
+        assert!(expected_warmed > 300, "{expected_warmed}: too few to test");
     }
 
     #[test]
