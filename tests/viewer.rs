@@ -961,7 +961,7 @@ fn the_side_panel_fits_what_matters_at_the_default_size() {
         "Pass",
         "Photons/s",
         "Elapsed",
-        "Estimated noise",
+        "Estimated error",
         "Photons per pass",
         "Alpha",
     ] {

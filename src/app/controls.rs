@@ -339,7 +339,7 @@ fn statistics_ui(viewer: &ViewerState, ui: &mut egui::Ui) {
     }
 }
 
-/// The error against time (log scale): the noise estimate from the render's own frames
+/// The error against time (log scale): the estimate from the render's own frames
 /// ([`crate::render::error_tracker`]) and, with a reference open, the true RMSE and relative
 /// MSE against it.
 fn convergence_plot_ui(viewer: &ViewerState, ui: &mut egui::Ui) {
@@ -347,10 +347,10 @@ fn convergence_plot_ui(viewer: &ViewerState, ui: &mut egui::Ui) {
     let title = if with_reference {
         "Error against time"
     } else {
-        "Estimated noise"
+        "Estimated error"
     };
     ui.label(title).on_hover_text(
-        "Log scale against seconds. Estimate: the relative RMS noise, from this render's frame and its frame at half the photons. Photon mapping's blur (bias) is not in it: where caustics are sharp it is a part of the true error early on. With a reference: its RMSE and pbrt's relative MSE",
+        "Log scale against seconds. Estimate: the relative RMS error from this render's own frames: the noise (the frame against its frame at half the photons) and photon mapping's blur (how the frames at a quarter, half and all the photons drift apart as the radii shrink). With a reference: its RMSE and pbrt's relative MSE",
     );
     let log = |v: f64| v.max(1e-12).log10();
     let series = |k: usize| -> Vec<[f64; 2]> {
@@ -375,14 +375,28 @@ fn convergence_plot_ui(viewer: &ViewerState, ui: &mut egui::Ui) {
         plot.y_axis_formatter(|mark, _| percent(10f64.powf(mark.value)))
     };
     plot.show(ui, |plot| {
-        plot.line(Line::new("noise estimate (relative)", PlotPoints::from(estimate)));
+        plot.line(Line::new(
+            "estimated error (relative)",
+            PlotPoints::from(estimate),
+        ));
         if with_reference {
             plot.line(Line::new("RMSE", PlotPoints::from(series(1))));
             plot.line(Line::new("relative MSE", PlotPoints::from(series(2))));
         }
     });
-    if let Some(e) = viewer.convergence.latest() {
-        ui.label(format!("now {} (noise; blur not included)", percent(e)));
+    match (viewer.convergence.latest(), viewer.convergence.latest_parts()) {
+        (Some(e), Some((noise, Some(blur)))) => {
+            ui.label(format!(
+                "now {} (noise {}, blur {})",
+                percent(e),
+                percent(noise),
+                percent(blur)
+            ));
+        }
+        (Some(e), _) => {
+            ui.label(format!("now {} (noise)", percent(e)));
+        }
+        _ => {}
     }
     if let Some(e) = viewer.reference_errors() {
         ui.label(format!(

@@ -12,8 +12,11 @@ use crate::render::error_tracker::ErrorTracker;
 #[derive(Clone, Default)]
 pub struct Convergence {
     tracker: ErrorTracker,
-    /// `(elapsed seconds, estimated relative RMS error)` per frame after the first.
+    /// `(elapsed seconds, estimated relative RMS error)` per frame after the first: the
+    /// noise, and from the third frame on the blur with it (`√(noise² + blur²)`).
     pub points: Vec<[f64; 2]>,
+    /// The newest estimate's parts: the noise, and the blur once three frames are held.
+    latest: Option<(f64, Option<f64>)>,
     /// `(elapsed seconds, RMSE, relative MSE)` against the reference, per frame since it was
     /// opened.
     pub reference_points: Vec<[f64; 3]>,
@@ -28,8 +31,10 @@ impl Convergence {
     /// Takes a frame of the current epoch made from `photons` photons with photon mapping's
     /// `alpha` (1 for a path tracer's plain means).
     pub fn add(&mut self, photons: u64, elapsed_secs: f64, radiance: &Arc<[[f32; 3]]>, alpha: f64) {
-        if let Some(e) = self.tracker.add(photons, radiance, alpha) {
-            self.points.push([elapsed_secs, e]);
+        if let Some(noise) = self.tracker.add(photons, radiance, alpha) {
+            let blur = self.tracker.blur();
+            self.points.push([elapsed_secs, noise.hypot(blur.unwrap_or(0.0))]);
+            self.latest = Some((noise, blur));
         }
     }
 
@@ -47,5 +52,11 @@ impl Convergence {
     /// The newest estimate.
     pub fn latest(&self) -> Option<f64> {
         self.points.last().map(|p| p[1])
+    }
+
+    /// The newest estimate's noise, and its blur (`None` before the third frame, or for plain
+    /// means).
+    pub fn latest_parts(&self) -> Option<(f64, Option<f64>)> {
+        self.latest
     }
 }

@@ -55,8 +55,18 @@ pub struct EstimateCheck {
     pub truth: f64,
     /// [`ErrorTracker`]'s estimate.
     pub estimate: Option<f64>,
+    /// [`ErrorTracker::blur`].
+    pub blur: Option<f64>,
     /// The previous frame's comparison (one pass apart).
     pub consecutive: Option<f64>,
+}
+
+impl EstimateCheck {
+    /// The noise and the blur together, `√(noise² + blur²)` (the noise alone without a blur
+    /// estimate).
+    pub fn total(&self) -> Option<f64> {
+        self.estimate.map(|n| n.hypot(self.blur.unwrap_or(0.0)))
+    }
 }
 
 /// `scene` at `width`, photon mapping, photons per pass scaled with the pixels.
@@ -85,6 +95,7 @@ pub fn check_estimates(scene: Scene, passes: &[u32], reference: &[[f32; 3]]) -> 
     let mut out = Vec::new();
     render_session(scene, options, |f| {
         let estimate = tracker.add(f.photons, &f.radiance, alpha);
+        let blur = tracker.blur();
         let consecutive = previous
             .as_ref()
             .and_then(|(n, a)| relative_error_estimate(*n, a, f.photons, &f.radiance));
@@ -95,6 +106,7 @@ pub fn check_estimates(scene: Scene, passes: &[u32], reference: &[[f32; 3]]) -> 
                 pass: f.pass,
                 truth: (diff2 / norm2).sqrt(),
                 estimate,
+                blur,
                 consecutive,
             });
         }
@@ -114,7 +126,10 @@ pub fn bench_estimate(args: EstimateArgs, out: &mut BenchOutput) -> Result<()> {
     } else {
         args.scenes.clone()
     };
-    out.say("scene  pass  true  estimate (ratio)  consecutive frames (ratio)".to_string());
+    out.say(
+        "scene  pass  true  noise (ratio)  blur (ratio)  noise and blur (ratio)  consecutive frames (ratio)"
+            .to_string(),
+    );
     for path in &scenes {
         let scene = scaled(Scene::load(path)?, args.width);
         let reference = reference(
@@ -132,11 +147,13 @@ pub fn bench_estimate(args: EstimateArgs, out: &mut BenchOutput) -> Result<()> {
                 })
             };
             out.say(format!(
-                "{}  {}  {:.2} %  {}  {}",
+                "{}  {}  {:.2} %  {}  {}  {}  {}",
                 path.display(),
                 c.pass,
                 100.0 * c.truth,
                 show(c.estimate),
+                show(c.blur),
+                show(c.total()),
                 show(c.consecutive)
             ));
             let name = path
@@ -149,6 +166,8 @@ pub fn bench_estimate(args: EstimateArgs, out: &mut BenchOutput) -> Result<()> {
                     "pass": c.pass,
                     "truth": c.truth,
                     "estimate": c.estimate,
+                    "blur": c.blur,
+                    "total": c.total(),
                     "consecutive": c.consecutive,
                 }),
             );
