@@ -69,7 +69,7 @@ pub fn noise_factor(rho: f64, alpha: f64) -> f64 {
 }
 
 /// Pixels a block of the blur's significance test holds (runs of the image in memory order).
-const BLUR_BLOCK: usize = 64;
+pub const BLUR_BLOCK: usize = 64;
 
 /// The relative RMS blur of frame `b` from frames `c`, `a`, `b` after `n_c < n_a < n_b`
 /// photons of one render with photon mapping's `alpha`: the mean over pixels and channels of
