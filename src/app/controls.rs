@@ -10,6 +10,7 @@ use super::params::{PanelParams, Ranges};
 use super::setting_ui;
 use super::settings::DisplayMode;
 use super::state::{Status, ViewerState};
+use crate::render::error_tracker::total_error;
 use crate::scene::RendererKind;
 
 /// Seconds as `1.23 s` or `4 min 05 s`.
@@ -384,19 +385,12 @@ fn convergence_plot_ui(viewer: &ViewerState, ui: &mut egui::Ui) {
             plot.line(Line::new("relative MSE", PlotPoints::from(series(2))));
         }
     });
-    match (viewer.convergence.latest(), viewer.convergence.latest_parts()) {
-        (Some(e), Some((noise, Some(blur)))) => {
-            ui.label(format!(
-                "now {} (noise {}, blur {})",
-                percent(e),
-                percent(noise),
-                percent(blur)
-            ));
-        }
-        (Some(e), _) => {
-            ui.label(format!("now {} (noise)", percent(e)));
-        }
-        _ => {}
+    if let Some((noise, blur)) = viewer.convergence.latest() {
+        let now = percent(total_error(noise, blur));
+        ui.label(match blur {
+            Some(blur) => format!("now {now} (noise {}, blur {})", percent(noise), percent(blur)),
+            None => format!("now {now} (noise)"),
+        });
     }
     if let Some(e) = viewer.reference_errors() {
         ui.label(format!(

@@ -6,7 +6,7 @@
 use std::sync::Arc;
 
 use crate::render::compare::ReferenceErrors;
-use crate::render::error_tracker::ErrorTracker;
+use crate::render::error_tracker::{total_error, ErrorTracker};
 
 /// Error estimates of one epoch against time.
 #[derive(Clone, Default)]
@@ -33,7 +33,7 @@ impl Convergence {
     pub fn add(&mut self, photons: u64, elapsed_secs: f64, radiance: &Arc<[[f32; 3]]>, alpha: f64) {
         if let Some(noise) = self.tracker.add(photons, radiance, alpha) {
             let blur = self.tracker.blur();
-            self.points.push([elapsed_secs, noise.hypot(blur.unwrap_or(0.0))]);
+            self.points.push([elapsed_secs, total_error(noise, blur)]);
             self.latest = Some((noise, blur));
         }
     }
@@ -49,14 +49,9 @@ impl Convergence {
         self.reference_points.clear();
     }
 
-    /// The newest estimate.
-    pub fn latest(&self) -> Option<f64> {
-        self.points.last().map(|p| p[1])
-    }
-
     /// The newest estimate's noise, and its blur (`None` before the third frame, or for plain
     /// means).
-    pub fn latest_parts(&self) -> Option<(f64, Option<f64>)> {
+    pub fn latest(&self) -> Option<(f64, Option<f64>)> {
         self.latest
     }
 }

@@ -263,8 +263,7 @@ impl ImageView {
         }
         if let Some(texture) = &self.texture {
             let uv = Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0));
-            ui.painter_at(rect)
-                .image(texture.id(), image_rect, uv, Color32::WHITE);
+            painter.image(texture.id(), image_rect, uv, Color32::WHITE);
         }
         let probe = response
             .hover_pos()

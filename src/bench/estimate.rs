@@ -17,7 +17,7 @@ use super::convergence::reference;
 use super::output::BenchOutput;
 use crate::args::Threads;
 use crate::render::error::{mean_squares, relative_error_estimate};
-use crate::render::error_tracker::ErrorTracker;
+use crate::render::error_tracker::{total_error, ErrorTracker};
 use crate::render::session::state::INTERACTIVE_FIRST_PASS_PHOTONS;
 use crate::render::session::SessionOptions;
 use crate::run::render_session;
@@ -65,7 +65,7 @@ impl EstimateCheck {
     /// The noise and the blur together, `√(noise² + blur²)` (the noise alone without a blur
     /// estimate).
     pub fn total(&self) -> Option<f64> {
-        self.estimate.map(|n| n.hypot(self.blur.unwrap_or(0.0)))
+        self.estimate.map(|n| total_error(n, self.blur))
     }
 }
 

@@ -73,6 +73,12 @@ pub fn noise_factor(rho: f64, alpha: f64) -> f64 {
     1.0 - rho.powf(2.0 - alpha) + (1.0 - rho).powi(2) * rho.powf(-alpha)
 }
 
+/// The error an estimate's noise and blur make together, `√(noise² + blur²)`: the noise
+/// alone where no blur was estimated.
+pub fn total_error(noise: f64, blur: Option<f64>) -> f64 {
+    noise.hypot(blur.unwrap_or(0.0))
+}
+
 /// Pixels a block of the blur's significance test holds (runs of the image in memory order).
 pub const BLUR_BLOCK: usize = 64;
 
