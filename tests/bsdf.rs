@@ -374,6 +374,54 @@ fn f_is_reciprocal() {
     assert!((f.x - 0.7 / PI).abs() < 1e-15);
 }
 
+/// Refraction through rough glass, seen from either side: the value for light crossing one
+/// way, times the radiance factor, is the value the surface seen from the far side gives for
+/// the crossing the other way (the adjoint BSDF that a light subpath's vertex and a camera
+/// subpath's vertex must agree on), and [`Bsdf::pdf_reverse`] is the far side's density of
+/// the way back. Above the surface it is the same surface's density with the directions
+/// swapped.
+#[test]
+fn refraction_is_adjoint_and_the_reverse_density_is_the_far_sides() {
+    let mut rng = Pcg64Mcg::seed_from_u64(8);
+    let random_dir = |rng: &mut Pcg64Mcg, up: bool| {
+        let z: f64 = rng.random::<f64>().max(1e-3);
+        let phi = TAU * rng.random::<f64>();
+        let r = (1.0 - z * z).sqrt();
+        DVec3::new(r * phi.cos(), r * phi.sin(), if up { z } else { -z })
+    };
+    let mut checked = 0;
+    for (eta, alpha) in [(1.5, 0.3), (1.0 / 1.5, 0.3), (1.33, 0.1)] {
+        let near = frosted(alpha, eta);
+        let Bsdf::RoughDielectric(b) = near else {
+            unreachable!()
+        };
+        let far = Bsdf::RoughDielectric(RoughDielectric {
+            eta: 1.0 / eta,
+            n: -b.n,
+            ..b
+        });
+        for _ in 0..5_000 {
+            let (wo, wi) = (random_dir(&mut rng, true), random_dir(&mut rng, false));
+            let f = near.eval(wo, wi) * near.radiance_scale(wo, wi);
+            let adjoint = far.eval(wi, wo);
+            assert!(
+                (f - adjoint).abs().max_element() <= 1e-9 * f.max_element().max(1e-3),
+                "η {eta}: {f} against {adjoint}"
+            );
+            assert_eq!(near.pdf_reverse(wo, wi), far.pdf(wi, wo));
+            checked += (f.x > 1e-6) as u32;
+            let up = random_dir(&mut rng, true);
+            assert_eq!(near.pdf_reverse(wo, up), near.pdf(up, wo));
+        }
+    }
+    assert!(checked > 1000, "too few crossings carried light: {checked}");
+    // A surface that only reflects takes nothing from beyond it.
+    assert_eq!(
+        diffuse(0.7, 0.0, 0.0).pdf_reverse(outgoing(10.0), -outgoing(30.0)),
+        0.0
+    );
+}
+
 #[test]
 fn delta_lobes_obey_the_mirror_law_snell_and_fresnel() {
     let n = DVec3::Z;

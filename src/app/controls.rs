@@ -235,17 +235,19 @@ fn exposure_ui(viewer: &ViewerState, ui: &mut egui::Ui, out: &mut Vec<Action>) {
     }
 }
 
-/// The settings only the current renderer reads, under its heading (none for the path tracer).
+/// The settings the current renderer reads, but not every renderer, under its heading (none
+/// for the path tracer).
 fn renderer_section_ui(p: &mut PanelParams, ranges: Ranges, ui: &mut egui::Ui) {
     let kind = p.render.renderer;
     let heading = match kind {
         RendererKind::Ppm => "Photon mapping",
         RendererKind::Whitted => "Ray tracing",
+        RendererKind::Vcm => "Vertex connection and merging",
         RendererKind::Path => return,
     };
     ui.separator();
     section(ui, heading, true, |ui| {
-        setting_ui::settings_ui(p, ranges, ui, setting_ui::only(kind));
+        setting_ui::settings_ui(p, ranges, ui, setting_ui::read_by(kind));
     });
 }
 
@@ -265,7 +267,7 @@ fn camera_section_ui(p: &mut PanelParams, ranges: Ranges, ui: &mut egui::Ui) {
             .text("Focal distance"),
     )
     .on_hover_text("Distance from the lens to the plane in focus. Restarts.");
-    setting_ui::settings_ui(p, ranges, ui, setting_ui::shared);
+    setting_ui::settings_ui(p, ranges, ui, setting_ui::every_renderer);
 }
 
 fn statistics_ui(viewer: &ViewerState, ui: &mut egui::Ui) {

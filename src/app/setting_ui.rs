@@ -21,14 +21,15 @@ pub fn settings_ui(p: &mut PanelParams, ranges: Ranges, ui: &mut Ui, wanted: imp
     }
 }
 
-/// Whether a setting is read by `kind` alone.
-pub fn only(kind: RendererKind) -> impl Fn(&Setting) -> bool {
-    move |s| s.renderers == [kind]
+/// Whether a setting is read by `kind` and not by every renderer: what the current
+/// renderer's own section shows (the merging radius's α under both photon mapping and VCM).
+pub fn read_by(kind: RendererKind) -> impl Fn(&Setting) -> bool {
+    move |s| s.renderers.contains(&kind) && !every_renderer(s)
 }
 
-/// Whether a setting is read by more than one renderer.
-pub fn shared(s: &Setting) -> bool {
-    s.renderers.len() > 1
+/// Whether a setting is read by every renderer (the depth of paths, the seed).
+pub fn every_renderer(s: &Setting) -> bool {
+    RendererKind::ALL.iter().all(|k| s.renderers.contains(k))
 }
 
 /// The tooltip: the table's help, and whether a change restarts the render.

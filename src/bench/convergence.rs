@@ -72,7 +72,7 @@ impl Config {
         let mut p = base.clone();
         for s in crate::settings::SETTINGS {
             let switch = matches!(s.kind, Kind::Bool | Kind::Auto);
-            if s.renderers == [RendererKind::Ppm] && switch {
+            if s.renderers.contains(&RendererKind::Ppm) && switch {
                 if let Some(v) = defaults.get(s.key) {
                     p.set(s.key, &v).map_err(anyhow::Error::msg)?;
                 }

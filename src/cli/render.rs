@@ -185,7 +185,7 @@ pub fn check_shard_flags(args: &RenderArgs) -> Result<()> {
     }
     let given = |key: &str| args.settings.get(key).map(|v| v.replace('-', "_"));
     if let Some(kind) = given("renderer").filter(|k| k != RendererKind::Ppm.name()) {
-        bail!("--renderer {kind}: a part is photon mapped with the global radius schedule");
+        bail!("--renderer {kind}: a part is photon mapped with the global radius schedule, whose passes are independent estimates that merge exactly; only photon mapping renders parts");
     }
     if let Some(schedule) = given("radius_schedule").filter(|s| s != RadiusSchedule::Global.name()) {
         bail!("--radius-schedule {schedule}: a part's passes follow the global radius schedule");

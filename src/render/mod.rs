@@ -21,6 +21,7 @@ pub mod sequence;
 pub mod session;
 pub mod shard;
 pub mod spectrum;
+pub mod vcm;
 pub mod wavelength;
 pub mod whitted;
 

@@ -17,7 +17,15 @@ fn readers(s: &Setting) -> String {
     if s.renderers.len() == RendererKind::ALL.len() {
         return String::new();
     }
-    let names: Vec<String> = s.renderers.iter().map(|k| k.label().to_lowercase()).collect();
+    // Labels in lower case within the sentence, but an acronym ("VCM") as it is.
+    let in_sentence = |label: &str| {
+        if label.chars().take(2).all(char::is_uppercase) {
+            label.to_owned()
+        } else {
+            label.to_lowercase()
+        }
+    };
+    let names: Vec<String> = s.renderers.iter().map(|k| in_sentence(k.label())).collect();
     let names = names.join(" and ");
     let mut first = names.chars();
     let capital: String = first

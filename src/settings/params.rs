@@ -22,6 +22,8 @@ pub const NEAR_SPECULAR: f64 = 0.15;
 
 /// The photon mapper alone.
 const PPM: &[RendererKind] = &[RendererKind::Ppm];
+/// Photon mapping and vertex connection and merging, which merges photons too.
+const MERGING: &[RendererKind] = &[RendererKind::Ppm, RendererKind::Vcm];
 /// The ray tracer alone.
 const WHITTED: &[RendererKind] = &[RendererKind::Whitted];
 
@@ -138,7 +140,7 @@ render_settings! {
     check any;
     flag "renderer", label "Renderer", default "\"whitted\"", unit "",
     renderers RendererKind::ALL, live false, widget Widget::Hidden;
-    help "Which renderer makes the image: \"whitted\" (the ray tracer: one fast frame), \"ppm\" (progressive photon mapping) or \"path\" (the path tracer: unbiased, one sample per pixel a pass).";
+    help "Which renderer makes the image: \"whitted\" (the ray tracer: one fast frame), \"ppm\" (progressive photon mapping), \"path\" (the path tracer: unbiased, one sample per pixel a pass) or \"vcm\" (vertex connection and merging: path tracing, light tracing and photon mapping weighted by multiple importance sampling, one light and one camera subpath per pixel a pass).";
 
     photons_per_pass: u64 = 200_000;
     check |n| limits::photons_per_pass(*n).map(drop);
@@ -155,14 +157,14 @@ render_settings! {
     alpha: f64 = 0.7;
     check |a| limits::alpha(*a).map(drop);
     flag "alpha", label "Alpha", default "0.7", unit "",
-    renderers PPM, live true, widget Widget::Slider { min: 0.05, max: 1.0, log: false, step: 0.0 };
-    help "The radius reduction α in (0, 1]: the fraction of a pass's new photons an estimate keeps (Hachisuka et al. 2008, who use 0.7); the radius shrinks faster when it is smaller. Applies from the next pass, without restarting (with the global radius schedule, it restarts).";
+    renderers MERGING, live true, widget Widget::Slider { min: 0.05, max: 1.0, log: false, step: 0.0 };
+    help "The radius reduction α in (0, 1]: the fraction of a pass's new photons an estimate keeps (Hachisuka et al. 2008, who use 0.7); the radius shrinks faster when it is smaller (for \"vcm\", the merging radius shrinks as (pass + 1)^((α − 1)/2)). Applies from the next pass, without restarting (with the global radius schedule, it restarts).";
 
     initial_radius: Option<f64> = None;
     check |r| r.map_or(Ok(()), |r| limits::radius(r).map(drop));
     flag "radius", label "Initial radius", default "automatic", unit "scene units",
-    renderers PPM, live false, widget Widget::Auto { automatic: "Automatic initial radius", min: 1e-5, max: 0.2, scene_length: true, manual: 0.0 };
-    help "The search radius photons are gathered over at first, in scene units. Automatic: twice one pixel's footprint at the median distance of the visible points.";
+    renderers MERGING, live false, widget Widget::Auto { automatic: "Automatic initial radius", min: 1e-5, max: 0.2, scene_length: true, manual: 0.0 };
+    help "The search radius photons are gathered over at first, in scene units. Automatic: twice one pixel's footprint at the median distance of the visible points. \"vcm\" merges within it too.";
 
     indirect_radius_scale: Option<f64> = None;
     check |k| k.map_or(Ok(()), |k| limits::radius_scale(k).map(drop));

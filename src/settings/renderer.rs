@@ -73,6 +73,7 @@ macro_rules! with_renderers {
             Whitted, "whitted", "Ray tracer", "Whitted ray tracer: one fast frame, direct light, mirrors and glass only", single, ray_tracer::RayTracer;
             Ppm, "ppm", "Photon mapping", "Progressive photon mapping: converges to caustics and indirect light", progressive, photon_mapping::PhotonMapping;
             Path, "path", "Path tracer", "Unidirectional path tracer with light sampling and MIS: an unbiased cross-check of photon mapping", progressive, path::PathTracer;
+            Vcm, "vcm", "VCM", "Vertex connection and merging: path tracing, light tracing and photon mapping combined by multiple importance sampling", progressive, vcm::Vcm;
         }
     };
 }

@@ -280,6 +280,26 @@ impl Bsdf {
         }
     }
 
+    /// The density with which a path arriving the other way, along `wi`, samples `wo`: what
+    /// bidirectional methods weigh a vertex by when the light's subpath, not the eye's, made
+    /// it (the reverse density of Veach 1997, §10.2). Where `wi` lies beyond the surface
+    /// (refraction) the surface is seen from the other side, through the inverse index.
+    pub fn pdf_reverse(&self, wo: DVec3, wi: DVec3) -> f64 {
+        if self.normal().dot(wi) >= 0.0 {
+            return self.pdf(wi, wo);
+        }
+        match *self {
+            Bsdf::RoughDielectric(b) => RoughDielectric {
+                eta: 1.0 / b.eta,
+                n: -b.n,
+                ..b
+            }
+            .pdf(wi, wo),
+            // Surfaces that only reflect take nothing from beyond them.
+            _ => 0.0,
+        }
+    }
+
     /// A direction from the smooth part, drawing what numbers it needs from `rng` (a
     /// Lambertian surface and a rough conductor draw two, a rough dielectric three). `None`
     /// when the part is empty, or the sample falls below the surface (or, refracted, on its

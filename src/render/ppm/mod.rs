@@ -67,6 +67,7 @@ pub use hash_grid::HashGrid;
 pub use index::SpatialIndex;
 pub use kd_tree::KdTree;
 pub use layers::PixelLayers;
+pub use points::SearchSphere;
 pub use progressive::{PassOutcome, Ppm};
 pub use seen::{SUBSAMPLES, VARIED_SUBSAMPLES};
 pub use stats::PpmStats;

@@ -1,9 +1,10 @@
-"""assets/compare/cornell_rough.toml in Mitsuba 3's path tracer (llvm_ad_rgb), for comparing
-caustic's renderers with an independent implementation of the same rough materials (GGX
-`roughdielectric` and `roughconductor` with `material = "none"`).
+"""assets/compare/cornell_rough.toml or cornell_smooth.toml in Mitsuba 3's path tracer
+(llvm_ad_rgb), for comparing caustic's renderers with an independent implementation of the same
+materials: rough (GGX `roughdielectric` and `roughconductor` with `material = "none"`) or smooth
+(`dielectric` and `conductor` with `material = "none"`).
 
     pip install mitsuba          # and Debian's libllvm19 for the llvm variant
-    python3 assets/compare/mitsuba_cornell_rough.py SPP OUT.exr
+    python3 assets/compare/mitsuba_cornell.py rough|smooth SPP OUT.exr
 """
 import sys, time
 import mitsuba as mi
@@ -16,7 +17,14 @@ def rect(center, rot_axis, rot_deg, bsdf, emitter=None):
     return d
 diffuse = lambda c: {"type": "diffuse", "reflectance": {"type": "rgb", "value": c}}
 grey, red, green = diffuse([0.75]*3), diffuse([0.75, 0.25, 0.25]), diffuse([0.25, 0.75, 0.25])
-spp = int(sys.argv[1])
+if len(sys.argv) != 4 or sys.argv[1] not in ("rough", "smooth"):
+    sys.exit("usage: mitsuba_cornell.py rough|smooth SPP OUT.exr")
+smooth = sys.argv[1] == "smooth"
+spp = int(sys.argv[2])
+glass = ({"type": "dielectric", "int_ior": 1.5, "ext_ior": 1.0} if smooth else
+         {"type": "roughdielectric", "distribution": "ggx", "alpha": 0.1, "int_ior": 1.5, "ext_ior": 1.0})
+mirror = ({"type": "conductor", "material": "none"} if smooth else
+          {"type": "roughconductor", "material": "none", "distribution": "ggx", "alpha": 0.2})
 scene = mi.load_dict({
     "type": "scene",
     "integrator": {"type": "path", "max_depth": 65},
@@ -34,13 +42,10 @@ scene = mi.load_dict({
               "to_world": T().translate([0, 0.99, 0]).rotate([1, 0, 0], 90).scale([0.25, 0.25, 1]),
               "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": [0, 0, 0]}},
               "emitter": {"type": "area", "radiance": {"type": "rgb", "value": [12, 12, 12]}}},
-    "glass": {"type": "sphere", "center": [0.45, -0.65, 0.30], "radius": 0.35,
-              "bsdf": {"type": "roughdielectric", "distribution": "ggx", "alpha": 0.1,
-                       "int_ior": 1.5, "ext_ior": 1.0}},
-    "mirror": {"type": "sphere", "center": [-0.45, -0.65, -0.35], "radius": 0.35,
-               "bsdf": {"type": "roughconductor", "material": "none", "distribution": "ggx", "alpha": 0.2}},
+    "glass": {"type": "sphere", "center": [0.45, -0.65, 0.30], "radius": 0.35, "bsdf": glass},
+    "mirror": {"type": "sphere", "center": [-0.45, -0.65, -0.35], "radius": 0.35, "bsdf": mirror},
 })
 t = time.time()
 img = mi.render(scene, spp=spp)
-mi.Bitmap(img).write(sys.argv[2])
+mi.Bitmap(img).write(sys.argv[3])
 print(f"{spp} spp in {time.time() - t:.1f} s")
