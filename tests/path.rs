@@ -4,13 +4,12 @@
 
 mod common;
 
-use std::f64::consts::PI;
 use std::path::Path;
 
 use caustic::render::integrator::{make, PassPlan, Setup};
 use caustic::render::ppm::{Control, Ppm, PpmOptions};
 use caustic::scene::{RendererKind, Scene};
-use common::lighting::{closed_form, mean_red, plane_lit_by, LIGHT_KINDS};
+use common::lighting::{assert_furnace, assert_light_kinds, mean_red, plane_lit_by, LIGHT_KINDS};
 
 /// `passes` path-traced passes of `scene`: the image.
 fn path_traced(scene: &Scene, passes: u32) -> Vec<[f32; 3]> {
@@ -26,77 +25,18 @@ fn path_traced(scene: &Scene, passes: u32) -> Vec<[f32; 3]> {
     pt.frame(0, 0.0).radiance.to_vec()
 }
 
-/// The camera inside a diffuse sphere of radius 2 and reflectance `rho`, with `light` at its
-/// centre.
-fn integrating_sphere(light: &str, rho: f64) -> Scene {
-    let text = format!(
-        r#"
-[camera]
-position = [0, 0, 0.5]
-look_at = [0, 0, 3]
-fov = 60
-width = 16
-height = 12
-
-[render]
-max_depth = 64
-
-[materials.wall]
-type = "diffuse"
-color = [{rho}, {rho}, {rho}]
-
-[[lights]]
-{light}
-
-[[objects]]
-type = "sphere"
-center = [0, 0, 0]
-radius = 2
-material = "wall"
-"#
-    );
-    Scene::from_str(&text, Path::new("furnace.toml"), None).expect("scene")
-}
-
-/// The furnace: in a diffuse sphere of reflectance ρ with a source of power Φ at its centre,
-/// every bounce lights the wall uniformly, so its radiance is ρΦ / (π · 4πR² · (1 − ρ)) — the
-/// integrating sphere's closed form, which needs every bounce (half the light here comes after
-/// the first). Both a point light and a small sphere light (sampled with MIS) reach it.
+/// The furnace ([`assert_furnace`]): every bounce counts; both a point light and a small
+/// sphere light (sampled with MIS) reach the closed form.
 #[test]
 fn an_integrating_sphere_gives_its_closed_form() {
-    let (rho, power, radius) = (0.5, 100.0, 2.0);
-    let expected = rho * power / (PI * 4.0 * PI * radius * radius * (1.0 - rho));
-    for light in [
-        "type = \"point\"\nposition = [0, 0, 0]\npower = 100",
-        "type = \"sphere\"\ncenter = [0, 0, 0]\nradius = 0.05\npower = 100",
-    ] {
-        let scene = integrating_sphere(light, rho);
-        let mean = mean_red(&path_traced(&scene, 256));
-        eprintln!("{light}: {mean:.5} against {expected:.5}");
-        assert!(
-            (mean / expected - 1.0).abs() < 0.01,
-            "{light}: path traced / closed form = {}",
-            mean / expected
-        );
-    }
+    assert_furnace("path traced", |scene| path_traced(scene, 256));
 }
 
 /// Every light kind over the diffuse plane: the closed form of the light it reflects (image
 /// means within 1 %), as light sampling in photon mapping is held to.
 #[test]
 fn every_light_kind_over_a_plane_gives_the_closed_form() {
-    for (kind, light) in LIGHT_KINDS {
-        let scene = plane_lit_by(light, true);
-        let expected = closed_form(&scene);
-        let expected_mean = expected.iter().map(|e| e.x).sum::<f64>() / expected.len() as f64;
-        let mean = mean_red(&path_traced(&scene, 64));
-        eprintln!("{kind}: path traced {mean:.5}, closed form {expected_mean:.5}");
-        assert!(
-            (mean / expected_mean - 1.0).abs() < 0.01,
-            "{kind}: path traced / closed form = {}",
-            mean / expected_mean
-        );
-    }
+    assert_light_kinds("path traced", |scene| path_traced(scene, 64));
 }
 
 /// The Cornell box (glass and mirror spheres, an area light, a teapot with a Phong lobe): the

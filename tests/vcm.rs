@@ -12,7 +12,7 @@ use caustic::render::integrator::{make, Integrator, PassPlan, Setup};
 use caustic::render::ppm::Control;
 use caustic::render::vcm::Techniques;
 use caustic::scene::{RendererKind, Scene};
-use common::lighting::{closed_form, mean_red, plane_lit_by, LIGHT_KINDS};
+use common::lighting::{assert_furnace, assert_light_kinds};
 
 /// `passes` passes of `integrator` over `scene`: the image.
 fn rendered(mut integrator: Box<dyn Integrator>, scene: &Scene, passes: u32) -> Vec<[f32; 3]> {
@@ -57,49 +57,17 @@ fn cornell(width: u32, height: u32) -> Scene {
     scene
 }
 
-/// The furnace (as the path tracer's test): inside a diffuse sphere of reflectance ρ with a
-/// source of power Φ at its centre the wall's radiance is ρΦ / (π · 4πR² · (1 − ρ)); every
-/// bounce counts, and every technique reaches some of them.
+/// The furnace ([`assert_furnace`]): every bounce counts, and every technique reaches some
+/// of them.
 #[test]
 fn an_integrating_sphere_gives_its_closed_form() {
-    let (rho, power, radius) = (0.5, 100.0, 2.0);
-    let expected =
-        rho * power / (std::f64::consts::PI * 4.0 * std::f64::consts::PI * radius * radius * (1.0 - rho));
-    for light in [
-        "type = \"point\"\nposition = [0, 0, 0]\npower = 100",
-        "type = \"sphere\"\ncenter = [0, 0, 0]\nradius = 0.05\npower = 100",
-    ] {
-        let text = format!(
-            "[camera]\nposition = [0, 0, 0.5]\nlook_at = [0, 0, 3]\nfov = 60\nwidth = 16\nheight = 12\n\n\
-             [render]\nmax_depth = 64\n\n[materials.wall]\ntype = \"diffuse\"\ncolor = [{rho}, {rho}, {rho}]\n\n\
-             [[lights]]\n{light}\n\n[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 2\nmaterial = \"wall\"\n"
-        );
-        let scene = Scene::from_str(&text, Path::new("furnace.toml"), None).expect("scene");
-        let got = mean_red(&vcm(&scene, Techniques::ALL, 256));
-        eprintln!("{light}: {got:.5} against {expected:.5}");
-        assert!(
-            (got / expected - 1.0).abs() < 0.01,
-            "{light}: VCM / closed form = {}",
-            got / expected
-        );
-    }
+    assert_furnace("VCM", |scene| vcm(scene, Techniques::ALL, 256));
 }
 
 /// Every light kind over the diffuse plane: the closed form within 1 %.
 #[test]
 fn every_light_kind_over_a_plane_gives_the_closed_form() {
-    for (kind, light) in LIGHT_KINDS {
-        let scene = plane_lit_by(light, true);
-        let expected = closed_form(&scene);
-        let expected_mean = expected.iter().map(|e| e.x).sum::<f64>() / expected.len() as f64;
-        let got = mean_red(&vcm(&scene, Techniques::ALL, 64));
-        eprintln!("{kind}: VCM {got:.5}, closed form {expected_mean:.5}");
-        assert!(
-            (got / expected_mean - 1.0).abs() < 0.01,
-            "{kind}: VCM / closed form = {}",
-            got / expected_mean
-        );
-    }
+    assert_light_kinds("VCM", |scene| vcm(scene, Techniques::ALL, 256));
 }
 
 /// Whether `got`'s mean is within 0.5 % of `traced`'s, channel by channel.

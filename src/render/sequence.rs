@@ -33,6 +33,9 @@
 
 use glam::DVec2;
 
+use crate::geometry::Ray;
+use crate::scene::Camera;
+
 /// The golden ratio (1 + √5)/2.
 const GOLDEN: f64 = 1.618_033_988_749_895;
 /// φ₄: the real root of x⁵ = x + 1.
@@ -115,6 +118,18 @@ pub fn rotated(point: DVec2, offset: DVec2) -> DVec2 {
     let p = (point + offset).fract();
     // `fract` of a value just below an integer can round up to 1.0.
     p.min(DVec2::splat(1.0 - f64::EPSILON / 2.0))
+}
+
+/// The eye ray of pixel `i` (row-major) in pass `pass` of a renderer that traces one a pixel a
+/// pass (the path tracer, VCM): its place in the pixel from Sobol's points, its lens point
+/// from R4's, each randomised by numbers drawn once for the pixel from `offsets` (a generator
+/// seeded by the pixel alone, the same every pass).
+pub fn pixel_ray(camera: &Camera, pass: u64, i: u64, offsets: &mut impl rand::Rng) -> Ray {
+    let w = camera.width as u64;
+    let jitter = sobol(pass, offsets.random());
+    let lens = rotated(r4(pass)[0], DVec2::new(offsets.random(), offsets.random()));
+    let pixel = DVec2::new((i % w) as f64, (i / w) as f64) + jitter;
+    camera.eye_rays().ray_with_lens_sample(pixel, lens)
 }
 
 #[cfg(test)]

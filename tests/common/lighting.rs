@@ -137,3 +137,74 @@ pub const LIGHT_KINDS: [(&str, &str); 4] = [
         "type = \"quad\"\ncorner = [1.7, 2.0, -0.3]\nedge_u = [0.6, 0, 0]\nedge_v = [0, 0, 0.6]\npower = 400",
     ),
 ];
+
+/// The camera inside a diffuse sphere of radius 2 and reflectance `rho`, with `light` at its
+/// centre.
+pub fn integrating_sphere(light: &str, rho: f64) -> Scene {
+    let text = format!(
+        r#"
+[camera]
+position = [0, 0, 0.5]
+look_at = [0, 0, 3]
+fov = 60
+width = 16
+height = 12
+
+[render]
+max_depth = 64
+
+[materials.wall]
+type = "diffuse"
+color = [{rho}, {rho}, {rho}]
+
+[[lights]]
+{light}
+
+[[objects]]
+type = "sphere"
+center = [0, 0, 0]
+radius = 2
+material = "wall"
+"#
+    );
+    Scene::from_str(&text, Path::new("furnace.toml"), None).expect("scene")
+}
+
+/// The furnace's closed form and what `render` makes of it, for a point light and a small
+/// sphere light at the centre of the integrating sphere (ρ 0.5, Φ 100, R 2): in a diffuse
+/// sphere of reflectance ρ with a source of power Φ at its centre, every bounce lights the
+/// wall uniformly, so its radiance is ρΦ / (π · 4πR² · (1 − ρ)), half of it after the first
+/// bounce. Asserts `render`'s image mean within 1 %.
+pub fn assert_furnace(name: &str, render: impl Fn(&Scene) -> Vec<[f32; 3]>) {
+    let (rho, power, radius) = (0.5, 100.0, 2.0);
+    let expected = rho * power / (PI * 4.0 * PI * radius * radius * (1.0 - rho));
+    for light in [
+        "type = \"point\"\nposition = [0, 0, 0]\npower = 100",
+        "type = \"sphere\"\ncenter = [0, 0, 0]\nradius = 0.05\npower = 100",
+    ] {
+        let got = mean_red(&render(&integrating_sphere(light, rho)));
+        eprintln!("{light}: {name} {got:.5} against {expected:.5}");
+        assert!(
+            (got / expected - 1.0).abs() < 0.01,
+            "{light}: {name} / closed form = {}",
+            got / expected
+        );
+    }
+}
+
+/// Every light kind over the diffuse plane, with direct light by light sampling: `render`'s
+/// image mean within 1 % of the closed form's.
+pub fn assert_light_kinds(name: &str, render: impl Fn(&Scene) -> Vec<[f32; 3]>) {
+    for (kind, light) in LIGHT_KINDS {
+        let scene = plane_lit_by(light, true);
+        let expected = closed_form(&scene);
+        let expected_mean = expected.iter().map(|e| e.x).sum::<f64>() / expected.len() as f64;
+        let got = mean_red(&render(&scene));
+        eprintln!("{kind}: {name} {got:.5}, closed form {expected_mean:.5}");
+        assert!(
+            (got / expected_mean - 1.0).abs() < 0.01,
+            "{kind}: {name} / closed form = {}",
+            got / expected_mean
+        );
+    }
+}

@@ -191,11 +191,7 @@ impl PathTracer {
     fn sample(&self, scene: &Scene, light_of: &[Option<usize>], pass: u64, i: u64) -> (DVec3, u64, u64) {
         let (w, h) = (self.size.0 as u64, self.size.1 as u64);
         let seed = scene.params.seed;
-        let mut offsets = stream_rng(seed, streams::OFFSETS, i);
-        let jitter = sequence::sobol(pass, offsets.random());
-        let lens = sequence::rotated(sequence::r4(pass)[0], DVec2::new(offsets.random(), offsets.random()));
-        let pixel = DVec2::new((i % w) as f64, (i / w) as f64) + jitter;
-        let ray = scene.camera.eye_rays().ray_with_lens_sample(pixel, lens);
+        let ray = sequence::pixel_ray(&scene.camera, pass, i, &mut stream_rng(seed, streams::OFFSETS, i));
         let mut path = Path {
             scene,
             light_of,

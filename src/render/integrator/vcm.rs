@@ -7,8 +7,7 @@
 
 use std::time::Instant;
 
-use glam::{DVec2, DVec3};
-use rand::Rng;
+use glam::DVec3;
 use rayon::prelude::*;
 
 use super::{Control, Integrator, PassPlan, Setup};
@@ -131,14 +130,8 @@ impl Vcm {
     /// One camera subpath of pixel `i`: its radiance, segments and merges.
     fn camera_sample(&self, pass: &PassData, own: &[LightVertex], i: u64) -> (DVec3, u64, u64) {
         let scene = pass.scene;
-        let (w, n) = (self.size.0 as u64, self.sums.len() as u64);
-        let seed = scene.params.seed;
-        let index = self.stats.passes as u64;
-        let mut offsets = stream_rng(seed, streams::OFFSETS, i);
-        let jitter = sequence::sobol(index, offsets.random());
-        let lens = sequence::rotated(sequence::r4(index)[0], DVec2::new(offsets.random(), offsets.random()));
-        let pixel = DVec2::new((i % w) as f64, (i / w) as f64) + jitter;
-        let ray = scene.camera.eye_rays().ray_with_lens_sample(pixel, lens);
+        let (n, seed, index) = (self.sums.len() as u64, scene.params.seed, self.stats.passes as u64);
+        let ray = sequence::pixel_ray(&scene.camera, index, i, &mut stream_rng(seed, streams::OFFSETS, i));
         let mut path = CameraPath {
             pass,
             own,
