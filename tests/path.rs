@@ -6,23 +6,14 @@ mod common;
 
 use std::path::Path;
 
-use caustic::render::integrator::{make, PassPlan, Setup};
+use caustic::render::integrator::{make, Setup};
 use caustic::render::ppm::{Control, Ppm, PpmOptions};
 use caustic::scene::{RendererKind, Scene};
 use common::lighting::{assert_furnace, assert_light_kinds, mean_red, plane_lit_by, LIGHT_KINDS};
 
 /// `passes` path-traced passes of `scene`: the image.
 fn path_traced(scene: &Scene, passes: u32) -> Vec<[f32; 3]> {
-    let mut pt = make(RendererKind::Path, scene, &Setup::default());
-    let plan = PassPlan {
-        params: scene.params.clone(),
-        first_pass_photons: None,
-    };
-    for _ in 0..passes {
-        assert!(pt.render_pass(scene, &plan, &mut |_| Control::Continue));
-    }
-    assert_eq!(pt.passes(), passes);
-    pt.frame(0, 0.0).radiance.to_vec()
+    common::rendered(make(RendererKind::Path, scene, &Setup::default()), scene, passes)
 }
 
 /// The furnace ([`assert_furnace`]): every bounce counts; both a point light and a small

@@ -8,24 +8,11 @@ mod common;
 use std::path::Path;
 
 use caustic::render::integrator::vcm::Vcm;
-use caustic::render::integrator::{make, Integrator, PassPlan, Setup};
-use caustic::render::ppm::Control;
+use caustic::render::integrator::{make, Setup};
 use caustic::render::vcm::Techniques;
 use caustic::scene::{RendererKind, Scene};
 use common::lighting::{assert_furnace, assert_light_kinds};
-
-/// `passes` passes of `integrator` over `scene`: the image.
-fn rendered(mut integrator: Box<dyn Integrator>, scene: &Scene, passes: u32) -> Vec<[f32; 3]> {
-    let plan = PassPlan {
-        params: scene.params.clone(),
-        first_pass_photons: None,
-    };
-    for _ in 0..passes {
-        assert!(integrator.render_pass(scene, &plan, &mut |_| Control::Continue));
-    }
-    assert_eq!(integrator.passes(), passes);
-    integrator.frame(0, 0.0).radiance.to_vec()
-}
+use common::rendered;
 
 /// `passes` passes of VCM with `techniques`.
 fn vcm(scene: &Scene, techniques: Techniques, passes: u32) -> Vec<[f32; 3]> {

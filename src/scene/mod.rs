@@ -175,6 +175,18 @@ impl Scene {
         true
     }
 
+    /// For each object, the light whose visible surface it is (what a path that meets an
+    /// emitter weighs against sampling that light).
+    pub fn light_of_objects(&self) -> Vec<Option<usize>> {
+        let mut light_of = vec![None; self.objects.len()];
+        for (k, object) in self.light_objects.iter().enumerate() {
+            if let Some(o) = object {
+                light_of[*o as usize] = Some(k);
+            }
+        }
+        light_of
+    }
+
     /// Whether something blocks the way from the surface point `point` (geometric normal
     /// `normal`) to the sample `ls` of light `light`: the shadow ray of
     /// [`light::LightSample::shadow_ray`], passing the light's own surface.
@@ -187,8 +199,27 @@ impl Scene {
     /// a Bézier patch ([`Hit::departure`]), so the patch's leaves around that point need not
     /// find the ray's own crossing again.
     pub fn occluded_from_hit(&self, hit: &Hit, light: usize, ls: &light::LightSample) -> bool {
+        let own = self.light_objects.get(light).copied().flatten();
+        self.blocked_from_hit(hit, ls, own)
+    }
+
+    /// Whether something lies between the point of `hit` and the point `distance` away along
+    /// the unit direction `wi` (another surface's point, a lens point): the shadow ray of
+    /// [`Scene::occluded_from_hit`], with no light's surface passed.
+    pub fn occluded_between(&self, hit: &Hit, wi: DVec3, distance: f64) -> bool {
+        let towards = light::LightSample {
+            wi,
+            distance,
+            incident: DVec3::ZERO,
+        };
+        self.blocked_from_hit(hit, &towards, None)
+    }
+
+    /// Whether something but the object `skip` lies on the shadow ray from `hit` to `ls`.
+    fn blocked_from_hit(&self, hit: &Hit, ls: &light::LightSample, skip: Option<u32>) -> bool {
         let (ray, reach) = ls.shadow_ray(hit.point, hit.normal);
-        self.shadow_ray_blocked(&ray.leaving(hit.departure(ls.wi)), reach, light)
+        self.geometry
+            .occluded_except(&ray.leaving(hit.departure(ls.wi)), reach, skip)
     }
 
     /// Whether something but light `light`'s own surface lies on the shadow ray `ray` within

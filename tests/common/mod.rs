@@ -132,3 +132,22 @@ pub fn pool(threads: usize) -> rayon::ThreadPool {
         .build()
         .expect("pool")
 }
+
+/// `passes` passes of `integrator` over `scene`, each completed: the image.
+pub fn rendered(
+    mut integrator: Box<dyn caustic::render::integrator::Integrator>,
+    scene: &caustic::scene::Scene,
+    passes: u32,
+) -> Vec<[f32; 3]> {
+    let plan = caustic::render::integrator::PassPlan {
+        params: scene.params.clone(),
+        first_pass_photons: None,
+    };
+    for _ in 0..passes {
+        assert!(integrator.render_pass(scene, &plan, &mut |_| {
+            caustic::render::integrator::Control::Continue
+        }));
+    }
+    assert_eq!(integrator.passes(), passes);
+    integrator.frame(0, 0.0).radiance.to_vec()
+}

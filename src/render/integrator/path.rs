@@ -211,12 +211,7 @@ impl Integrator for PathTracer {
         let start = Instant::now();
         let width = self.size.0 as usize;
         let pass = self.stats.passes as u64;
-        let mut light_of = vec![None; scene.objects.len()];
-        for (k, object) in scene.light_objects.iter().enumerate() {
-            if let Some(o) = object {
-                light_of[*o as usize] = Some(k);
-            }
-        }
+        let light_of = scene.light_of_objects();
         let mut samples = vec![DVec3::ZERO; self.sums.len()];
         let (mut segments, mut shadow_rays) = (0, 0);
         // The path tracer has no live setting: the settings it gets back are left alone.

@@ -92,14 +92,13 @@ impl Vcm {
     /// The light subpaths of the coming pass, `None` when abandoned.
     fn light_paths(
         &self,
-        scene: &Scene,
+        (scene, target): (&Scene, Option<(DVec3, f64)>),
         k: &PassConstants,
         live: &mut RenderParams,
         control: &mut dyn FnMut(&mut RenderParams) -> Control,
     ) -> Option<LightPaths> {
         let n = self.sums.len();
         let (seed, pass) = (scene.params.seed, self.stats.passes as u64);
-        let target = scene.geometry.bounding_sphere();
         let batch = (BATCH_ROWS * self.size.0 as usize).max(1);
         let mut paths = LightPaths {
             vertices: Vec::new(),
@@ -169,22 +168,24 @@ impl Integrator for Vcm {
         );
         // Nothing here is a live setting: the settings it gets back are left alone.
         let mut live = plan.params.clone();
+        // What point lights outside the scene aim their emission at.
+        let target = scene.geometry.bounding_sphere();
         let Some(LightPaths {
             vertices,
             starts,
             mut image,
             mut segments,
-        }) = self.light_paths(scene, &k, &mut live, control)
+        }) = self.light_paths((scene, target), &k, &mut live, control)
         else {
             return false;
         };
         let photons = k.techniques.merge.then(|| Photons::build(&vertices, k.radius));
-        let light_of = light_of(scene);
+        let light_of = scene.light_of_objects();
         let pass = PassData {
             scene,
             k: &k,
             light_of: &light_of,
-            target: scene.geometry.bounding_sphere(),
+            target,
             vertices: &vertices,
             photons: photons.as_ref(),
         };
@@ -268,17 +269,6 @@ impl LightPaths {
         }
         self.segments += path.segments;
     }
-}
-
-/// For each object, the light whose visible surface it is.
-fn light_of(scene: &Scene) -> Vec<Option<usize>> {
-    let mut light_of = vec![None; scene.objects.len()];
-    for (k, object) in scene.light_objects.iter().enumerate() {
-        if let Some(o) = object {
-            light_of[*o as usize] = Some(k);
-        }
-    }
-    light_of
 }
 
 /// The statistics as a frame's.

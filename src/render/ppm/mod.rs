@@ -69,6 +69,7 @@ pub use kd_tree::KdTree;
 pub use layers::PixelLayers;
 pub use points::SearchSphere;
 pub use progressive::{PassOutcome, Ppm};
+pub use radius::footprint_radius;
 pub use seen::{SUBSAMPLES, VARIED_SUBSAMPLES};
 pub use stats::PpmStats;
 pub use warm::{StreamOffset, WarmStart};

@@ -7,7 +7,7 @@
 use super::estimate::{Estimate, Restart, Slot};
 use super::gathered::Gathered;
 use super::points::VisiblePoints;
-use crate::scene::Scene;
+use crate::scene::{Camera, Scene};
 use crate::settings::RenderParams;
 
 /// How the indirect estimate's radius is chosen ([`RenderParams::indirect_radius_scale`]).
@@ -274,12 +274,19 @@ pub fn automatic_radius(points: &VisiblePoints, scene: &Scene) -> f64 {
         .iter()
         .map(|p| (p.position - cam.position).dot(cam.forward).abs())
         .collect();
+    footprint_radius(&mut distances, cam)
+}
+
+/// Twice the footprint of one pixel of `camera` at the median of `distances` (along the view
+/// axis; reordered): the automatic radius's rule, which VCM's radius follows too. 1e-3 when
+/// there is no distance.
+pub fn footprint_radius(distances: &mut [f64], camera: &Camera) -> f64 {
     if distances.is_empty() {
         return 1e-3;
     }
     let mid = distances.len() / 2;
     let median = *distances.select_nth_unstable_by(mid, f64::total_cmp).1;
-    let pixel = 2.0 * (0.5 * cam.fov_y).tan() / cam.height as f64;
+    let pixel = 2.0 * (0.5 * camera.fov_y).tan() / camera.height as f64;
     (2.0 * median * pixel).max(1e-9)
 }
 

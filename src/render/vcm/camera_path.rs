@@ -9,14 +9,13 @@ use rand::Rng;
 use rand_pcg::Pcg64Mcg;
 
 use super::camera_link::eye_ray_pdf;
-use super::emission::{area_and_normal, direct_pdf_area, emission_pdf};
+use super::emission::{area_and_normal, direct_pdf_area, emission_pdf, pick_chance, pick_light};
 use super::light_path::{LightVertex, Photons};
 use super::state::Subpath;
 use super::{mis, PassConstants};
 use crate::geometry::{Hit, Ray};
 use crate::render::bsdf::Bsdf;
 use crate::render::wavelength::Wavelength;
-use crate::scene::light::LightSample;
 use crate::scene::Scene;
 
 /// What a pass gives every camera subpath to read.
@@ -160,7 +159,7 @@ impl CameraPath<'_> {
             return emitted;
         };
         let light = &scene.lights[k];
-        let pick = 1.0 / scene.lights.len() as f64;
+        let pick = pick_chance(scene.lights.len());
         let direct = pick * direct_pdf_area(light, hit.point, previous);
         let emission = pick * emission_pdf(light, hit.point, -dir, self.pass.target);
         emitted / (1.0 + mis(direct) * s.d_vcm + mis(emission) * s.d_vc)
@@ -170,16 +169,13 @@ impl CameraPath<'_> {
     /// BSDF's sample hitting it and the light subpaths that would have reached this vertex.
     fn light_sample(&mut self, at: &At, s: &Subpath) -> DVec3 {
         let (scene, k) = (self.pass.scene, self.pass.k);
-        let count = scene.lights.len();
         let (choice, u) = (
             self.rng.random::<f64>(),
             DVec2::new(self.rng.random(), self.rng.random()),
         );
-        if count == 0 {
+        let Some((index, pick)) = pick_light(scene.lights.len(), choice) else {
             return DVec3::ZERO;
-        }
-        let pick = 1.0 / count as f64;
-        let index = ((choice * count as f64) as usize).min(count - 1);
+        };
         let light = &scene.lights[index];
         let Some(ls) = light.sample(at.hit.point, u) else {
             return DVec3::ZERO;
@@ -237,12 +233,7 @@ impl CameraPath<'_> {
             if !value.is_finite() || value == DVec3::ZERO {
                 continue;
             }
-            let towards = LightSample {
-                wi: dir,
-                distance: d,
-                incident: DVec3::ZERO,
-            };
-            if !scene.occluded_from_hit(at.hit, usize::MAX, &towards) {
+            if !scene.occluded_between(at.hit, dir, d) {
                 sum += value;
             }
         }

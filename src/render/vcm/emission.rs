@@ -12,6 +12,18 @@ use crate::render::vcm::state::Subpath;
 use crate::render::wavelength::Wavelength;
 use crate::scene::light::{spot_falloff, Light};
 
+/// The chance of each of `count` lights to be picked: every light equally likely, for
+/// emission and light sampling alike.
+pub fn pick_chance(count: usize) -> f64 {
+    1.0 / count as f64
+}
+
+/// The light the uniform number `u` picks ([`pick_chance`]) and its chance; `None` without
+/// lights.
+pub fn pick_light(count: usize, u: f64) -> Option<(usize, f64)> {
+    (count > 0).then(|| (((u * count as f64) as usize).min(count - 1), pick_chance(count)))
+}
+
 /// An area light's area and its unit normal at its surface point `on` (`None` for point and
 /// spot lights, which have neither).
 pub fn area_and_normal(light: &Light, on: DVec3) -> Option<(f64, DVec3)> {

@@ -8,13 +8,12 @@ use rand::Rng;
 use rand_pcg::Pcg64Mcg;
 
 use super::camera_link::link;
-use super::emission::{direct_pdf_area, emit};
+use super::emission::{direct_pdf_area, emit, pick_light};
 use super::state::Subpath;
 use super::{mis, PassConstants};
 use crate::geometry::Hit;
 use crate::render::bsdf::Bsdf;
 use crate::render::ppm::{HashGrid, SearchSphere};
-use crate::scene::light::LightSample;
 use crate::scene::{Scene, Surface};
 
 /// A light subpath's vertex on a surface with a smooth part. A pass keeps one per pixel or
@@ -80,12 +79,10 @@ pub struct LightPath {
 /// the subpath leaves the scene, is absorbed, or could reach no further technique.
 pub fn trace(scene: &Scene, k: &PassConstants, target: Option<(DVec3, f64)>, mut rng: Pcg64Mcg) -> LightPath {
     let mut out = LightPath::default();
-    let count = scene.lights.len();
-    if count == 0 {
+    let Some((index, pick)) = pick_light(scene.lights.len(), rng.random()) else {
         return out;
-    }
-    let pick = 1.0 / count as f64;
-    let light = &scene.lights[((rng.random::<f64>() * count as f64) as usize).min(count - 1)];
+    };
+    let light = &scene.lights[index];
     let u = [rng.random(), rng.random(), rng.random(), rng.random()];
     let Some(emitted) = emit(light, pick, u, target, k) else {
         return out;
@@ -181,13 +178,7 @@ fn to_camera(
     if !value.is_finite() || value == DVec3::ZERO {
         return None;
     }
-    let towards = LightSample {
-        wi: wc,
-        distance: link.distance,
-        incident: DVec3::ZERO,
-    };
-    // No light's surface is exempt: the lens is not a light.
-    if scene.occluded_from_hit(hit, usize::MAX, &towards) {
+    if scene.occluded_between(hit, wc, link.distance) {
         return None;
     }
     Some((link.pixel as u32, value))

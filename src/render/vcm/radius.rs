@@ -1,8 +1,9 @@
-//! The merging radius a render starts from when the scene does not set one: the rule photon
-//! mapping uses (`crate::render::ppm`'s automatic radius), twice the footprint of one pixel
-//! at the median distance of what the camera sees, measured here on the first surfaces met
-//! by rays through a grid of pixel centres.
+//! The merging radius a render starts from when the scene does not set one: photon mapping's
+//! rule ([`footprint_radius`]: twice the footprint of one pixel at the median distance of
+//! what the camera sees), measured here on the first surfaces met by rays through a grid of
+//! pixel centres.
 
+use crate::render::ppm::footprint_radius;
 use crate::scene::Scene;
 
 /// Rays traced along each side of the grid, at most.
@@ -26,11 +27,5 @@ pub fn automatic_radius(scene: &Scene) -> f64 {
             }
         }
     }
-    if distances.is_empty() {
-        return 1e-3;
-    }
-    let mid = distances.len() / 2;
-    let median = *distances.select_nth_unstable_by(mid, f64::total_cmp).1;
-    let pixel = 2.0 * (0.5 * camera.fov_y).tan() / camera.height as f64;
-    (2.0 * median * pixel).max(1e-9)
+    footprint_radius(&mut distances, camera)
 }
