@@ -2,15 +2,16 @@
 //! renders with different seeds differ by `√2` times one render's noise. On three scenes, pool
 //! among them (whose error comes from rare bright paths, where comparing consecutive frames
 //! said a fifth of the truth), at 160 pixels wide with the photons per pass scaled with the
-//! pixels, as the viewer renders them (measured: 1.20 and 1.39 times on pool after 16 and 64
-//! passes, 0.91 and 0.80 on cornell, 1.11 and 1.02 on ring).
+//! pixels, as the viewer renders them. Where the error is in a few pixels (pool's), one
+//! frame's noise is itself a matter of luck: there the estimate must say it is uncertain, and
+//! only there.
 
 use std::path::Path;
 use std::sync::Arc;
 
 use caustic::bench::estimate::scaled;
 use caustic::render::error::mean_squares;
-use caustic::render::error_tracker::ErrorTracker;
+use caustic::render::error_tracker::{effective_pixels, ErrorEstimate, ErrorTracker, FEW_PIXELS};
 use caustic::render::session::state::INTERACTIVE_FIRST_PASS_PHOTONS;
 use caustic::render::session::SessionOptions;
 use caustic::run::render_session;
@@ -18,8 +19,8 @@ use caustic::scene::Scene;
 
 const PASSES: [u32; 2] = [16, 64];
 
-/// A frame and the tracker's estimate of its noise.
-type Estimated = (Arc<[[f32; 3]]>, Option<f64>);
+/// A frame and the tracker's estimate of its error.
+type Estimated = (Arc<[[f32; 3]]>, Option<ErrorEstimate>);
 
 /// The frames after [`PASSES`] of `scene` with `seed`, and the tracker's estimate at each.
 fn frames(mut scene: Scene, seed: u64) -> Vec<Estimated> {
@@ -43,7 +44,8 @@ fn frames(mut scene: Scene, seed: u64) -> Vec<Estimated> {
 }
 
 #[test]
-fn the_noise_estimate_is_within_1_5_times_the_measured_noise() {
+fn the_noise_estimate_is_within_1_5_times_the_measured_noise_or_says_it_is_uncertain() {
+    let mut uncertain = Vec::new();
     for name in ["pool", "cornell", "ring"] {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("scenes/{name}.toml"));
         let scene = scaled(Scene::load(&path).expect("loads"), 160);
@@ -53,12 +55,27 @@ fn the_noise_estimate_is_within_1_5_times_the_measured_noise() {
             // Two seeds' frames differ by √2 times one frame's noise.
             let (diff2, norm2) = mean_squares(fb, fa);
             let noise = (diff2 / 2.0 / norm2).sqrt();
+            let measured_pixels = effective_pixels(fa, fb);
             let estimate = estimate.expect("estimated");
-            let ratio = estimate / noise;
-            assert!(
-                (1.0 / 1.5..=1.5).contains(&ratio),
-                "{name} after {pass} passes: estimate {estimate:.4} against measured noise {noise:.4} ({ratio:.2}x)"
+            let ratio = estimate.noise / noise;
+            let what = format!(
+                "{name} after {pass} passes: estimate {:.4} on {:.0} pixels against measured noise {noise:.4} on {measured_pixels:.0} ({ratio:.2}x)",
+                estimate.noise, estimate.pixels
             );
+            if estimate.uncertain() {
+                // Said only where the measured noise, too, is in a few pixels.
+                assert!(measured_pixels < FEW_PIXELS, "{what}");
+                uncertain.push(what);
+            } else {
+                assert!((1.0 / 1.5..=1.5).contains(&ratio), "{what}");
+            }
         }
     }
+    // Ring's noise is spread over a thousand pixels; pool's, after 64 passes, is in two
+    // (measured 2 for both the estimate and the two seeds).
+    assert!(uncertain.iter().all(|w| !w.starts_with("ring")), "{uncertain:?}");
+    assert!(
+        uncertain.iter().any(|w| w.starts_with("pool after 64")),
+        "{uncertain:?}"
+    );
 }

@@ -558,6 +558,41 @@ fn window_snapshot_with_a_fixed_frame() {
     h.snapshot(common::gpu::snapshot_name("viewer_window", backend));
 }
 
+/// Frames that differ only in one bright pixel: the plot's estimate says it is uncertain and
+/// why (the error is in about one pixel), and draws those estimates as points; frames that
+/// differ alike everywhere get no such note.
+#[test]
+fn an_estimate_resting_on_a_few_pixels_says_so() {
+    for speck in [true, false] {
+        let mut h = window(egui::Vec2::new(1180.0, 760.0));
+        let mut v = Viewer::with_pause(&h.ctx, ball(), ViewerSettings::default(), true);
+        for (k, mut f) in fixed_frames().into_iter().enumerate() {
+            let pixels = f.radiance.len();
+            f.radiance = (0..pixels)
+                .map(|p| {
+                    let noise = if speck {
+                        if p == pixels / 2 {
+                            50.0 / (k + 1) as f32
+                        } else {
+                            0.0
+                        }
+                    } else {
+                        0.1 * ((p * 7 + k * 13) % 5) as f32 / (k + 1) as f32
+                    };
+                    [0.5 + noise; 3]
+                })
+                .collect();
+            v.show_frame(f);
+        }
+        *h.state_mut() = Some(v);
+        h.run_steps(3);
+        let noted = h.query_by_label_contains("uncertain: in ~1 pixels").is_some();
+        assert_eq!(noted, speck, "speck {speck}: the note is shown: {noted}");
+        let points = viewer(&h).convergence().uncertain_points.len();
+        assert_eq!(points > 0, speck, "speck {speck}: {points} uncertain points");
+    }
+}
+
 /// Storage as eframe hands it to the app: string values by key.
 #[derive(Default)]
 struct MemoryStorage(std::collections::HashMap<String, String>);

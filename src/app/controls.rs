@@ -2,7 +2,7 @@
 //! [`Action`]s; a control edits a copy of a value and asks for the new one.
 
 use egui::{Color32, RichText};
-use egui_plot::{Line, Plot, PlotPoints};
+use egui_plot::{Line, Plot, PlotPoints, Points};
 
 use super::action::Action;
 use super::commands::{self, Menu};
@@ -10,7 +10,6 @@ use super::params::{PanelParams, Ranges};
 use super::setting_ui;
 use super::settings::DisplayMode;
 use super::state::{Status, ViewerState};
-use crate::render::error_tracker::total_error;
 use crate::scene::RendererKind;
 
 /// Seconds as `1.23 s` or `4 min 05 s`.
@@ -342,6 +341,9 @@ fn statistics_ui(viewer: &ViewerState, ui: &mut egui::Ui) {
     }
 }
 
+/// The colour of an uncertain estimate on the plot and its note (amber).
+const UNCERTAIN: Color32 = Color32::from_rgb(235, 170, 60);
+
 /// The error against time (log scale): the estimate from the render's own frames
 /// ([`crate::render::error_tracker`]) and, with a reference open, the true RMSE and relative
 /// MSE against it.
@@ -360,12 +362,9 @@ fn convergence_plot_ui(viewer: &ViewerState, ui: &mut egui::Ui) {
         let points = &viewer.convergence.reference_points;
         points.iter().map(|p| [p[0], log(p[k])]).collect()
     };
-    let estimate: Vec<[f64; 2]> = viewer
-        .convergence
-        .points
-        .iter()
-        .map(|[t, e]| [*t, log(*e)])
-        .collect();
+    let logged =
+        |points: &[[f64; 2]]| -> Vec<[f64; 2]> { points.iter().map(|[t, e]| [*t, log(*e)]).collect() };
+    let estimate = logged(&viewer.convergence.points);
     let mut plot = Plot::new("caustic-convergence")
         .height(if with_reference { 150.0 } else { 120.0 })
         .allow_zoom(false)
@@ -377,23 +376,25 @@ fn convergence_plot_ui(viewer: &ViewerState, ui: &mut egui::Ui) {
     } else {
         plot.y_axis_formatter(|mark, _| percent(10f64.powf(mark.value)))
     };
+    let uncertain = logged(&viewer.convergence.uncertain_points);
     plot.show(ui, |plot| {
         plot.line(Line::new(
             "estimated error (relative)",
             PlotPoints::from(estimate),
         ));
+        if !uncertain.is_empty() {
+            plot.points(
+                Points::new("uncertain: a few pixels", PlotPoints::from(uncertain))
+                    .color(UNCERTAIN)
+                    .radius(2.0),
+            );
+        }
         if with_reference {
             plot.line(Line::new("RMSE", PlotPoints::from(series(1))));
             plot.line(Line::new("relative MSE", PlotPoints::from(series(2))));
         }
     });
-    if let Some((noise, blur)) = viewer.convergence.latest() {
-        let now = percent(total_error(noise, blur));
-        ui.label(match blur {
-            Some(blur) => format!("now {now} (noise {}, blur {})", percent(noise), percent(blur)),
-            None => format!("now {now} (noise)"),
-        });
-    }
+    latest_estimate_ui(viewer, ui);
     if let Some(e) = viewer.reference_errors() {
         ui.label(format!(
             "against the reference: RMSE {:.3e}, relative MSE {:.3e}",
@@ -408,6 +409,26 @@ fn convergence_plot_ui(viewer: &ViewerState, ui: &mut egui::Ui) {
             .small(),
         );
     }
+}
+
+/// The newest estimate in words: its noise and blur, and a note where it is uncertain.
+fn latest_estimate_ui(viewer: &ViewerState, ui: &mut egui::Ui) {
+    let Some(e) = viewer.convergence.latest() else {
+        return;
+    };
+    let now = percent(e.total());
+    ui.horizontal_wrapped(|ui| {
+        ui.label(match e.blur {
+            Some(blur) => format!("now {now} (noise {}, blur {})", percent(e.noise), percent(blur)),
+            None => format!("now {now} (noise)"),
+        });
+        if e.uncertain() {
+            ui.colored_label(UNCERTAIN, format!("uncertain: in ~{:.0} pixels", e.pixels.max(1.0)))
+                .on_hover_text(
+                    "The error is in a few bright pixels (bright specks that come and go: a light seen in a pixel's corner, rare caustic paths), so this frame's true error may be far from the estimate either way",
+                );
+        }
+    });
 }
 
 /// Help, scene error, renderer failure, overwrite and unsaved-edits windows.

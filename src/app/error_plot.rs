@@ -6,7 +6,7 @@
 use std::sync::Arc;
 
 use crate::render::compare::ReferenceErrors;
-use crate::render::error_tracker::{total_error, ErrorTracker};
+use crate::render::error_tracker::{ErrorEstimate, ErrorTracker};
 
 /// Error estimates of one epoch against time.
 #[derive(Clone, Default)]
@@ -15,8 +15,11 @@ pub struct Convergence {
     /// `(elapsed seconds, estimated relative RMS error)` per frame after the first: the
     /// noise, and from the third frame on the blur with it (`√(noise² + blur²)`).
     pub points: Vec<[f64; 2]>,
-    /// The newest estimate's parts: the noise, and the blur once three frames are held.
-    latest: Option<(f64, Option<f64>)>,
+    /// Those of [`Convergence::points`] whose estimate is uncertain
+    /// ([`ErrorEstimate::uncertain`]: the error is in a few pixels).
+    pub uncertain_points: Vec<[f64; 2]>,
+    /// The newest estimate.
+    latest: Option<ErrorEstimate>,
     /// `(elapsed seconds, RMSE, relative MSE)` against the reference, per frame since it was
     /// opened.
     pub reference_points: Vec<[f64; 3]>,
@@ -31,10 +34,12 @@ impl Convergence {
     /// Takes a frame of the current epoch made from `photons` photons with photon mapping's
     /// `alpha` (1 for a path tracer's plain means).
     pub fn add(&mut self, photons: u64, elapsed_secs: f64, radiance: &Arc<[[f32; 3]]>, alpha: f64) {
-        if let Some(noise) = self.tracker.add(photons, radiance, alpha) {
-            let blur = self.tracker.blur();
-            self.points.push([elapsed_secs, total_error(noise, blur)]);
-            self.latest = Some((noise, blur));
+        if let Some(estimate) = self.tracker.add(photons, radiance, alpha) {
+            self.points.push([elapsed_secs, estimate.total()]);
+            if estimate.uncertain() {
+                self.uncertain_points.push([elapsed_secs, estimate.total()]);
+            }
+            self.latest = Some(estimate);
         }
     }
 
@@ -49,9 +54,8 @@ impl Convergence {
         self.reference_points.clear();
     }
 
-    /// The newest estimate's noise, and its blur (`None` before the third frame, or for plain
-    /// means).
-    pub fn latest(&self) -> Option<(f64, Option<f64>)> {
+    /// The newest estimate.
+    pub fn latest(&self) -> Option<ErrorEstimate> {
         self.latest
     }
 }

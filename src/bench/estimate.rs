@@ -17,7 +17,7 @@ use super::convergence::reference;
 use super::output::BenchOutput;
 use crate::args::Threads;
 use crate::render::error::{mean_squares, relative_error_estimate};
-use crate::render::error_tracker::{total_error, ErrorTracker};
+use crate::render::error_tracker::{effective_pixels, ErrorEstimate, ErrorTracker};
 use crate::render::session::state::INTERACTIVE_FIRST_PASS_PHOTONS;
 use crate::render::session::SessionOptions;
 use crate::run::render_session;
@@ -53,19 +53,30 @@ pub struct EstimateCheck {
     pub pass: u32,
     /// `RMS(L − reference) / RMS(reference)`.
     pub truth: f64,
+    /// The effective number of pixels the true error is in ([`effective_pixels`] of the
+    /// frame and the reference).
+    pub truth_pixels: f64,
     /// [`ErrorTracker`]'s estimate.
-    pub estimate: Option<f64>,
-    /// [`ErrorTracker::blur`].
-    pub blur: Option<f64>,
+    pub estimate: Option<ErrorEstimate>,
     /// The previous frame's comparison (one pass apart).
     pub consecutive: Option<f64>,
 }
 
 impl EstimateCheck {
-    /// The noise and the blur together, `√(noise² + blur²)` (the noise alone without a blur
-    /// estimate).
-    pub fn total(&self) -> Option<f64> {
-        self.estimate.map(|n| total_error(n, self.blur))
+    /// The estimate (noise and blur) over the truth.
+    pub fn ratio(&self) -> Option<f64> {
+        self.estimate.map(|e| e.total() / self.truth)
+    }
+
+    /// What the check found: `within` (the estimate within 1.5 times the truth either way),
+    /// `uncertain` (the estimate says it rests on few pixels), `off`, or `none` (no estimate).
+    pub fn verdict(&self) -> &'static str {
+        match (self.estimate, self.ratio()) {
+            (Some(_), Some(r)) if (1.0 / 1.5..=1.5).contains(&r) => "within",
+            (Some(e), _) if e.uncertain() => "uncertain",
+            (Some(_), _) => "off",
+            (None, _) => "none",
+        }
     }
 }
 
@@ -95,7 +106,6 @@ pub fn check_estimates(scene: Scene, passes: &[u32], reference: &[[f32; 3]]) -> 
     let mut out = Vec::new();
     render_session(scene, options, |f| {
         let estimate = tracker.add(f.photons, &f.radiance, alpha);
-        let blur = tracker.blur();
         let consecutive = previous
             .as_ref()
             .and_then(|(n, a)| relative_error_estimate(*n, a, f.photons, &f.radiance));
@@ -105,8 +115,8 @@ pub fn check_estimates(scene: Scene, passes: &[u32], reference: &[[f32; 3]]) -> 
             out.push(EstimateCheck {
                 pass: f.pass,
                 truth: (diff2 / norm2).sqrt(),
+                truth_pixels: effective_pixels(&f.radiance, reference),
                 estimate,
-                blur,
                 consecutive,
             });
         }
@@ -127,7 +137,7 @@ pub fn bench_estimate(args: EstimateArgs, out: &mut BenchOutput) -> Result<()> {
         args.scenes.clone()
     };
     out.say(
-        "scene  pass  true  noise (ratio)  blur (ratio)  noise and blur (ratio)  consecutive frames (ratio)"
+        "scene  pass  true (pixels)  noise (ratio)  blur (ratio)  noise and blur (ratio, pixels)  verdict  consecutive frames (ratio)"
             .to_string(),
     );
     for path in &scenes {
@@ -146,14 +156,24 @@ pub fn bench_estimate(args: EstimateArgs, out: &mut BenchOutput) -> Result<()> {
                     format!("{:.2} % ({:.2}x)", 100.0 * e, e / c.truth)
                 })
             };
+            let total = c.estimate.map_or("-".into(), |e| {
+                format!(
+                    "{:.2} % ({:.2}x, {:.0})",
+                    100.0 * e.total(),
+                    e.total() / c.truth,
+                    e.pixels
+                )
+            });
             out.say(format!(
-                "{}  {}  {:.2} %  {}  {}  {}  {}",
+                "{}  {}  {:.2} % ({:.0})  {}  {}  {}  {}  {}",
                 path.display(),
                 c.pass,
                 100.0 * c.truth,
-                show(c.estimate),
-                show(c.blur),
-                show(c.total()),
+                c.truth_pixels,
+                show(c.estimate.map(|e| e.noise)),
+                show(c.estimate.and_then(|e| e.blur)),
+                total,
+                c.verdict(),
                 show(c.consecutive)
             ));
             let name = path
@@ -165,9 +185,12 @@ pub fn bench_estimate(args: EstimateArgs, out: &mut BenchOutput) -> Result<()> {
                     "scene": name,
                     "pass": c.pass,
                     "truth": c.truth,
-                    "estimate": c.estimate,
-                    "blur": c.blur,
-                    "total": c.total(),
+                    "truth_pixels": c.truth_pixels,
+                    "estimate": c.estimate.map(|e| e.noise),
+                    "blur": c.estimate.and_then(|e| e.blur),
+                    "total": c.estimate.map(|e| e.total()),
+                    "pixels": c.estimate.map(|e| e.pixels),
+                    "verdict": c.verdict(),
                     "consecutive": c.consecutive,
                 }),
             );
