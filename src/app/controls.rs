@@ -425,7 +425,7 @@ fn latest_estimate_ui(viewer: &ViewerState, ui: &mut egui::Ui) {
         if e.uncertain() {
             ui.colored_label(UNCERTAIN, format!("uncertain: in ~{:.0} pixels", e.pixels.max(1.0)))
                 .on_hover_text(
-                    "The error is in a few bright pixels (bright specks that come and go: a light seen in a pixel's corner, rare caustic paths), so this frame's true error may be far from the estimate either way",
+                    "The error is in a few pixels (bright specks that come and go: a light seen in a pixel's corner, rare caustic paths, a focus a few pixels wide), so this frame's true error may be far from the estimate either way",
                 );
         }
     });
