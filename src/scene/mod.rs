@@ -147,7 +147,7 @@ impl Scene {
         if !old.can_become(&light) {
             return false;
         }
-        if let Some(object) = self.light_objects.get(k).copied().flatten() {
+        if let Some(object) = self.light_surface(k) {
             let moved = match light {
                 Light::Sphere { center, radius, .. } => self
                     .geometry
@@ -192,15 +192,15 @@ impl Scene {
     /// [`light::LightSample::shadow_ray`], passing the light's own surface.
     pub fn occluded_from(&self, point: DVec3, normal: DVec3, light: usize, ls: &light::LightSample) -> bool {
         let (ray, reach) = ls.shadow_ray(point, normal);
-        self.shadow_ray_blocked(&ray, reach, light)
+        self.geometry
+            .occluded_except(&ray, reach, self.light_surface(light))
     }
 
     /// [`Scene::occluded_from`] the point of `hit`: the shadow ray also carries where it leaves
     /// a Bézier patch ([`Hit::departure`]), so the patch's leaves around that point need not
     /// find the ray's own crossing again.
     pub fn occluded_from_hit(&self, hit: &Hit, light: usize, ls: &light::LightSample) -> bool {
-        let own = self.light_objects.get(light).copied().flatten();
-        self.blocked_from_hit(hit, ls, own)
+        self.blocked_from_hit(hit, ls, self.light_surface(light))
     }
 
     /// Whether something lies between the point of `hit` and the point `distance` away along
@@ -222,11 +222,10 @@ impl Scene {
             .occluded_except(&ray.leaving(hit.departure(ls.wi)), reach, skip)
     }
 
-    /// Whether something but light `light`'s own surface lies on the shadow ray `ray` within
-    /// `reach`.
-    fn shadow_ray_blocked(&self, ray: &crate::geometry::Ray, reach: f64, light: usize) -> bool {
-        let own = self.light_objects.get(light).copied().flatten();
-        self.geometry.occluded_except(ray, reach, own)
+    /// The object that is light `light`'s visible surface, which its own shadow rays pass
+    /// (`None` for point and spot lights, or no such light).
+    fn light_surface(&self, light: usize) -> Option<u32> {
+        self.light_objects.get(light).copied().flatten()
     }
 
     /// What the scene contains, for skipping work it does not need.
