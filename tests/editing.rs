@@ -444,7 +444,7 @@ fn overlay_app<'a>(yaw: f64) -> (App<'a>, &'static str) {
     scene.camera = turned(&scene.camera, yaw);
     let mut v = Viewer::with_pause(&h.ctx, scene, ViewerSettings::default(), true);
     // egui_kittest's render pass has no depth attachment.
-    v.install_overlay(&render_state, None);
+    v.install_wgpu(&render_state, None);
     v.show_frame(teapot_frame());
     v.settings.exposure_stops = 1.0;
     *h.state_mut() = Some(v);
@@ -455,6 +455,51 @@ fn overlay_app<'a>(yaw: f64) -> (App<'a>, &'static str) {
     h.key_press(egui::Key::A);
     h.run_steps(3);
     (h, backend)
+}
+
+/// The teapot frame in the window, the overlay hidden, its image drawn by the wgpu image
+/// pipeline (`wgpu`) or by egui's own image path.
+fn rendered_window(wgpu: bool) -> image::RgbaImage {
+    let (render_state, _) = common::gpu::render_state();
+    let renderer = egui_kittest::wgpu::WgpuTestRenderer::from_render_state(render_state.clone());
+    let mut h = harness(Harness::builder().renderer(renderer));
+    let settings = ViewerSettings {
+        show_wireframe: false,
+        ..ViewerSettings::default()
+    };
+    let mut v = Viewer::with_pause(&h.ctx, teapot(), settings, true);
+    if wgpu {
+        v.install_wgpu(&render_state, None);
+    }
+    v.show_frame(teapot_frame());
+    v.settings.exposure_stops = 1.0;
+    *h.state_mut() = Some(v);
+    h.run_steps(2);
+    h.render().expect("the window renders")
+}
+
+/// The wgpu image pipeline draws the picture egui's image path draws: the same pixels, in the
+/// same place, in the same colours (both magnify by nearest texel; a pixel may differ by a
+/// level of rounding, or where the two put a texel's edge).
+#[test]
+fn the_wgpu_image_is_the_image_egui_draws() {
+    let (ours, egui) = (rendered_window(true), rendered_window(false));
+    assert_eq!(ours.dimensions(), egui.dimensions());
+    let differing = ours
+        .pixels()
+        .zip(egui.pixels())
+        .filter(|(a, b)| a.0.iter().zip(b.0).any(|(x, y)| x.abs_diff(y) > 2))
+        .count();
+    let total = (ours.width() * ours.height()) as usize;
+    assert!(
+        differing * 200 < total,
+        "{differing} of {total} pixels differ by more than 2 levels"
+    );
+    // The picture is there: the teapot frame is not the window's bare background.
+    let (w, h) = ours.dimensions();
+    let centre = ours.get_pixel(w * 3 / 8, h / 2).0;
+    let background = ours.get_pixel(w * 3 / 8, 3).0;
+    assert_ne!(centre, background, "no image where the image should be");
 }
 
 #[test]

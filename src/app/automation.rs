@@ -282,6 +282,8 @@ pub struct Automation {
     drags: Vec<DragFigures>,
     /// Exit status for the process (non-zero when the run failed).
     pub failed: Option<String>,
+    /// Whether the window's frames are paced while an edit waits ([`super::pacing`]).
+    pub paced: bool,
 }
 
 impl Automation {
@@ -297,6 +299,7 @@ impl Automation {
             latencies: Vec::new(),
             drags: Vec::new(),
             failed: None,
+            paced: false,
         })
     }
 
@@ -474,6 +477,16 @@ impl Automation {
         if let Some(t) = self.first_image_secs {
             println!("  launch to first image:        {:.0} ms", t * 1e3);
         }
+        println!(
+            "  UI frames while an edit waits for its image: {}",
+            match self.paced {
+                true => format!(
+                    "at most one per {} ms (the window is painted on the CPU)",
+                    super::pacing::EDIT_FRAME_INTERVAL.as_millis()
+                ),
+                false => "not paced (the window is painted on a GPU)".to_owned(),
+            }
+        );
         if let Some((fps, worst, ui)) = self.fps {
             println!(
                 "  UI frame rate while rendering: {fps:.1} fps (slowest frame {:.0} ms; the viewer's own UI code {:.1} ms per frame)",

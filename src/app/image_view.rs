@@ -1,11 +1,14 @@
 //! The central image: the render's texture placed by fit / 1:1 / wheel zoom / drag pan, and
 //! the pixel under the cursor for the probe.
 
+use std::sync::Arc;
+
 use egui::{Color32, ColorImage, Pos2, Rect, Sense, TextureHandle, TextureOptions, Vec2};
 
 use super::difference::{difference_bytes, DifferenceKind, Legend};
 use super::false_colour::false_colour_image;
 use super::settings::{DisplayMode, Zoom};
+use crate::gpu::image_quad::{ImageCallback, ImagePixels, ImageUniforms};
 use crate::render::film::srgb8;
 use crate::render::session::Frame;
 use crate::render::Image;
@@ -17,7 +20,13 @@ pub const MAX_SCALE: f32 = 64.0;
 
 /// Texture and placement of the displayed image.
 pub struct ImageView {
+    /// The image as an egui texture (where the wgpu image pipeline is not installed).
     texture: Option<TextureHandle>,
+    /// The image's pixels for the wgpu image pipeline ([`crate::gpu::image_quad`]), with their
+    /// generation, once [`ImageView::draw_with_wgpu`] chose it.
+    pixels: Option<(Arc<ImagePixels>, u64)>,
+    /// Whether the image is drawn by the wgpu image pipeline.
+    wgpu: bool,
     /// Offset of the image centre from the view centre, in points (used with [`Zoom::Scale`]).
     pan: Vec2,
     /// Set when the texture must be rebuilt (new frame, exposure or display mode changed).
@@ -53,6 +62,8 @@ impl Default for ImageView {
     fn default() -> Self {
         Self {
             texture: None,
+            pixels: None,
+            wgpu: false,
             pan: Vec2::ZERO,
             dirty: true,
             legend: None,
@@ -177,6 +188,19 @@ impl ImageView {
         self.dirty = true;
     }
 
+    /// Draws the image with the wgpu image pipeline from now on (once
+    /// [`crate::gpu::image_quad::install`] has set it up for the window's renderer).
+    pub fn draw_with_wgpu(&mut self) {
+        self.wgpu = true;
+        self.texture = None;
+        self.dirty = true;
+    }
+
+    /// Whether there is an image to draw.
+    fn has_image(&self) -> bool {
+        self.texture.is_some() || self.pixels.is_some()
+    }
+
     /// Rebuilds the texture from `frame` if it is stale.
     pub fn update_texture(
         &mut self,
@@ -186,11 +210,25 @@ impl ImageView {
         exposure: f32,
         comparison: Comparison,
     ) {
-        if !self.dirty && self.texture.is_some() {
+        if !self.dirty && self.has_image() {
             return;
         }
         let (bytes, legend) = display_bytes(frame, mode, exposure, comparison);
         self.legend = legend;
+        self.dirty = false;
+        if self.wgpu {
+            let rgba = bytes
+                .chunks_exact(3)
+                .flat_map(|p| [p[0], p[1], p[2], 255])
+                .collect();
+            let pixels = ImagePixels {
+                size: [frame.width, frame.height],
+                rgba,
+            };
+            let generation = self.pixels.as_ref().map_or(0, |(_, g)| g + 1);
+            self.pixels = Some((Arc::new(pixels), generation));
+            return;
+        }
         let image = ColorImage::from_rgb([frame.width as usize, frame.height as usize], &bytes);
         // Nearest when magnified, so zoomed-in pixels stay crisp for the probe.
         let options = TextureOptions {
@@ -201,7 +239,6 @@ impl ImageView {
             Some(t) => t.set(image, options),
             None => self.texture = Some(ctx.load_texture("caustic-render", image, options)),
         }
-        self.dirty = false;
     }
 
     /// Image pixels per point for `zoom` in a view of `view` points.
@@ -253,7 +290,7 @@ impl ImageView {
         // pays for every covered pixel, and a full backdrop under the image cost as much as
         // the image itself.
         let painter = ui.painter_at(rect);
-        let covered = if self.texture.is_some() {
+        let covered = if self.has_image() {
             image_rect
         } else {
             Rect::NOTHING
@@ -264,6 +301,14 @@ impl ImageView {
         if let Some(texture) = &self.texture {
             let uv = Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0));
             painter.image(texture.id(), image_rect, uv, Color32::WHITE);
+        }
+        if let Some((pixels, generation)) = &self.pixels {
+            let callback = ImageCallback {
+                uniforms: ImageUniforms::new(image_rect, rect),
+                pixels: pixels.clone(),
+                generation: *generation,
+            };
+            painter.add(eframe::egui_wgpu::Callback::new_paint_callback(rect, callback));
         }
         let probe = response
             .hover_pos()

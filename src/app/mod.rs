@@ -51,6 +51,7 @@ pub mod light_markers;
 pub mod material_panel;
 pub mod navigate;
 pub mod overlay;
+pub mod pacing;
 pub mod params;
 pub mod reference;
 mod reference_files;
@@ -81,12 +82,17 @@ pub struct CausticApp {
     /// The viewer.
     pub viewer: Viewer,
     automation: Option<Automation>,
+    /// Paces frames while an edit waits for its image, where the window is painted on the CPU.
+    pacer: pacing::FramePacer,
     /// Set when a scripted run failed (read after the window closed).
     failure: std::sync::Arc<std::sync::Mutex<Option<String>>>,
 }
 
 impl eframe::App for CausticApp {
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        let viewer = &self.viewer;
+        let pending = viewer.restart_pending() && !viewer.paused();
+        self.pacer.wait(pending, || viewer.frame_waiting());
         let start = std::time::Instant::now();
         self.viewer.ui(ui);
         let ui_secs = start.elapsed().as_secs_f64();
@@ -151,7 +157,7 @@ pub fn run(scene_path: Option<PathBuf>, mut launch: LaunchOptions) -> anyhow::Re
             let mut viewer = Viewer::new(&cc.egui_ctx, scene, settings);
             if let Some(render_state) = &cc.wgpu_render_state {
                 // eframe's default `depth_buffer: 0` gives egui's pass no depth attachment.
-                viewer.install_overlay(render_state, None);
+                viewer.install_wgpu(render_state, None);
             }
             if let Some(e) = error {
                 viewer.report_launch_failure(e);
@@ -162,9 +168,15 @@ pub fn run(scene_path: Option<PathBuf>, mut launch: LaunchOptions) -> anyhow::Re
             if let Some(dir) = watch {
                 viewer.watch_folder(dir);
             }
+            let software = cc.wgpu_render_state.as_ref().is_some_and(pacing::paints_on_cpu);
+            let mut automation = Automation::new(launch);
+            if let Some(a) = &mut automation {
+                a.paced = software;
+            }
             Ok(Box::new(CausticApp {
                 viewer,
-                automation: Automation::new(launch),
+                automation,
+                pacer: pacing::FramePacer::new(software),
                 failure: app_failure,
             }))
         }),

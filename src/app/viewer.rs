@@ -134,14 +134,17 @@ impl Viewer {
         }
     }
 
-    /// Draws the control-net overlay with wgpu from now on: sets its pipelines up in
-    /// `render_state` (eframe's, or a test's). `depth_format` must match the render pass's.
-    pub fn install_overlay(
+    /// Draws the image and the control-net overlay with wgpu from now on: sets their pipelines
+    /// up in `render_state` (eframe's, or a test's). `depth_format` must match the render
+    /// pass's.
+    pub fn install_wgpu(
         &mut self,
         render_state: &eframe::egui_wgpu::RenderState,
         depth_format: Option<eframe::wgpu::TextureFormat>,
     ) {
         crate::gpu::wireframe::install(render_state, depth_format, 1);
+        crate::gpu::image_quad::install(render_state, depth_format, 1);
+        self.image_view.draw_with_wgpu();
         self.overlay_installed = true;
     }
 

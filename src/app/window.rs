@@ -20,6 +20,11 @@ use super::view_input;
 use super::viewer::Viewer;
 
 impl Viewer {
+    /// Whether the render session has a frame the window has not taken yet.
+    pub fn frame_waiting(&self) -> bool {
+        !self.session.frames().is_empty()
+    }
+
     /// Takes new frames, failures and finished jobs; call once per UI frame.
     pub fn poll(&mut self) {
         // Newest frame of the newest epoch.
