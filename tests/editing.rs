@@ -502,6 +502,43 @@ fn the_wgpu_image_is_the_image_egui_draws() {
     assert_ne!(centre, background, "no image where the image should be");
 }
 
+/// On a window cleared to the panels' colour, the menu bar, the status bar and the side panel
+/// paint no fill: no rectangle of the panels' colour is a bar across the window or a panel down
+/// it (without it, the bars' and the panel's fills are there).
+#[test]
+fn panels_on_the_clear_colour_paint_no_fill() {
+    let fills = |on_clear: bool| {
+        let mut h = harness(Harness::builder());
+        let mut v = Viewer::with_pause(&h.ctx, teapot(), ViewerSettings::default(), true);
+        if on_clear {
+            v.panels_on_clear_colour();
+        }
+        v.show_frame(flat_frame());
+        *h.state_mut() = Some(v);
+        h.run_steps(2);
+        let fill = h.ctx.global_style().visuals.panel_fill;
+        let screen = h.ctx.content_rect();
+        let shapes = &h.output().shapes;
+        // The harness's own background is the one fill that covers (nearly) the whole window.
+        let panel_fills = shapes.iter().filter(|c| match &c.shape {
+            egui::Shape::Rect(r) => {
+                let (w, h) = (r.rect.width(), r.rect.height());
+                let bar = w >= screen.width() * 0.9 && h < 60.0;
+                let side = h >= screen.height() * 0.8 && w < screen.width() / 2.0;
+                r.fill == fill && (bar || side)
+            }
+            _ => false,
+        });
+        panel_fills.count()
+    };
+    assert_eq!(fills(true), 0, "a panel painted its fill");
+    assert_eq!(
+        fills(false),
+        3,
+        "the menu bar, status bar and side panel fills were not found"
+    );
+}
+
 #[test]
 fn overlay_snapshot_over_the_teapot() {
     let (mut h, backend) = overlay_app(0.0);

@@ -104,6 +104,12 @@ impl eframe::App for CausticApp {
         }
     }
 
+    /// The panels' colour: the bars and the side panel are drawn on it without a fill of their
+    /// own ([`Viewer::panels_on_clear_colour`]).
+    fn clear_color(&self, visuals: &egui::Visuals) -> [f32; 4] {
+        visuals.panel_fill.to_normalized_gamma_f32()
+    }
+
     fn save(&mut self, storage: &mut dyn eframe::Storage) {
         eframe::set_value(storage, settings::STORAGE_KEY, &self.viewer.settings);
     }
@@ -159,6 +165,7 @@ pub fn run(scene_path: Option<PathBuf>, mut launch: LaunchOptions) -> anyhow::Re
                 // eframe's default `depth_buffer: 0` gives egui's pass no depth attachment.
                 viewer.install_wgpu(render_state, None);
             }
+            viewer.panels_on_clear_colour();
             if let Some(e) = error {
                 viewer.report_launch_failure(e);
             }

@@ -5,11 +5,12 @@
 //! cores it needs to make that image; at every other time, and on a real GPU, frames are not
 //! paced.
 //!
-//! Measured with `caustic view scenes/teapot.toml --bench` under Xvfb (lavapipe, 2 cores),
-//! the median drag step to its new image: 630–700 ms unpaced (the UI at 25 fps while dragging),
-//! 510–550 ms at 50 ms between frames (19 fps, the rate a drag had before the image got its
-//! own pipeline), 400 ms at 100 ms (11 fps); and 490–520 ms at 50 ms once a paced frame stops
-//! waiting when the image arrives.
+//! Why 50 ms: under Xvfb (lavapipe, 2 cores), `caustic view scenes/teapot.toml --bench`'s
+//! median drag step to its new image was 630–700 ms unpaced (the UI at 25 fps while dragging),
+//! 510–550 ms at 50 ms between frames (19 fps) and 400 ms at 100 ms (11 fps), with the panels
+//! still painting their fills; 50 ms keeps a drag's overlay at about 20 fps. With the panels on
+//! the clear colour ([`super::viewer::Viewer::panels_on_clear_colour`]) the step is 330–340 ms
+//! at 50 ms, the UI at 21 fps while dragging.
 
 use std::time::{Duration, Instant};
 

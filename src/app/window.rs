@@ -122,13 +122,19 @@ impl Viewer {
             );
         }
 
-        egui::Panel::top("caustic-menu").show(ui, |ui| controls::menu_ui(self, ui, &mut actions));
-        egui::Panel::bottom("caustic-status").show(ui, |ui| controls::status_ui(self, ui));
+        let frame = self.panel_frame(ui.style());
+        egui::Panel::top("caustic-menu")
+            .frame(frame)
+            .show(ui, |ui| controls::menu_ui(self, ui, &mut actions));
+        egui::Panel::bottom("caustic-status")
+            .frame(frame)
+            .show(ui, |ui| controls::status_ui(self, ui));
         if self.settings.show_side_panel {
             // The panel opens scrolled to its top: egui keeps a scroll position from the last
             // run, which would open the next with "Render" half hidden.
             let first = !std::mem::replace(&mut self.side_panel_shown, true);
             egui::Panel::right("caustic-controls")
+                .frame(frame)
                 .resizable(true)
                 .default_size(290.0)
                 .show(ui, |ui| {
@@ -166,6 +172,16 @@ impl Viewer {
     /// Whether a file dialog is showing inside the window (no native one could be shown).
     pub fn file_dialog_in_window(&self) -> bool {
         self.file_dialogs().any(FileDialog::in_window)
+    }
+
+    /// The frame of the bars and the side panel: egui's, without its fill where the window is
+    /// cleared to it ([`Viewer::panels_on_clear_colour`]).
+    fn panel_frame(&self, style: &egui::Style) -> egui::Frame {
+        let frame = egui::Frame::side_top_panel(style);
+        match self.panels_on_clear {
+            true => frame.fill(egui::Color32::TRANSPARENT),
+            false => frame,
+        }
     }
 
     /// The image, the control-net overlay over it, and the mouse.
