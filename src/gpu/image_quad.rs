@@ -15,6 +15,8 @@ use std::sync::Arc;
 use bytemuck::{Pod, Zeroable};
 use eframe::egui_wgpu::{self, wgpu};
 
+use super::target::{uniform_buffer, Target};
+
 /// The image's shader, validated by a naga test.
 pub const SHADER: &str = include_str!("../../shaders/image.wgsl");
 
@@ -75,22 +77,25 @@ pub fn install(
     msaa_samples: u32,
 ) {
     let device = &render_state.device;
-    let target = render_state.target_format;
+    let target = Target {
+        format: render_state.target_format,
+        depth_format,
+        msaa_samples,
+    };
     let layout = bind_group_layout(device);
-    let pipeline = pipeline(device, &layout, target, depth_format, msaa_samples);
+    let pipeline = pipeline(device, &layout, &target);
     let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
         label: Some("caustic image sampler"),
         mag_filter: wgpu::FilterMode::Nearest,
         min_filter: wgpu::FilterMode::Linear,
         ..Default::default()
     });
-    let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("caustic image uniforms"),
-        size: std::mem::size_of::<ImageUniforms>() as u64,
-        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let format = if target.is_srgb() {
+    let uniforms = uniform_buffer(
+        device,
+        "caustic image uniforms",
+        std::mem::size_of::<ImageUniforms>(),
+    );
+    let format = if target.format.is_srgb() {
         wgpu::TextureFormat::Rgba8UnormSrgb
     } else {
         wgpu::TextureFormat::Rgba8Unorm
@@ -146,13 +151,7 @@ fn bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
 }
 
 /// The opaque pipeline: no blending, never depth tested.
-fn pipeline(
-    device: &wgpu::Device,
-    layout: &wgpu::BindGroupLayout,
-    format: wgpu::TextureFormat,
-    depth_format: Option<wgpu::TextureFormat>,
-    msaa_samples: u32,
-) -> wgpu::RenderPipeline {
+fn pipeline(device: &wgpu::Device, layout: &wgpu::BindGroupLayout, target: &Target) -> wgpu::RenderPipeline {
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("caustic image shader"),
         source: wgpu::ShaderSource::Wgsl(SHADER.into()),
@@ -172,26 +171,13 @@ fn pipeline(
             buffers: &[],
         },
         primitive: wgpu::PrimitiveState::default(),
-        depth_stencil: depth_format.map(|format| wgpu::DepthStencilState {
-            format,
-            depth_write_enabled: Some(false),
-            depth_compare: Some(wgpu::CompareFunction::Always),
-            stencil: Default::default(),
-            bias: Default::default(),
-        }),
-        multisample: wgpu::MultisampleState {
-            count: msaa_samples.max(1),
-            ..Default::default()
-        },
+        depth_stencil: target.depth_stencil(),
+        multisample: target.multisample(),
         fragment: Some(wgpu::FragmentState {
             module: &module,
             entry_point: Some("fs_main"),
             compilation_options: Default::default(),
-            targets: &[Some(wgpu::ColorTargetState {
-                format,
-                blend: None,
-                write_mask: wgpu::ColorWrites::ALL,
-            })],
+            targets: &[Some(target.color(None))],
         }),
         multiview_mask: None,
         cache: None,

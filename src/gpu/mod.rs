@@ -2,4 +2,5 @@
 //! Built with the `viewer` feature; it depends on egui-wgpu, never on the viewer itself.
 
 pub mod image_quad;
+pub mod target;
 pub mod wireframe;

@@ -13,6 +13,8 @@ use std::sync::Arc;
 use bytemuck::{Pod, Zeroable};
 use eframe::egui_wgpu::{self, wgpu};
 
+use super::target::{uniform_buffer, Target};
+
 /// The overlay's shader, validated by a naga test.
 pub const SHADER: &str = include_str!("../../shaders/wireframe.wgsl");
 
@@ -137,13 +139,6 @@ pub fn install(
         });
 }
 
-/// What the overlay's pipelines draw into: egui's render pass.
-struct Target {
-    format: wgpu::TextureFormat,
-    depth_format: Option<wgpu::TextureFormat>,
-    msaa_samples: u32,
-}
-
 /// A pipeline drawing one screen-space quad per instance (a segment or a marker) with the
 /// vertex entry point `entry`, premultiplied-alpha blended, never depth tested.
 fn instanced_pipeline(
@@ -167,26 +162,15 @@ fn instanced_pipeline(
             })],
         },
         primitive: wgpu::PrimitiveState::default(),
-        depth_stencil: target.depth_format.map(|format| wgpu::DepthStencilState {
-            format,
-            depth_write_enabled: Some(false),
-            depth_compare: Some(wgpu::CompareFunction::Always),
-            stencil: Default::default(),
-            bias: Default::default(),
-        }),
-        multisample: wgpu::MultisampleState {
-            count: target.msaa_samples.max(1),
-            ..Default::default()
-        },
+        depth_stencil: target.depth_stencil(),
+        multisample: target.multisample(),
         fragment: Some(wgpu::FragmentState {
             module,
             entry_point: Some("fs_main"),
             compilation_options: Default::default(),
-            targets: &[Some(wgpu::ColorTargetState {
-                format: target.format,
-                blend: Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING),
-                write_mask: wgpu::ColorWrites::ALL,
-            })],
+            targets: &[Some(
+                target.color(Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING)),
+            )],
         }),
         multiview_mask: None,
         cache: None,
@@ -195,12 +179,11 @@ fn instanced_pipeline(
 
 /// The uniform buffer, its bind group layout and its bind group.
 fn uniform_binding(device: &wgpu::Device) -> (wgpu::Buffer, wgpu::BindGroupLayout, wgpu::BindGroup) {
-    let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("caustic wireframe uniforms"),
-        size: std::mem::size_of::<Uniforms>() as u64,
-        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
+    let uniforms = uniform_buffer(
+        device,
+        "caustic wireframe uniforms",
+        std::mem::size_of::<Uniforms>(),
+    );
     let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("caustic wireframe bind group layout"),
         entries: &[wgpu::BindGroupLayoutEntry {
