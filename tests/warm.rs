@@ -6,7 +6,7 @@
 use std::path::Path;
 use std::time::Duration;
 
-use caustic::render::ppm::{Control, Ppm, PpmOptions};
+use caustic::render::ppm::{Changed, Control, Ppm, PpmOptions};
 use caustic::render::session::{Command, Frame, RenderSession, SessionOptions};
 use caustic::scene::Scene;
 use glam::DVec3;
@@ -175,6 +175,129 @@ fn the_moved_sheet_takes_nearby_estimates_and_the_rest_is_kept() {
         assert!(kept > 0.5 && kept < 0.99, "antialias {antialias}: kept {kept}");
         assert!(nearby > 0.0, "antialias {antialias}: nearby {nearby}");
     }
+}
+
+/// `scenes/teapot.toml` (a Phong teapot in a box under a sphere light) at `width`, stochastic.
+fn teapot(width: u32) -> Scene {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/teapot.toml");
+    let mut scene = Scene::load(&path).expect("scenes/teapot.toml loads");
+    scene.camera.resize(Some(width), None);
+    scene.params.photons_per_pass = 20_000;
+    scene.params.antialias = true;
+    scene
+}
+
+/// Three passes of `scene`, then `edit` warm for two passes, told what the edit changed when
+/// `described`: the image and the share of pixels the first warm pass copied.
+fn warm_after(scene: &Scene, edit: &Scene, light_moved: bool, described: bool) -> (Vec<[f32; 3]>, f64) {
+    let mut old = Ppm::new(scene, options());
+    run(&mut old, scene, 3);
+    let mut kept = old.into_warm_start().expect("warm start");
+    if light_moved {
+        kept.light_moved(0);
+    }
+    if described {
+        kept.edited(Changed::edit(scene, edit));
+    }
+    let mut new = Ppm::new(edit, options());
+    new.inherit(edit, kept);
+    run(&mut new, edit, 1);
+    let copied = new.stats().copied_share;
+    run(&mut new, edit, 1);
+    (new.radiance(), copied)
+}
+
+/// A flat diffuse patch between a sphere lamp and a floor, seen from low down beside it:
+/// the floor under the patch's shadow is seen by rays that pass below the patch.
+const SHADOW: &str = r#"
+[camera]
+position = [6, 1, 0]
+look_at = [0, 0, 0]
+fov = 40
+width = 96
+height = 72
+
+[render]
+photons_per_pass = 20000
+
+[materials.grey]
+type = "diffuse"
+color = [0.7, 0.7, 0.7]
+
+[[lights]]
+type = "sphere"
+center = [0, 5, 0]
+radius = 0.3
+power = 800
+
+[[objects]]
+type = "plane"
+point = [0, 0, 0]
+normal = [0, 1, 0]
+material = "grey"
+
+[[objects]]
+type = "patches"
+material = "grey"
+patches = [[
+    [-0.6, 2, -0.6], [-0.2, 2, -0.6], [0.2, 2, -0.6], [0.6, 2, -0.6],
+    [-0.6, 2, -0.2], [-0.2, 2, -0.2], [0.2, 2, -0.2], [0.6, 2, -0.2],
+    [-0.6, 2, 0.2], [-0.2, 2, 0.2], [0.2, 2, 0.2], [0.6, 2, 0.2],
+    [-0.6, 2, 0.6], [-0.2, 2, 0.6], [0.2, 2, 0.6], [0.6, 2, 0.6],
+]]
+"#;
+
+#[test]
+fn a_moved_shadow_is_sampled_again_where_the_floor_is_copied() {
+    let mut scene = Scene::from_str(SHADOW, Path::new("shadow.toml"), None).expect("the scene loads");
+    scene.params.antialias = true;
+    let mut patch = scene.geometry.patches()[0].0;
+    patch
+        .points
+        .iter_mut()
+        .for_each(|p| *p += DVec3::new(0.0, 0.0, 0.7));
+    let mut edit = scene.clone();
+    edit.geometry.update_patches(&[(0, patch)]);
+    let (traced, _) = warm_after(&scene, &edit, false, false);
+    let (copied, share) = warm_after(&scene, &edit, false, true);
+    assert!(share > 0.8, "the floor is copied: {share}");
+    assert!(traced == copied, "the shadow moved on the copied floor");
+}
+
+#[test]
+fn a_warm_first_pass_copies_what_the_edit_cannot_reach_and_the_image_is_the_traced_one() {
+    let scene = teapot(96);
+    let mut patch = scene.geometry.patches()[0].0;
+    // Out sideways: the shadow on the floor changes where the floor is copied.
+    patch.points[5] += DVec3::new(1.0, -1.0, 0.0);
+    let mut moved_patch = scene.clone();
+    moved_patch.geometry.update_patches(&[(0, patch)]);
+    let (moved_light, _) = light_moved(&scene, DVec3::new(-1.5, 1.0, -0.5));
+    for (edit, light, what) in [
+        (&moved_patch, false, "control point"),
+        (&moved_light, true, "light"),
+    ] {
+        let (traced, none) = pool(2).install(|| warm_after(&scene, edit, light, false));
+        assert_eq!(
+            none, 0.0,
+            "{what}: nothing is copied unless the edit is described"
+        );
+        let (copied, share) = pool(2).install(|| warm_after(&scene, edit, light, true));
+        assert!(share > 0.5, "{what}: most pixels copied: {share}");
+        assert!(
+            traced == copied,
+            "{what}: the image with {share} of the pixels copied is the traced one"
+        );
+        let (one, _) = pool(1).install(|| warm_after(&scene, edit, light, true));
+        assert!(one == copied, "{what}: the same image for 1 and 2 threads");
+    }
+    // The moved patch is in view: its pixels are traced again.
+    let (_, share) = warm_after(&scene, &moved_patch, false, true);
+    let (_, unmoved) = warm_after(&scene, &scene, false, true);
+    assert!(
+        share < unmoved,
+        "the moved patch's pixels are traced: {share} against {unmoved}"
+    );
 }
 
 fn next_frame(session: &RenderSession) -> Frame {

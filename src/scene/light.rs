@@ -188,6 +188,29 @@ impl Light {
         }
     }
 
+    /// The bounds of the light's visible surface (area lights; `None` for point and spot
+    /// lights, which no ray can meet).
+    pub fn surface_bounds(&self) -> Option<crate::geometry::Aabb> {
+        match *self {
+            Light::Point { .. } | Light::Spot { .. } => None,
+            Light::Sphere { center, radius, .. } => Some(crate::geometry::Aabb::new(
+                center - DVec3::splat(radius),
+                center + DVec3::splat(radius),
+            )),
+            Light::Quad {
+                corner,
+                edge_u,
+                edge_v,
+                ..
+            } => Some(crate::geometry::Aabb::from_points([
+                corner,
+                corner + edge_u,
+                corner + edge_v,
+                corner + edge_u + edge_v,
+            ])),
+        }
+    }
+
     /// Whether many shadow samples are needed (area lights) or one is exact (point lights).
     pub fn is_area(&self) -> bool {
         matches!(self, Light::Sphere { .. } | Light::Quad { .. })

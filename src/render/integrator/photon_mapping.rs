@@ -3,7 +3,7 @@
 
 use super::{Control, Integrator, PassPlan, Setup};
 use crate::render::frame::{Frame, FrameStats, PixelLayer, StatRow};
-use crate::render::ppm::{PassOutcome, Ppm, PpmOptions, PpmStats};
+use crate::render::ppm::{Changed, PassOutcome, Ppm, PpmOptions, PpmStats};
 use crate::render::provenance;
 use crate::scene::Scene;
 use crate::settings::RendererKind;
@@ -14,6 +14,8 @@ pub struct PhotonMapping {
     guided_emission: bool,
     /// The lights as this render began (a warm restart tells the next which moved).
     lights: Vec<crate::scene::Light>,
+    /// The patches as this render began (a warm restart tells the next where they moved).
+    patches: Vec<crate::geometry::BezierPatch>,
 }
 
 impl PhotonMapping {
@@ -30,6 +32,7 @@ impl PhotonMapping {
             ppm,
             guided_emission: scene.params.guided_emission,
             lights: scene.lights.clone(),
+            patches: scene.geometry.patches().iter().map(|(p, _)| *p).collect(),
         }
     }
 }
@@ -72,6 +75,7 @@ impl Integrator for PhotonMapping {
         if let Some(mut kept) = self.ppm.into_warm_start() {
             let moved = (0..scene.lights.len()).filter(|&k| self.lights.get(k) != scene.lights.get(k));
             moved.for_each(|k| kept.light_moved(k));
+            kept.edited(Changed::between(&self.patches, &self.lights, scene));
             next.ppm.inherit(scene, kept);
         }
         Box::new(next)

@@ -34,19 +34,20 @@ pub fn has_area_lights(scene: &Scene) -> bool {
 /// block is 1.5 MiB. Large enough that each block keeps every thread busy.
 const BLOCK: usize = 1 << 16;
 
-/// Reflected radiance from every area light at each point (one sample each), handed to
-/// `add(k, light)` in point order: `point.weight(wi) × L × cos θ / pdf` where the shadow ray is
+/// Reflected radiance from every area light at each point (one sample each; none at the
+/// points `skip` names), handed to `add(k, light)` in point order: `point.weight(wi) × L × cos θ / pdf` where the shadow ray is
 /// clear. `key(k)` names point `k` stably across passes (its statistics slot), for the
 /// stratification. Sampled `BLOCK` points at a time, in parallel.
 pub fn area_light_pass(
     scene: &Scene,
     points: &VisiblePoints,
     key: impl Fn(usize) -> u64 + Sync,
-    pass: u64,
-    seed: u64,
+    (pass, seed): (u64, u64),
+    skip: Option<&(dyn Fn(usize) -> bool + Sync)>,
     mut add: impl FnMut(usize, DVec3),
 ) {
-    let sampler = Sampler::new(scene, points, key, pass, seed);
+    let mut sampler = Sampler::new(scene, points, key, pass, seed);
+    sampler.skip = skip;
     let mut light = Vec::with_capacity(BLOCK.min(points.len()));
     for first in (0..points.len()).step_by(BLOCK) {
         sampler.sample(first..(first + BLOCK).min(points.len()), &mut light);
@@ -65,6 +66,9 @@ struct Sampler<'a, K> {
     seed: u64,
     /// The scene's area lights with their indices.
     lights: Vec<(u64, &'a crate::scene::Light)>,
+    /// Points whose light is known already (a copy of the previous pass's,
+    /// [`super::reuse`]): they are handed no light.
+    skip: Option<&'a (dyn Fn(usize) -> bool + Sync)>,
 }
 
 impl<'a, K: Fn(usize) -> u64 + Sync> Sampler<'a, K> {
@@ -76,13 +80,22 @@ impl<'a, K: Fn(usize) -> u64 + Sync> Sampler<'a, K> {
             pass,
             seed,
             lights: (0u64..).zip(&scene.lights).filter(|(_, l)| l.is_area()).collect(),
+            skip: None,
         }
+    }
+
+    /// The numbers of point `k`'s sample of light `l` in this pass.
+    fn numbers(&self, k: usize, l: u64) -> DVec2 {
+        let count = self.scene.lights.len() as u64;
+        let mut rng = stream_rng(self.seed, OFFSET_STREAM, (self.key)(k) * count + l);
+        let offset = DVec2::new(rng.random(), rng.random());
+        sequence::rotated(sequence::r4(self.pass)[1], offset)
     }
 
     /// The light at the points `block`, in point order, into `light` (replacing what it held,
     /// keeping its memory).
     fn sample(&self, block: Range<usize>, light: &mut Vec<DVec3>) {
-        let (scene, count) = (self.scene, self.scene.lights.len() as u64);
+        let scene = self.scene;
         let first = block.start;
         self.points.reach[block.clone()]
             .par_iter()
@@ -91,12 +104,12 @@ impl<'a, K: Fn(usize) -> u64 + Sync> Sampler<'a, K> {
             .map(|(i, (reach, shade))| {
                 let k = first + i;
                 let (position, normal) = (reach.position, shade.normal.as_dvec3());
+                if self.skip.is_some_and(|skip| skip(k)) {
+                    return DVec3::ZERO;
+                }
                 let mut sum = DVec3::ZERO;
                 for &(l, light) in &self.lights {
-                    let mut rng = stream_rng(self.seed, OFFSET_STREAM, (self.key)(k) * count + l);
-                    let offset = DVec2::new(rng.random(), rng.random());
-                    let u = sequence::rotated(sequence::r4(self.pass)[1], offset);
-                    let Some(ls) = light.sample(position, u) else {
+                    let Some(ls) = light.sample(position, self.numbers(k, l)) else {
                         continue;
                     };
                     // Zero below the surface, unless the point refracts.
@@ -155,7 +168,7 @@ mod tests {
         assert_eq!(whole, blocked);
         // The pass hands every point's light once, in point order.
         let mut handed = Vec::new();
-        area_light_pass(&scene, &points, key, 5, 11, |k, l| handed.push((k, l)));
+        area_light_pass(&scene, &points, key, (5, 11), None, |k, l| handed.push((k, l)));
         assert_eq!(handed, whole.into_iter().enumerate().collect::<Vec<_>>());
     }
 }

@@ -14,6 +14,7 @@ use super::index::SpatialIndex;
 use super::kd_tree::KdTree;
 use super::light::LightSeen;
 use super::points::VisiblePoints;
+use super::reuse::{PathKind, Reuse};
 use super::seen;
 use super::streams;
 use super::visible::{trace_eye, Branching, ShadowRays, VisiblePoint};
@@ -28,6 +29,11 @@ use crate::settings::IndexKind;
 pub struct EyePass {
     /// This pass's visible points (classic PPM: the one eye pass's).
     pub points: VisiblePoints,
+    /// Per pixel, what its eye path was in this stochastic pass ([`super::reuse`]).
+    pub kinds: Vec<PathKind>,
+    /// With [`EyeJob::keep_copy`], a copy of this stochastic pass's points, one place a pixel
+    /// (placeholders kept).
+    pub copy: VisiblePoints,
     /// The hash grid over the points as they lie now, kept while no eye pass replaces them
     /// (classic PPM traces one) for as long as it serves the shrinking radii
     /// ([`HashGrid::serves`]).
@@ -43,6 +49,12 @@ pub struct EyeJob<'a> {
     pub pass: u64,
     /// Polled during the pass; true abandons it.
     pub interrupt: Option<&'a (dyn Fn() -> bool + Send + Sync)>,
+    /// The previous pass's points, to copy where the pass would find them again (a warm
+    /// epoch's first pass, [`super::reuse`]).
+    pub reuse: Option<&'a Reuse<'a>>,
+    /// Whether to keep a copy of the points in pixel order ([`EyePass::copy`]), for a warm
+    /// restart's reuse.
+    pub keep_copy: bool,
 }
 
 impl EyePass {
@@ -72,8 +84,16 @@ impl EyePass {
         let pixels = (w * h) as usize;
         // New points: the grid over the old ones no longer holds them.
         self.kept_grid = None;
-        self.points.reset(pixels, Bsdf::scene_has_glossy(scene));
+        // A warm epoch's first pass starts from the previous pass's points, each pixel's at
+        // its place, and traces only the pixels an edit may have changed.
+        match job.reuse {
+            Some(r) if r.points().len() == pixels => self.points.copy_from(r.points()),
+            _ => self.points.reset(pixels, Bsdf::scene_has_glossy(scene)),
+        }
+        let reuse = job.reuse.filter(|r| r.points().len() == pixels);
         let (seen, pass_direct) = light.start_stochastic_pass();
+        self.kinds.clear();
+        self.kinds.resize(pixels, PathKind::Other);
         let rays = scene.camera.eye_rays();
         let subsampler = seen::Subsampler {
             scene,
@@ -87,35 +107,51 @@ impl EyePass {
         self.points
             .places_mut()
             .zip(pass_direct.par_iter_mut())
+            .zip(self.kinds.par_iter_mut())
             .enumerate()
-            .for_each(|(i, (mut place, direct))| {
+            .for_each(|(i, ((mut place, direct), kind))| {
                 if interrupt.is_some_and(|f| f()) {
                     skipped.store(true, std::sync::atomic::Ordering::Relaxed);
                     return;
                 }
                 let i = i as u64;
                 let (x, y) = (i % w, i / w);
-                let mut rng = stream_rng(seed, streams::EYE, pass * w * h + i);
-                let (jitter, lens, first) = eye_sample(seed, pass, i, sequences, &mut rng);
-                let px = DVec2::new(x as f64, y as f64) + jitter;
-                let mut sink = |vp: VisiblePoint| place.set(&vp);
                 // A supersampled pixel's light seen comes from its extra rays alone, so its
                 // own ray needs no shadow rays (they draw no random numbers: the point is the
                 // same).
                 let chosen = seen.chosen(i as usize);
-                let seen_once = trace_eye(
+                // The previous pass's point, already in place, where it is still right.
+                let reuse = reuse.filter(|_| !chosen);
+                if reuse.is_some_and(|r| r.copies_unseen(i as usize, x, y)) {
+                    *kind = PathKind::Copied;
+                    return;
+                }
+                let mut rng = stream_rng(seed, streams::EYE, pass * w * h + i);
+                let (jitter, lens, first) = eye_sample(seed, pass, i, sequences, &mut rng);
+                let px = DVec2::new(x as f64, y as f64) + jitter;
+                let ray = rays.ray_with_lens_sample(px, lens);
+                if let Some(r) = reuse {
+                    if r.copies(i as usize, &ray) {
+                        *kind = PathKind::Copied;
+                        return;
+                    }
+                    place.clear();
+                }
+                let mut sink = |vp: VisiblePoint| place.set(&vp);
+                let traced = trace_eye(
                     scene,
-                    &rays.ray_with_lens_sample(px, lens),
+                    &ray,
                     i as u32,
                     Branching::Choose { first },
                     ShadowRays::new(direct_light, !chosen),
                     &mut rng,
                     &mut sink,
                 );
+                *kind = PathKind::traced(traced.rays, traced.direct, chosen);
                 *direct = if chosen {
                     subsampler.light_seen(i, x, y, seen.subsamples(i as usize))
                 } else {
-                    seen_once
+                    traced.direct
                 }
                 .as_vec3();
             });
@@ -124,6 +160,9 @@ impl EyePass {
         }
         if observe {
             light.observe(w as usize);
+        }
+        if job.keep_copy {
+            self.copy.copy_from(&self.points);
         }
         self.points.drop_empty();
         true
@@ -193,15 +232,18 @@ pub fn trace_classic(job: &EyeJob, scene: &Scene) -> Option<(Vec<DVec3>, Vec<Vis
                 let i = y * w + x;
                 let mut rng = stream_rng(seed, streams::EYE, pass * w * h + i);
                 let px = Scene::pixel_center(x as u32, y as u32);
-                direct.push(trace_eye(
-                    scene,
-                    &rays.ray(px, DVec2::ZERO),
-                    i as u32,
-                    Branching::Split,
-                    ShadowRays::new(direct_light, true),
-                    &mut rng,
-                    &mut |vp| points.push(vp),
-                ));
+                direct.push(
+                    trace_eye(
+                        scene,
+                        &rays.ray(px, DVec2::ZERO),
+                        i as u32,
+                        Branching::Split,
+                        ShadowRays::new(direct_light, true),
+                        &mut rng,
+                        &mut |vp| points.push(vp),
+                    )
+                    .direct,
+                );
             }
             (direct, points)
         })

@@ -111,6 +111,17 @@ impl LightSeen {
         (&self.seen, &mut self.pass_direct)
     }
 
+    /// This stochastic pass's light seen per pixel so far (its eye pass's, and its area-light
+    /// samples once taken).
+    pub fn pass_light(&self) -> &[Vec3] {
+        &self.pass_direct
+    }
+
+    /// This stochastic pass's light seen per pixel, to add to.
+    pub fn pass_light_mut(&mut self) -> &mut [Vec3] {
+        &mut self.pass_direct
+    }
+
     /// After a complete stochastic eye pass of a `width`-pixel-wide image: the candidates for
     /// supersampling, from the light it saw ([`SeenLight::observe`]).
     pub fn observe(&mut self, width: usize) {
@@ -159,12 +170,17 @@ impl LightSeen {
         scene: &Scene,
         (points, slots): (&VisiblePoints, &[Slot]),
         (pass, seed): (u64, u64),
-        stochastic: bool,
+        (stochastic, skip): (bool, Option<&(dyn Fn(usize) -> bool + Sync)>),
     ) {
         let shade = &points.shade;
         let key = |k: usize| shade[k].slot as u64;
         let (pass_direct, area_direct) = (&mut self.pass_direct, &mut self.area_direct);
-        direct::area_light_pass(scene, points, key, pass, seed, |k, l| {
+        direct::area_light_pass(scene, points, key, (pass, seed), skip, |k, l| {
+            // No light adds nothing: the points in shadow and those skipped cost no look-up
+            // of their pixel (the points lie in the spatial index's order).
+            if l == DVec3::ZERO {
+                return;
+            }
             let pixel = slots[shade[k].slot as usize].pixel as usize;
             if stochastic {
                 pass_direct[pixel] += l.as_vec3();

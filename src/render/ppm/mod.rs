@@ -29,8 +29,8 @@
 //! slots (`estimates.rs`, each slot's [`Estimate`]s in `estimate.rs`), the eye pass
 //! (`eye_pass.rs`), the photon pass (`photon_pass.rs`, handing flux in `deposit.rs`), the
 //! radius policy (`radius.rs`), the emission guide ([`guide`]), the light seen directly
-//! (`light.rs`, supersampled by `seen.rs`), warm restarts ([`warm`]) and the global radius
-//! schedule (`global.rs`). This file only declares them.
+//! (`light.rs`, supersampled by `seen.rs`), warm restarts ([`warm`], whose first pass copies
+//! what an edit cannot have changed, `reuse.rs`) and the global radius schedule (`global.rs`). This file only declares them.
 
 mod config;
 mod deposit;
@@ -46,6 +46,7 @@ mod photon_pass;
 mod points;
 mod progressive;
 mod radius;
+mod reuse;
 mod seen;
 mod stats;
 mod streams;
@@ -70,6 +71,7 @@ pub use layers::PixelLayers;
 pub use points::SearchSphere;
 pub use progressive::{PassOutcome, Ppm};
 pub use radius::footprint_radius;
+pub use reuse::Changed;
 pub use seen::{SUBSAMPLES, VARIED_SUBSAMPLES};
 pub use stats::PpmStats;
 pub use warm::{StreamOffset, WarmStart};

@@ -105,6 +105,16 @@ pub struct Place<'a> {
 }
 
 impl Place<'_> {
+    /// Empties this place (it held a point copied from an earlier pass that is to be traced
+    /// again, [`super::reuse`]).
+    pub fn clear(&mut self) {
+        *self.reach = Reach::default();
+        *self.shade = Shade::EMPTY;
+        if let Some(g) = self.glossy.as_deref_mut() {
+            *g = None;
+        }
+    }
+
     /// Puts `vp` here (once: a chosen path ends at one point).
     pub fn set(&mut self, vp: &VisiblePoint) {
         debug_assert!(self.shade.slot == Shade::NONE, "a chosen path ends once");
@@ -186,6 +196,13 @@ impl VisiblePoints {
             .zip(self.shade.par_iter_mut())
             .zip(glossy)
             .map(|((reach, shade), glossy)| Place { reach, shade, glossy })
+    }
+
+    /// Makes this a copy of `other`, in the memory this one holds.
+    pub fn copy_from(&mut self, other: &VisiblePoints) {
+        self.reach.clone_from(&other.reach);
+        self.shade.clone_from(&other.shade);
+        self.glossy.clone_from(&other.glossy);
     }
 
     /// Removes the placeholders, keeping the points' order.

@@ -20,6 +20,7 @@ use super::light::LightSeen;
 use super::photon;
 use super::photon_pass::{guided_pass_photons, PhotonJob, PhotonPass};
 use super::radius::{IndirectScale, RadiusPolicy};
+use super::reuse::PathKind;
 use super::stats::{skipped_work, PpmStats};
 use super::warm::{records, Epoch, PointRecord, Reopen, StreamOffset, WarmStart, PRIOR_PASSES};
 use crate::render::control::{Control, Interrupt};
@@ -238,16 +239,29 @@ impl Ppm {
             config: &self.config,
             pass: self.stream_pass(),
             interrupt: self.interrupt.as_deref(),
+            reuse: None,
+            keep_copy: false,
         }
+    }
+
+    /// Whether this is a warm epoch's first stochastic pass, which may reuse the previous
+    /// epoch's last ([`super::reuse`]).
+    fn reuses(&self) -> bool {
+        self.stats.passes == 0 && self.config.stochastic && self.global.is_none()
     }
 
     /// Traces a stochastic eye pass ([`EyePass::trace_stochastic`]); its light seen chooses
     /// pixels to supersample except on the global schedule after the pilot.
     fn trace_stochastic_eye_pass(&mut self, scene: &Scene) -> bool {
+        let reuses = self.reuses();
+        let inherited = self.epoch.inherited.as_ref().filter(|_| reuses);
+        let reuse = inherited.and_then(|w| w.reuse(&scene.camera));
         let job = EyeJob {
             config: &self.config,
             pass: self.stream_pass(),
             interrupt: self.interrupt.as_deref(),
+            reuse: reuse.as_ref(),
+            keep_copy: self.config.options.warm_restarts,
         };
         let observe = self.global.as_ref().is_none_or(Global::learning);
         self.eye.trace_stochastic(&job, scene, &mut self.light, observe)
@@ -298,6 +312,8 @@ impl Ppm {
         let kept = warm.keep_unmoved(&mut self.estimates.slots, &now, &reopen, size);
         self.light.set_prior(kept.light);
         self.stats.nearby_share = kept.nearby_share;
+        let copied = self.eye.kinds.iter().filter(|&&k| k == PathKind::Copied).count();
+        self.stats.copied_share = copied as f64 / self.eye.kinds.len().max(1) as f64;
         self.stats.kept_share = kept.kept_share;
     }
 
@@ -359,9 +375,22 @@ impl Ppm {
         }
         let start = Instant::now();
         let (pass, seed) = (self.stream_pass(), self.config.seed);
-        let parts = (&self.eye.points, self.estimates.slots.as_slice());
-        self.light
-            .sample_area_lights(scene, parts, (pass, seed), self.config.stochastic);
+        let reuses = self.reuses();
+        let inherited = self.epoch.inherited.as_ref().filter(|_| reuses);
+        let reuse = inherited.and_then(|w| w.reuse(&scene.camera));
+        // Copied points whose light is the previous pass's (stochastic: slot k is pixel k).
+        let known = reuse
+            .map(|r| r.copy_area_light(scene, &self.eye.kinds, self.light.pass_light_mut()))
+            .unwrap_or_default();
+        let shade = &self.eye.points.shade;
+        let skip = |k: usize| known.get(shade[k].slot as usize).is_some_and(|&b| b);
+        let skip: Option<&(dyn Fn(usize) -> bool + Sync)> = (!known.is_empty()).then_some(&skip);
+        self.light.sample_area_lights(
+            scene,
+            (&self.eye.points, &self.estimates.slots),
+            (pass, seed),
+            (self.config.stochastic, skip),
+        );
         self.stats.direct_secs += start.elapsed().as_secs_f64();
     }
 
@@ -388,7 +417,8 @@ impl Ppm {
             self.stats.widened_share = widened;
         }
         if self.config.stochastic && self.config.options.warm_restarts {
-            self.epoch.last_points = self.point_records();
+            let kept = self.epoch.last_eye.get_or_insert_with(Default::default);
+            kept.keep(&mut self.eye.copy, &self.eye.kinds, self.light.pass_light());
         }
         if self.config.stochastic {
             self.stats.eye_passes += 1;
@@ -497,10 +527,13 @@ impl Ppm {
         }
         // A stochastic eye pass interrupted since the last completed pass left its points
         // half written: the records kept at that pass count (see `update`).
-        let points = if self.config.stochastic {
-            std::mem::take(&mut self.epoch.last_points)
+        let (points, eye) = if self.config.stochastic {
+            let eye = self.epoch.last_eye.take();
+            let slots = self.estimates.slots.len();
+            let points = eye.as_ref().map(|e| records(slots, &e.points));
+            (points.unwrap_or_default(), eye)
         } else {
-            self.point_records()
+            (self.point_records(), None)
         };
         let s = &self.stats;
         Some(WarmStart {
@@ -517,6 +550,8 @@ impl Ppm {
                 passes: self.epoch.offset.passes + s.passes as u64,
                 photons: self.epoch.offset.photons + s.photons,
             },
+            eye,
+            changed: None,
         })
     }
 

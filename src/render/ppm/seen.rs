@@ -347,7 +347,8 @@ impl Subsampler<'_> {
                 ShadowRays::new(self.direct_light, true),
                 &mut rng,
                 &mut |_| {},
-            );
+            )
+            .direct;
         }
         sum / subsamples as f64
     }

@@ -40,6 +40,9 @@ pub struct PpmStats {
     /// Share of the pixels whose points moved and that a warm restart gave the previous
     /// estimate of a point near their own.
     pub nearby_share: f64,
+    /// Share of the pixels whose eye path a warm restart's first pass copied from the
+    /// previous epoch's last instead of tracing it again (the `reuse` module).
+    pub copied_share: f64,
     /// Seconds spent in completed passes.
     pub elapsed_secs: f64,
     /// Seconds spent tracing photons.

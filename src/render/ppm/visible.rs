@@ -97,6 +97,8 @@ pub enum Branching {
 struct EyeOut<'a> {
     points: &'a mut dyn FnMut(VisiblePoint),
     direct: DVec3,
+    /// Rays cast so far: the path's segments and its shadow rays.
+    rays: u32,
     /// The number for the next glass choice, used once (see [`Branching::Choose`]).
     first_choice: Option<f64>,
 }
@@ -126,8 +128,18 @@ impl ShadowRays {
     }
 }
 
+/// What one pixel's eye path found besides its visible points.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EyeTrace {
+    /// The light seen directly.
+    pub direct: DVec3,
+    /// The rays the path cast: its segments and its shadow rays. A path of one ray that saw no
+    /// light depends only on the scene along that ray (`ppm::reuse`).
+    pub rays: u32,
+}
+
 /// Traces the eye ray `ray` (of a pixel), handing each visible point, tagged with `slot`, to
-/// `points`; returns the light seen directly.
+/// `points`; returns the light seen directly and the rays cast.
 pub fn trace_eye(
     scene: &Scene,
     ray: &Ray,
@@ -136,10 +148,11 @@ pub fn trace_eye(
     shadow_rays: ShadowRays,
     rng: &mut Pcg64Mcg,
     points: &mut dyn FnMut(VisiblePoint),
-) -> DVec3 {
+) -> EyeTrace {
     let mut out = EyeOut {
         points,
         direct: DVec3::ZERO,
+        rays: 0,
         first_choice: match branching {
             Branching::Choose { first } => first,
             Branching::Split => None,
@@ -152,7 +165,10 @@ pub fn trace_eye(
         shadow_rays,
     };
     walk.walk(ray, (DVec3::ONE, Wavelength::WHITE), 0, rng, &mut out, None);
-    out.direct
+    EyeTrace {
+        direct: out.direct,
+        rays: out.rays,
+    }
 }
 
 /// What stays fixed along one pixel's eye path.
@@ -181,6 +197,7 @@ impl EyeWalk<'_> {
         if throughput.max_element() <= 0.0 {
             return;
         }
+        out.rays += 1;
         let Some(hit) = scene.geometry.intersect(ray, f64::INFINITY) else {
             out.direct += throughput * scene.background;
             return;
@@ -275,6 +292,8 @@ impl EyeWalk<'_> {
         let share = lobe_share(&lobes, bsdf);
         if self.shadow_rays != ShadowRays::None {
             for (k, light) in self.scene.lights.iter().enumerate() {
+                // Counted whether or not it is cast: what decides that depends on the light.
+                out.rays += 1;
                 let u = DVec2::new(rng.random(), rng.random());
                 let Some(ls) = light.sample(hit.point, u) else {
                     continue;
@@ -339,6 +358,8 @@ impl EyeWalk<'_> {
                 .enumerate()
                 .filter(|(_, l)| direct_by_shadow_rays(l))
             {
+                // Counted whether or not it is cast: what decides that depends on the light.
+                out.rays += 1;
                 let Some(ls) = light.sample(hit.point, DVec2::ZERO) else {
                     continue;
                 };

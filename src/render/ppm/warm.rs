@@ -48,12 +48,14 @@ use super::estimate::{Estimate, Slot};
 use super::guide::EmissionGuide;
 use super::hash_grid::HashGrid;
 use super::light::PriorLight;
-use super::points::{SearchSphere, VisiblePoints};
+use super::points::{SearchSphere, Shade, VisiblePoints};
 use super::radius::{IndirectScale, RadiusPolicy, DENSE_PHOTONS, INDIRECT_PHOTONS};
+use super::reuse::{Changed, KeptEye, Reuse};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
 use crate::geometry::Aabb;
+use crate::scene::Camera;
 
 /// The most a kept pixel's previous estimate counts for, in passes of the epoch's first pass's
 /// photons (the photon ramp's first pass in the viewer, 16,384 photons: on
@@ -98,9 +100,31 @@ pub struct WarmStart {
     pub(super) moved_lights: Vec<usize>,
     /// The streams after the last completed pass.
     pub(super) next: StreamOffset,
+    /// The last completed stochastic pass's points, for the next epoch's first pass to copy
+    /// where the edits cannot have changed them ([`super::reuse`]).
+    pub(super) eye: Option<KeptEye>,
+    /// What the edits since that pass changed (`None`: not known, nothing is reused).
+    pub(super) changed: Option<Changed>,
 }
 
 impl WarmStart {
+    /// Notes what an edit changed (added to what earlier edits since the kept pass did): the
+    /// next epoch's first pass traces again whatever may meet it, and copies the rest of the
+    /// kept pass's points (`ppm::reuse`). Without it nothing is copied.
+    pub fn edited(&mut self, changed: Changed) {
+        match &mut self.changed {
+            Some(c) => c.add(changed),
+            None => self.changed = Some(changed),
+        }
+    }
+
+    /// The reuse of the kept pass's points by the next epoch's first pass, when there is one.
+    pub(super) fn reuse(&self, camera: &Camera) -> Option<Reuse<'_>> {
+        let eye = self.eye.as_ref()?;
+        let changed = self.changed.as_ref()?;
+        Some(Reuse::new(eye, changed, camera, !self.moved_lights.is_empty()))
+    }
+
     /// Notes that light `light` moved or turned: its part of the emission guide is kept at
     /// one first pass's worth, and the light seen directly starts afresh.
     pub fn light_moved(&mut self, light: usize) {
@@ -130,10 +154,14 @@ impl PointRecord {
     }
 }
 
-/// Each of `slots` slots' visible point among `points` (each point names its slot).
+/// Each of `slots` slots' visible point among `points` (each point names its slot;
+/// placeholders are passed over).
 pub fn records(slots: usize, points: &VisiblePoints) -> Vec<PointRecord> {
     let mut out = vec![PointRecord::default(); slots];
     for (k, (r, s)) in points.reach.iter().zip(&points.shade).enumerate() {
+        if s.slot == Shade::NONE {
+            continue;
+        }
         out[s.slot as usize] = PointRecord {
             position: r.position.as_vec3(),
             normal: s.normal,
@@ -262,11 +290,10 @@ pub(super) struct Epoch {
     pub offset: StreamOffset,
     /// What a warm restart inherited, until the first pass completes.
     pub inherited: Option<WarmStart>,
-    /// Per slot, its visible point in the last completed stochastic pass, with
-    /// [`PpmOptions::warm_restarts`] ([`records`]).
+    /// The last completed stochastic pass's points, with [`PpmOptions::warm_restarts`].
     ///
     /// [`PpmOptions::warm_restarts`]: super::PpmOptions::warm_restarts
-    pub last_points: Vec<PointRecord>,
+    pub last_eye: Option<KeptEye>,
 }
 
 impl Epoch {
@@ -327,19 +354,64 @@ impl WarmStart {
         let pixels = size.0 as usize * size.1 as usize;
         let mut light = vec![PriorLight::default(); pixels];
         let mut carried = vec![false; slots.len()];
-        // Pixels and their slots, as runs of slots: one slot a pixel (stochastic) needs no
-        // search, so both sides are simply zipped.
-        let (old, new) = if self.stochastic && self.slots.len() == slots.len() {
-            let one = |s: &[Slot]| {
-                s.iter()
-                    .enumerate()
-                    .map(|(k, s)| (s.pixel, k..k + 1))
-                    .collect::<Vec<_>>()
-            };
-            (one(&self.slots), one(slots))
+        let one_each = self.stochastic && self.slots.len() == slots.len() && slots.len() == pixels;
+        let kept = if one_each {
+            self.keep_one_each(slots, now, reopen, (&mut light, &mut carried))
         } else {
-            (runs(&self.slots), runs(slots))
+            self.keep_runs(slots, now, reopen, (&mut light, &mut carried))
         };
+        let nearby = self.carry_nearby(slots, now, &carried, reopen);
+        let pixels = (size.0 as f64 * size.1 as f64).max(1.0);
+        Kept {
+            kept_share: kept as f64 / pixels,
+            nearby_share: nearby as f64 / pixels,
+            light,
+        }
+    }
+
+    /// [`WarmStart::keep_unmoved`] where every pixel has one slot, its own (stochastic: slot
+    /// `k` is pixel `k`), in parallel: the slots kept, their light seen, and which were kept.
+    /// Returns the pixels kept.
+    fn keep_one_each(
+        &self,
+        slots: &mut [Slot],
+        now: &[PointRecord],
+        reopen: &Reopen,
+        (light, carried): (&mut [PriorLight], &mut [bool]),
+    ) -> usize {
+        let keep_light = self.moved_lights.is_empty();
+        slots
+            .par_iter_mut()
+            .zip(light.par_iter_mut())
+            .zip(carried.par_iter_mut())
+            .enumerate()
+            .with_min_len(4096)
+            .map(|(k, ((slot, light), carried))| {
+                let old = &self.slots[k];
+                let Some(factor) = carry(&self.points[k], &now[k], old.primary.radius2()) else {
+                    return 0;
+                };
+                if keep_light {
+                    *light = self.light[k].capped(PRIOR_PASSES, factor);
+                }
+                *slot = reopen.prior(*old, factor);
+                *carried = true;
+                1
+            })
+            .sum()
+    }
+
+    /// [`WarmStart::keep_unmoved`] for pixels with any number of slots (classic PPM's split
+    /// glass paths): a pixel keeps its slots when it has as many as before and every one of
+    /// its points carries. Returns the pixels kept.
+    fn keep_runs(
+        &self,
+        slots: &mut [Slot],
+        now: &[PointRecord],
+        reopen: &Reopen,
+        (light, carried): (&mut [PriorLight], &mut [bool]),
+    ) -> usize {
+        let (old, new) = (runs(&self.slots), runs(slots));
         // Whether each run's points all carry, decided in parallel.
         let carries: Vec<Option<(usize, DVec3)>> = new
             .par_iter()
@@ -377,13 +449,7 @@ impl WarmStart {
             kept += 1;
             carried[range.clone()].iter_mut().for_each(|c| *c = true);
         }
-        let nearby = self.carry_nearby(slots, now, &carried, reopen);
-        let pixels = (size.0 as f64 * size.1 as f64).max(1.0);
-        Kept {
-            kept_share: kept as f64 / pixels,
-            nearby_share: nearby as f64 / pixels,
-            light,
-        }
+        kept
     }
 
     /// For each slot of a moved pixel whose new visible point lies within the radius of a
@@ -575,6 +641,8 @@ mod tests {
             guide: None,
             moved_lights: Vec::new(),
             next: StreamOffset::default(),
+            eye: None,
+            changed: None,
         };
         let now: Vec<PointRecord> = (0..3000).map(|_| record(&mut rng)).collect();
         let carried: Vec<bool> = (0..3000).map(|k| k % 3 == 0).collect();
