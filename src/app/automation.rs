@@ -542,7 +542,10 @@ fn report_drag(drag: &DragFigures, viewer: &Viewer) {
         l.len(),
         ms.join(", ")
     );
-    println!("  UI frame rate while dragging the {what}:  {:.1} fps", drag.fps);
+    println!(
+        "  UI frame rate while dragging the {what}:  {:.1} fps  (each step moves once and rests: where frames are paced, a frame without input waits for the image)",
+        drag.fps
+    );
     match &drag.edit {
         Some((before, edit)) => match drag_preview_error(viewer.scene(), before, edit) {
             Ok(line) => println!("  {what} {line}"),

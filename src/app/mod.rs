@@ -92,7 +92,10 @@ impl eframe::App for CausticApp {
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         let viewer = &self.viewer;
         let pending = viewer.restart_pending() && !viewer.paused();
-        self.pacer.wait(pending, || viewer.frame_waiting());
+        let input = ui
+            .ctx()
+            .input(|i| !i.events.is_empty() || i.pointer.delta() != egui::Vec2::ZERO);
+        self.pacer.wait((pending, input), || viewer.frame_waiting());
         let start = std::time::Instant::now();
         self.viewer.ui(ui);
         let ui_secs = start.elapsed().as_secs_f64();

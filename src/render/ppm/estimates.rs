@@ -87,7 +87,8 @@ impl Estimates {
         let restarted = (emitted - self.first_pass_photons) as f64;
         let emitted = emitted as f64;
         self.slots
-            .iter()
+            .par_iter()
+            .with_min_len(4096)
             .map(|s| {
                 let all = emitted + s.prior as f64;
                 let primary = match s.restart {

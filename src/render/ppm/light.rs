@@ -5,6 +5,7 @@
 //! ([`super::seen`]); and what a warm restart kept of it ([`PriorLight`]).
 
 use glam::{DVec3, Vec3};
+use rayon::prelude::*;
 
 use super::config::Config;
 use super::direct;
@@ -211,6 +212,8 @@ impl LightSeen {
     /// passes (with what this epoch inherited).
     pub fn kept(&self, eye_passes: u32, passes: u32) -> Vec<PriorLight> {
         (0..self.direct.len())
+            .into_par_iter()
+            .with_min_len(4096)
             .map(|i| {
                 let prior = self.prior.get(i).copied().unwrap_or_default();
                 PriorLight {

@@ -22,7 +22,9 @@ use super::photon_pass::{guided_pass_photons, PhotonJob, PhotonPass};
 use super::radius::{IndirectScale, RadiusPolicy};
 use super::reuse::PathKind;
 use super::stats::{skipped_work, PpmStats};
-use super::warm::{records, Epoch, PointRecord, Reopen, StreamOffset, WarmStart, PRIOR_PASSES};
+use super::warm::{
+    records, records_in_place, Epoch, PointRecord, Reopen, StreamOffset, WarmStart, PRIOR_PASSES,
+};
 use crate::render::control::{Control, Interrupt};
 use crate::render::shard::{PassSet, PassSums};
 use crate::scene::Scene;
@@ -307,7 +309,12 @@ impl Ppm {
             return;
         };
         let reopen = Reopen::new(&self.radius, self.alpha, self.photons_per_pass);
-        let now = self.point_records();
+        // This pass's copy in place, when it keeps one (with warm restarts, as here).
+        let now = if self.eye.copy.len() == self.estimates.slots.len() {
+            records_in_place(&self.eye.copy)
+        } else {
+            self.point_records()
+        };
         let size = self.size();
         let kept = warm.keep_unmoved(&mut self.estimates.slots, &now, &reopen, size);
         self.light.set_prior(kept.light);
@@ -529,8 +536,7 @@ impl Ppm {
         // half written: the records kept at that pass count (see `update`).
         let (points, eye) = if self.config.stochastic {
             let eye = self.epoch.last_eye.take();
-            let slots = self.estimates.slots.len();
-            let points = eye.as_ref().map(|e| records(slots, &e.points));
+            let points = eye.as_ref().map(|e| records_in_place(&e.points));
             (points.unwrap_or_default(), eye)
         } else {
             (self.point_records(), None)

@@ -172,6 +172,28 @@ pub fn records(slots: usize, points: &VisiblePoints) -> Vec<PointRecord> {
     out
 }
 
+/// [`records`] of points that lie one place a slot (place `k` holds slot `k`'s point or a
+/// placeholder: a stochastic pass's, before the placeholders are dropped), in parallel.
+pub fn records_in_place(points: &VisiblePoints) -> Vec<PointRecord> {
+    (0..points.len())
+        .into_par_iter()
+        .with_min_len(4096)
+        .map(|k| {
+            let (r, s) = (&points.reach[k], &points.shade[k]);
+            if s.slot == Shade::NONE {
+                return PointRecord::default();
+            }
+            debug_assert_eq!(s.slot as usize, k, "one place a slot");
+            PointRecord {
+                position: r.position.as_vec3(),
+                normal: s.normal,
+                weight: s.weight,
+                glossy: matches!(points.glossy.get(k), Some(Some(_))),
+            }
+        })
+        .collect()
+}
+
 /// How a previous slot's estimate carries to a new visible point of the same pixel: `None`
 /// when the point moved by more than [`NEAR`] of the estimate's radius, turned, its weight
 /// changed more than twofold, or it changed at all on a glossy surface (whose estimate
