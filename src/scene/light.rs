@@ -193,21 +193,20 @@ impl Light {
     pub fn surface_bounds(&self) -> Option<crate::geometry::Aabb> {
         match *self {
             Light::Point { .. } | Light::Spot { .. } => None,
-            Light::Sphere { center, radius, .. } => Some(crate::geometry::Aabb::new(
-                center - DVec3::splat(radius),
-                center + DVec3::splat(radius),
-            )),
+            Light::Sphere { center, radius, .. } => Some(crate::geometry::Sphere { center, radius }.bounds()),
             Light::Quad {
                 corner,
                 edge_u,
                 edge_v,
                 ..
-            } => Some(crate::geometry::Aabb::from_points([
-                corner,
-                corner + edge_u,
-                corner + edge_v,
-                corner + edge_u + edge_v,
-            ])),
+            } => Some(
+                crate::geometry::Quad {
+                    corner,
+                    edge_u,
+                    edge_v,
+                }
+                .bounds(),
+            ),
         }
     }
 

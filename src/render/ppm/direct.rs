@@ -35,9 +35,10 @@ pub fn has_area_lights(scene: &Scene) -> bool {
 const BLOCK: usize = 1 << 16;
 
 /// Reflected radiance from every area light at each point (one sample each; none at the
-/// points `skip` names), handed to `add(k, light)` in point order: `point.weight(wi) × L × cos θ / pdf` where the shadow ray is
-/// clear. `key(k)` names point `k` stably across passes (its statistics slot), for the
-/// stratification. Sampled `BLOCK` points at a time, in parallel.
+/// points `skip` names), handed to `add(k, light)` in point order:
+/// `point.weight(wi) × L × cos θ / pdf` where the shadow ray is clear. `key(k)` names point
+/// `k` stably across passes (its statistics slot), for the stratification. Sampled `BLOCK`
+/// points at a time, in parallel.
 pub fn area_light_pass(
     scene: &Scene,
     points: &VisiblePoints,

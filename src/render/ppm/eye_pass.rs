@@ -2,7 +2,7 @@
 //! no anti-aliasing; glass paths split), every pass for stochastic PPM (Hachisuka & Jensen
 //! 2009: one jittered point per pixel) — and the spatial index over them.
 
-use glam::{DVec2, DVec3};
+use glam::{DVec2, DVec3, Vec3};
 use rand::Rng;
 use rand_pcg::Pcg64Mcg;
 use rayon::prelude::*;
@@ -13,7 +13,7 @@ use super::hash_grid::HashGrid;
 use super::index::SpatialIndex;
 use super::kd_tree::KdTree;
 use super::light::LightSeen;
-use super::points::VisiblePoints;
+use super::points::{Place, VisiblePoints};
 use super::reuse::{PathKind, Reuse};
 use super::seen;
 use super::streams;
@@ -95,65 +95,32 @@ impl EyePass {
         self.kinds.clear();
         self.kinds.resize(pixels, PathKind::Other);
         let rays = scene.camera.eye_rays();
-        let subsampler = seen::Subsampler {
-            scene,
-            rays: &rays,
-            seed,
-            pass,
-            pixels: w * h,
-            stratified: config.stratified_eye_rays,
-            direct_light,
+        let tracer = PixelTracer {
+            subsampler: seen::Subsampler {
+                scene,
+                rays: &rays,
+                seed,
+                pass,
+                pixels: w * h,
+                stratified: config.stratified_eye_rays,
+                direct_light,
+            },
+            seen,
+            reuse,
+            sequences,
+            width: w,
         };
         self.points
             .places_mut()
             .zip(pass_direct.par_iter_mut())
             .zip(self.kinds.par_iter_mut())
             .enumerate()
-            .for_each(|(i, ((mut place, direct), kind))| {
+            .for_each(|(i, ((place, direct), kind))| {
                 if interrupt.is_some_and(|f| f()) {
                     skipped.store(true, std::sync::atomic::Ordering::Relaxed);
                     return;
                 }
-                let i = i as u64;
-                let (x, y) = (i % w, i / w);
-                // A supersampled pixel's light seen comes from its extra rays alone, so its
-                // own ray needs no shadow rays (they draw no random numbers: the point is the
-                // same).
-                let chosen = seen.chosen(i as usize);
-                // The previous pass's point, already in place, where it is still right.
-                let reuse = reuse.filter(|_| !chosen);
-                if reuse.is_some_and(|r| r.copies_unseen(i as usize, x, y)) {
-                    *kind = PathKind::Copied;
-                    return;
-                }
-                let mut rng = stream_rng(seed, streams::EYE, pass * w * h + i);
-                let (jitter, lens, first) = eye_sample(seed, pass, i, sequences, &mut rng);
-                let px = DVec2::new(x as f64, y as f64) + jitter;
-                let ray = rays.ray_with_lens_sample(px, lens);
-                if let Some(r) = reuse {
-                    if r.copies(i as usize, &ray) {
-                        *kind = PathKind::Copied;
-                        return;
-                    }
-                    place.clear();
-                }
-                let mut sink = |vp: VisiblePoint| place.set(&vp);
-                let traced = trace_eye(
-                    scene,
-                    &ray,
-                    i as u32,
-                    Branching::Choose { first },
-                    ShadowRays::new(direct_light, !chosen),
-                    &mut rng,
-                    &mut sink,
-                );
-                *kind = PathKind::traced(traced.rays, traced.direct, chosen);
-                *direct = if chosen {
-                    subsampler.light_seen(i, x, y, seen.subsamples(i as usize))
-                } else {
-                    traced.direct
-                }
-                .as_vec3();
+                (*direct, *kind) = tracer.trace(i as u64, place);
             });
         if skipped.into_inner() {
             return false;
@@ -206,6 +173,64 @@ impl EyePass {
         if let SpatialIndex::Grid(grid) = index {
             self.kept_grid = Some(grid);
         }
+    }
+}
+
+/// What one pixel's eye path in a stochastic pass needs besides its place: the scene, the
+/// pass and its streams (held by the supersampler, which needs them too), the pixels chosen
+/// to supersample, and the previous pass's points a warm epoch's first pass may copy.
+struct PixelTracer<'a> {
+    subsampler: seen::Subsampler<'a>,
+    seen: &'a seen::SeenLight,
+    reuse: Option<&'a Reuse<'a>>,
+    /// This pass's points of the lens and first-choice sequences, with stratified eye rays.
+    sequences: Option<(DVec2, f64)>,
+    width: u64,
+}
+
+impl PixelTracer<'_> {
+    /// Traces pixel `i`'s eye path into `place` (or keeps the previous pass's point there,
+    /// [`Reuse`]): the light it saw directly and what the path was.
+    fn trace(&self, i: u64, mut place: Place) -> (Vec3, PathKind) {
+        let sub = &self.subsampler;
+        let (x, y) = (i % self.width, i / self.width);
+        // A supersampled pixel's light seen comes from its extra rays alone, so its own ray
+        // needs no shadow rays (they draw no random numbers: the point is the same).
+        let chosen = self.seen.chosen(i as usize);
+        // The previous pass's point, already in place, where it is still right.
+        let reuse = self.reuse.filter(|_| !chosen);
+        if reuse.is_some_and(|r| r.copies_unseen(i as usize, x, y)) {
+            return (Vec3::ZERO, PathKind::Copied);
+        }
+        let mut rng = stream_rng(sub.seed, streams::EYE, sub.pass * sub.pixels + i);
+        let (jitter, lens, first) = eye_sample(sub.seed, sub.pass, i, self.sequences, &mut rng);
+        let px = DVec2::new(x as f64, y as f64) + jitter;
+        let ray = sub.rays.ray_with_lens_sample(px, lens);
+        if let Some(r) = reuse {
+            if r.copies(i as usize, &ray) {
+                return (Vec3::ZERO, PathKind::Copied);
+            }
+            place.clear();
+        }
+        let mut sink = |vp: VisiblePoint| place.set(&vp);
+        let traced = trace_eye(
+            sub.scene,
+            &ray,
+            i as u32,
+            Branching::Choose { first },
+            ShadowRays::new(sub.direct_light, !chosen),
+            &mut rng,
+            &mut sink,
+        );
+        let direct = if chosen {
+            sub.light_seen(i, x, y, self.seen.subsamples(i as usize))
+        } else {
+            traced.direct
+        };
+        (
+            direct.as_vec3(),
+            PathKind::traced(traced.rays, traced.direct, chosen),
+        )
     }
 }
 

@@ -255,9 +255,7 @@ impl Ppm {
     /// Traces a stochastic eye pass ([`EyePass::trace_stochastic`]); its light seen chooses
     /// pixels to supersample except on the global schedule after the pilot.
     fn trace_stochastic_eye_pass(&mut self, scene: &Scene) -> bool {
-        let reuses = self.reuses();
-        let inherited = self.epoch.inherited.as_ref().filter(|_| reuses);
-        let reuse = inherited.and_then(|w| w.reuse(&scene.camera));
+        let reuse = self.epoch.reuse(self.reuses(), &scene.camera);
         let job = EyeJob {
             config: &self.config,
             pass: self.stream_pass(),
@@ -382,9 +380,7 @@ impl Ppm {
         }
         let start = Instant::now();
         let (pass, seed) = (self.stream_pass(), self.config.seed);
-        let reuses = self.reuses();
-        let inherited = self.epoch.inherited.as_ref().filter(|_| reuses);
-        let reuse = inherited.and_then(|w| w.reuse(&scene.camera));
+        let reuse = self.epoch.reuse(self.reuses(), &scene.camera);
         // Copied points whose light is the previous pass's (stochastic: slot k is pixel k).
         let known = reuse
             .map(|r| r.copy_area_light(scene, &self.eye.kinds, self.light.pass_light_mut()))

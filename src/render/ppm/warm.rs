@@ -154,14 +154,10 @@ impl PointRecord {
     }
 }
 
-/// Each of `slots` slots' visible point among `points` (each point names its slot;
-/// placeholders are passed over).
+/// Each of `slots` slots' visible point among `points` (each point names its slot).
 pub fn records(slots: usize, points: &VisiblePoints) -> Vec<PointRecord> {
     let mut out = vec![PointRecord::default(); slots];
     for (k, (r, s)) in points.reach.iter().zip(&points.shade).enumerate() {
-        if s.slot == Shade::NONE {
-            continue;
-        }
         out[s.slot as usize] = PointRecord {
             position: r.position.as_vec3(),
             normal: s.normal,
@@ -319,6 +315,12 @@ pub(super) struct Epoch {
 }
 
 impl Epoch {
+    /// The reuse of the previous epoch's last pass by this epoch's first (`first`), seen by
+    /// `camera`, when it inherited one ([`WarmStart::reuse`]).
+    pub fn reuse(&self, first: bool, camera: &Camera) -> Option<Reuse<'_>> {
+        self.inherited.as_ref().filter(|_| first)?.reuse(camera)
+    }
+
     /// Whether this epoch continues an earlier one's estimates (it inherited a warm start).
     pub fn is_warm(&self) -> bool {
         self.offset != StreamOffset::default()
