@@ -256,23 +256,13 @@ fn vcm_is_identical_for_one_and_two_threads() {
 }
 
 /// `caustic render --renderer vcm` renders passes, reports them, records them, and `--from`
-/// renders the same pixels again; `--shard` refuses it, saying why.
+/// renders the same pixels again.
 #[test]
 fn render_with_vcm_reports_and_reproduces() {
     let dir = tempfile::tempdir().expect("temp dir");
     let (first, second) = (dir.path().join("a.exr"), dir.path().join("b.exr"));
     let first_arg = first.to_str().expect("utf-8");
-    let args = [
-        "render",
-        "scenes/cornell.toml",
-        "--renderer",
-        "vcm",
-        "--width",
-        "40",
-        "--passes",
-        "5",
-    ];
-    let out = common::caustic(&[&args[..], &["--out", first_arg]].concat());
+    let out = common::caustic(&[&VCM_CORNELL[..], &["--out", first_arg]].concat());
     let t = common::text(&out);
     assert!(out.status.success(), "{t}");
     assert!(t.contains("40x30, 5 passes"), "{t}");
@@ -293,15 +283,114 @@ fn render_with_vcm_reports_and_reproduces() {
     );
     let [a, b] = [&first, &second].map(|p| image::open(p).expect("EXR").into_rgb32f().into_raw());
     assert_eq!(a, b, "--from renders the same pixels");
-    let part = dir.path().join("part.exr");
-    let refused = common::caustic(
-        &[
-            &args[..],
-            &["--shard", "0/2", "--out", part.to_str().expect("utf-8")],
-        ]
-        .concat(),
+}
+
+/// `render --renderer vcm`: five passes of the Cornell box at 40 pixels wide.
+const VCM_CORNELL: [&str; 8] = [
+    "render",
+    "scenes/cornell.toml",
+    "--renderer",
+    "vcm",
+    "--width",
+    "40",
+    "--passes",
+    "5",
+];
+
+/// VCM's passes are independent: `--shard` renders a part of VCM passes; two shards merged
+/// equal the one-shard render bit for bit (on one thread and on two) and the plain render
+/// within float rounding; `render --from` a part renders its passes again; a part's settings
+/// tell it from a photon-mapped part of the same scene; `--renderer path` is refused, saying
+/// why.
+#[test]
+fn vcm_shards_merge_into_the_plain_render() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = |name: &str| dir.path().join(name).to_str().expect("utf-8").to_owned();
+    let shard = |k: &str, out: &str, threads: &str| {
+        let out = common::caustic(
+            &[
+                &VCM_CORNELL[..],
+                &["--shard", k, "--out", &path(out), "--threads", threads],
+            ]
+            .concat(),
+        );
+        let t = common::text(&out);
+        assert!(out.status.success(), "{t}");
+        assert!(t.contains("light subpaths"), "{t}");
+    };
+    shard("0/2", "p0.exr", "1");
+    shard("1/2", "p1.exr", "2");
+    shard("0/1", "all.exr", "2");
+    let merge = |parts: &[&str], out: &str| {
+        let mut args = vec!["merge".to_owned()];
+        args.extend(parts.iter().map(|p| path(p)));
+        args.extend(["--out".to_owned(), path(out)]);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        common::caustic(&args)
+    };
+    for (parts, out) in [
+        (&["p0.exr", "p1.exr"][..], "merged.exr"),
+        (&["all.exr"][..], "one.exr"),
+    ] {
+        let done = merge(parts, out);
+        assert!(done.status.success(), "{}", common::text(&done));
+    }
+    let plain = common::caustic(&[&VCM_CORNELL[..], &["--out", &path("plain.exr")]].concat());
+    assert!(plain.status.success(), "{}", common::text(&plain));
+    let [merged, one, plain] = ["merged.exr", "one.exr", "plain.exr"]
+        .map(|p| image::open(path(p)).expect("EXR").into_rgb32f().into_raw());
+    assert_eq!(
+        merged, one,
+        "two shards merged are the one-shard render, bit for bit"
     );
+    assert!(merged.iter().any(|&v| v > 0.0), "the image is not black");
+    for (m, p) in merged.iter().zip(&plain) {
+        assert!(
+            (m - p).abs() <= 1e-5 * p.abs().max(1e-3),
+            "{m} against the plain render's {p}"
+        );
+    }
+    let again = common::caustic(&[
+        "render",
+        "--from",
+        &path("p0.exr"),
+        "--shard",
+        "1/2",
+        "--out",
+        &path("p1b.exr"),
+    ]);
+    assert!(again.status.success(), "{}", common::text(&again));
+    let [p1, p1b] =
+        ["p1.exr", "p1b.exr"].map(|p| image::open(path(p)).expect("EXR").into_rgb32f().into_raw());
+    assert_eq!(p1, p1b, "a sibling shard from a part's record");
+    let ppm = common::caustic(&[
+        "render",
+        "scenes/cornell.toml",
+        "--width",
+        "40",
+        "--passes",
+        "5",
+        "--photons",
+        "2000",
+        "--shard",
+        "1/2",
+        "--out",
+        &path("q1.exr"),
+    ]);
+    assert!(ppm.status.success(), "{}", common::text(&ppm));
+    let mixed = merge(&["p0.exr", "q1.exr"], "mixed.exr");
+    let t = common::text(&mixed);
+    assert!(
+        !mixed.status.success() && t.contains("renderer \"vcm\" and \"ppm\""),
+        "{t}"
+    );
+    let mut path_tracer = VCM_CORNELL;
+    path_tracer[3] = "path";
+    let refused = common::caustic(&[&path_tracer[..], &["--shard", "0/2", "--out", &path("r.exr")]].concat());
     let t = common::text(&refused);
     assert!(!refused.status.success(), "{t}");
-    assert!(t.contains("--renderer vcm") && t.contains("photon mapped"), "{t}");
+    assert!(
+        t.contains("--renderer path") && t.contains("only photon mapping"),
+        "{t}"
+    );
 }

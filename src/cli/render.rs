@@ -64,9 +64,10 @@ pub struct RenderArgs {
     /// Print the summary as JSON on stdout (progress and warnings stay on stderr).
     #[arg(long)]
     json: bool,
-    /// Render shard K of N: the passes i ≡ K (mod N) of 0..--passes, photon mapped with the
-    /// global radius schedule (this flag sets both), into an EXR part file holding their exact sums, for
-    /// `caustic merge` (see README, "Rendering on a cluster").
+    /// Render shard K of N: the passes i ≡ K (mod N) of 0..--passes, into an EXR part file
+    /// holding their exact sums, for `caustic merge` (see README, "Rendering on a cluster").
+    /// A VCM scene's passes are VCM's; any other scene's are photon mapped with the global
+    /// radius schedule (this flag sets both).
     #[arg(long, value_name = "K/N", value_parser = caustic::render::shard::Shard::parse)]
     shard: Option<caustic::render::shard::Shard>,
     #[command(flatten)]
@@ -184,10 +185,13 @@ pub fn check_shard_flags(args: &RenderArgs) -> Result<()> {
         bail!("--time-limit cannot be used for a part: a part holds whole passes, chosen by their number");
     }
     let given = |key: &str| args.settings.get(key).map(|v| v.replace('-', "_"));
-    if let Some(kind) = given("renderer").filter(|k| k != RendererKind::Ppm.name()) {
-        bail!("--renderer {kind}: a part is photon mapped with the global radius schedule, whose passes are independent estimates that merge exactly; only photon mapping renders parts");
+    if let Some(kind) =
+        given("renderer").filter(|k| k != RendererKind::Ppm.name() && k != RendererKind::Vcm.name())
+    {
+        bail!("--renderer {kind}: a part's passes must be independent estimates that merge exactly; only photon mapping (with the global radius schedule) and vcm render parts");
     }
-    if let Some(schedule) = given("radius_schedule").filter(|s| s != RadiusSchedule::Global.name()) {
+    let vcm = given("renderer").is_some_and(|k| k == RendererKind::Vcm.name());
+    if let Some(schedule) = given("radius_schedule").filter(|s| !vcm && s != RadiusSchedule::Global.name()) {
         bail!("--radius-schedule {schedule}: a part's passes follow the global radius schedule");
     }
     Ok(())

@@ -13,8 +13,9 @@ use caustic::render::shard::{merge_parts, shard_part};
 use caustic::scene::Scene;
 use caustic::settings::limits;
 
-/// Renders the passes `passes` of a `total`-pass render of `scene` (its photon-mapping flags
-/// laid in) into the part file `out`, which `render` has checked may be written.
+/// Renders the passes `passes` of a `total`-pass render of `scene` (its flags laid in;
+/// [`caustic::render::shard::render_part::shard_renderer`] says which renderer) into the part
+/// file `out`, which `render` has checked may be written.
 pub fn render_shard(scene: &mut Scene, passes: PassSet, total: u32, out: &Path, force: bool) -> Result<()> {
     if !out.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr")) {
         bail!(
@@ -36,8 +37,14 @@ pub fn render_shard(scene: &mut Scene, passes: PassSet, total: u32, out: &Path, 
     let (part, photons) = shard_part(scene, &passes, total, || bar.inc(1))?;
     bar.finish_and_clear();
     part.write(out, force)?;
+    // What a pass emits: VCM's light subpaths are its photons.
+    let emitted = if scene.params.renderer == caustic::scene::RendererKind::Vcm {
+        "light subpaths"
+    } else {
+        "photons"
+    };
     println!(
-        "{passes}: {count} of {total} passes, {photons} photons in {:.2} s ({:.2} passes/s) → {}",
+        "{passes}: {count} of {total} passes, {photons} {emitted} in {:.2} s ({:.2} passes/s) → {}",
         start.elapsed().as_secs_f64(),
         count as f64 / start.elapsed().as_secs_f64().max(1e-9),
         out.display()

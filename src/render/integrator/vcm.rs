@@ -4,6 +4,9 @@
 //! to the image, which is the mean of its passes. Every random number comes from
 //! `(seed, stream, pass · pixels + index)`, and light tracing's contributions are added in
 //! subpath order: the image is the same for any number of threads.
+//!
+//! Pass `i`'s radius and random streams depend on `(scene, i)` alone, so any set of passes
+//! can be rendered apart and their sums merged ([`Vcm::render_only`], `render --shard`).
 
 use std::time::Instant;
 
@@ -15,6 +18,7 @@ use crate::render::frame::{Frame, FrameStats, StatRow};
 use crate::render::provenance;
 use crate::render::rng::stream_rng;
 use crate::render::sequence;
+use crate::render::shard::{PassSet, PassSums};
 use crate::render::vcm::camera_path::{CameraPath, PassData};
 use crate::render::vcm::light_path::{self, LightPath, LightVertex, Photons};
 use crate::render::vcm::radius::automatic_radius;
@@ -62,6 +66,11 @@ pub struct Vcm {
     techniques: Techniques,
     sums: Vec<DVec3>,
     stats: VcmStats,
+    /// The passes of the render this one renders, in order (all of them unless a shard's).
+    passes: PassSet,
+    /// The rendered passes' exact sums, kept when a set of passes was chosen
+    /// ([`Vcm::render_only`]).
+    part: Option<PassSums>,
 }
 
 impl Vcm {
@@ -81,7 +90,26 @@ impl Vcm {
             techniques,
             sums: vec![DVec3::ZERO; size.0 as usize * size.1 as usize],
             stats: VcmStats::default(),
+            passes: PassSet::default(),
+            part: None,
         }
+    }
+
+    /// Renders only `passes` of the render (a shard's, or a part's own list), in order, and
+    /// keeps their exact sums ([`Vcm::pass_sums`]) for a part file.
+    pub fn render_only(&mut self, passes: PassSet) {
+        self.passes = passes;
+        self.part = Some(PassSums::new(self.size.0, self.size.1));
+    }
+
+    /// The exact sums of the passes rendered, after [`Vcm::render_only`].
+    pub fn pass_sums(&self) -> Option<&PassSums> {
+        self.part.as_ref()
+    }
+
+    /// The index in the render of the next pass this one renders.
+    fn next_pass(&self) -> u64 {
+        self.passes.pass(self.stats.passes)
     }
 
     /// What it did so far.
@@ -98,7 +126,7 @@ impl Vcm {
         control: &mut dyn FnMut(&mut RenderParams) -> Control,
     ) -> Option<LightPaths> {
         let n = self.sums.len();
-        let (seed, pass) = (scene.params.seed, self.stats.passes as u64);
+        let (seed, pass) = (scene.params.seed, self.next_pass());
         let batch = (BATCH_ROWS * self.size.0 as usize).max(1);
         let mut paths = LightPaths {
             vertices: Vec::new(),
@@ -129,7 +157,7 @@ impl Vcm {
     /// One camera subpath of pixel `i`: its radiance, segments and merges.
     fn camera_sample(&self, pass: &PassData, own: &[LightVertex], i: u64) -> (DVec3, u64, u64) {
         let scene = pass.scene;
-        let (n, seed, index) = (self.sums.len() as u64, scene.params.seed, self.stats.passes as u64);
+        let (n, seed, index) = (self.sums.len() as u64, scene.params.seed, self.next_pass());
         let ray = sequence::pixel_ray(&scene.camera, index, i, &mut stream_rng(seed, streams::OFFSETS, i));
         let mut path = CameraPath {
             pass,
@@ -158,11 +186,13 @@ impl Integrator for Vcm {
         }
         let n = self.sums.len();
         let max_length = scene.params.max_depth.max(1) * 4 + 1;
+        // A pass of the render's passes (`--passes`, at most a u32).
+        let index = u32::try_from(self.next_pass()).unwrap_or(u32::MAX);
         let k = PassConstants::new(
             self.techniques,
             self.stats.initial_radius,
             plan.params.alpha,
-            self.stats.passes,
+            index,
             n,
             max_length,
         );
@@ -214,6 +244,9 @@ impl Integrator for Vcm {
         }
         for (sum, v) in self.sums.iter_mut().zip(&image) {
             *sum += *v;
+        }
+        if let Some(part) = &mut self.part {
+            part.add_pass(index, &image, n as u64);
         }
         let s = &mut self.stats;
         s.passes += 1;
