@@ -107,6 +107,16 @@ impl Vcm {
         self.part.as_ref()
     }
 
+    /// Adds pass `index`'s image (one estimate per pixel) to the sums, and to the part's.
+    fn add_to_sums(&mut self, index: u32, image: &[DVec3]) {
+        for (sum, v) in self.sums.iter_mut().zip(image) {
+            *sum += *v;
+        }
+        if let Some(part) = &mut self.part {
+            part.add_pass(index, image, image.len() as u64);
+        }
+    }
+
     /// The index in the render of the next pass this one renders.
     fn next_pass(&self) -> u64 {
         self.passes.pass(self.stats.passes)
@@ -242,12 +252,7 @@ impl Integrator for Vcm {
         if self.setup.interrupted() {
             return false;
         }
-        for (sum, v) in self.sums.iter_mut().zip(&image) {
-            *sum += *v;
-        }
-        if let Some(part) = &mut self.part {
-            part.add_pass(index, &image, n as u64);
-        }
+        self.add_to_sums(index, &image);
         let s = &mut self.stats;
         s.passes += 1;
         s.radius = k.radius;
