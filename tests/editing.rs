@@ -43,6 +43,7 @@ fn flat_frame() -> Frame {
         epoch: 0,
         pass: 1,
         photons: 1,
+        restarts: Default::default(),
         elapsed_secs: 0.1,
         stats: FrameStats::from(PpmStats::default()),
         width: SIZE.0,

@@ -4,7 +4,9 @@
 //! said a fifth of the truth), at 160 pixels wide with the photons per pass scaled with the
 //! pixels, as the viewer renders them. Where the error is in a few pixels (pool's), one
 //! frame's noise is itself a matter of luck: there the estimate must say it is uncertain, and
-//! only there.
+//! only there. Leaf's lamp outlines start their light seen again at their first supersampled
+//! pass: compared pixel by pixel with their own samples, or left out, they no longer read as
+//! noise (told nothing of it, the tracker said 1.9 times the truth after 16 passes).
 
 use std::path::Path;
 use std::sync::Arc;
@@ -34,7 +36,7 @@ fn frames(mut scene: Scene, seed: u64) -> Vec<Estimated> {
     let mut tracker = ErrorTracker::default();
     let mut out = Vec::new();
     render_session(scene, options, |f| {
-        let estimate = tracker.add(f.photons, &f.radiance, alpha);
+        let estimate = tracker.add((f.photons, &f.restarts), &f.radiance, alpha);
         if PASSES.contains(&f.pass) {
             out.push((f.radiance.clone(), estimate));
         }
@@ -46,7 +48,7 @@ fn frames(mut scene: Scene, seed: u64) -> Vec<Estimated> {
 #[test]
 fn the_noise_estimate_is_within_1_5_times_the_measured_noise_or_says_it_is_uncertain() {
     let mut uncertain = Vec::new();
-    for name in ["pool", "cornell", "ring"] {
+    for name in ["pool", "cornell", "ring", "leaf"] {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("scenes/{name}.toml"));
         let scene = scaled(Scene::load(&path).expect("loads"), 160);
         let a = frames(scene.clone(), 11);
@@ -62,9 +64,15 @@ fn the_noise_estimate_is_within_1_5_times_the_measured_noise_or_says_it_is_uncer
                 "{name} after {pass} passes: estimate {:.4} on {:.0} pixels against measured noise {noise:.4} on {measured_pixels:.0} ({ratio:.2}x)",
                 estimate.noise, estimate.pixels
             );
-            if estimate.uncertain() {
+            if estimate.pixels < FEW_PIXELS {
                 // Said only where the measured noise, too, is in a few pixels.
                 assert!(measured_pixels < FEW_PIXELS, "{what}");
+                uncertain.push(what);
+            } else if estimate.settling {
+                // Some pixels started again since the frame compared, and hold too much of the
+                // image to leave out: said early on, or later where a few pixels hold the
+                // noise (pool's specks, each supersampled once first seen).
+                assert!(*pass == PASSES[0] || measured_pixels < FEW_PIXELS, "{what}");
                 uncertain.push(what);
             } else {
                 assert!((1.0 / 1.5..=1.5).contains(&ratio), "{what}");
@@ -72,7 +80,7 @@ fn the_noise_estimate_is_within_1_5_times_the_measured_noise_or_says_it_is_uncer
         }
     }
     // Ring's noise is spread over a thousand pixels; pool's, after 64 passes, is in two
-    // (measured 2 for both the estimate and the two seeds).
+    // (the two seeds'), specks supersampled since the frame compared: settling.
     assert!(uncertain.iter().all(|w| !w.starts_with("ring")), "{uncertain:?}");
     assert!(
         uncertain.iter().any(|w| w.starts_with("pool after 64")),

@@ -384,9 +384,12 @@ fn convergence_plot_ui(viewer: &ViewerState, ui: &mut egui::Ui) {
         ));
         if !uncertain.is_empty() {
             plot.points(
-                Points::new("uncertain: a few pixels", PlotPoints::from(uncertain))
-                    .color(UNCERTAIN)
-                    .radius(2.0),
+                Points::new(
+                    "uncertain: a few pixels, or settling",
+                    PlotPoints::from(uncertain),
+                )
+                .color(UNCERTAIN)
+                .radius(2.0),
             );
         }
         if with_reference {
@@ -414,6 +417,8 @@ fn convergence_plot_ui(viewer: &ViewerState, ui: &mut egui::Ui) {
 /// The newest estimate in words: its noise and blur, and a note where it is uncertain.
 fn latest_estimate_ui(viewer: &ViewerState, ui: &mut egui::Ui) {
     let Some(e) = viewer.convergence.latest() else {
+        ui.label(RichText::new("no estimate yet: it compares two frames").small())
+            .on_hover_text("The first estimate comes once a frame holds about twice the photons of an earlier one of the same render; with photon mapping, of one made after its estimates restarted with the adaptive radius (after the first pass)");
         return;
     };
     let now = percent(e.total());
@@ -422,11 +427,14 @@ fn latest_estimate_ui(viewer: &ViewerState, ui: &mut egui::Ui) {
             Some(blur) => format!("now {now} (noise {}, blur {})", percent(e.noise), percent(blur)),
             None => format!("now {now} (noise)"),
         });
-        if e.uncertain() {
-            ui.colored_label(UNCERTAIN, format!("uncertain: in ~{:.0} pixels", e.pixels.max(1.0)))
-                .on_hover_text(
-                    "The error is in a few pixels (bright specks that come and go: a light seen in a pixel's corner, rare caustic paths, a focus a few pixels wide), so this frame's true error may be far from the estimate either way",
-                );
+        if let Some(why) = e.why_uncertain() {
+            let help = if e.settling {
+                "Some pixels started their estimates anew a few passes ago (a lamp's outline that now takes extra rays, the adaptive radius after the first pass), so the frames compared differ there by both frames' noise: the estimate is high until those pixels have a few passes of their own"
+            } else {
+                "The error is in a few pixels (bright specks that come and go: a light seen in a pixel's corner, rare caustic paths, a focus a few pixels wide), so this frame's true error may be far from the estimate either way"
+            };
+            ui.colored_label(UNCERTAIN, format!("uncertain: {why}"))
+                .on_hover_text(help);
         }
     });
 }

@@ -6,7 +6,7 @@
 use std::sync::Arc;
 
 use crate::render::compare::ReferenceErrors;
-use crate::render::error_tracker::{ErrorEstimate, ErrorTracker};
+use crate::render::error_tracker::{ErrorEstimate, ErrorTracker, Restarts};
 
 /// Error estimates of one epoch against time.
 #[derive(Clone, Default)]
@@ -16,7 +16,8 @@ pub struct Convergence {
     /// noise, and from the third frame on the blur with it (`√(noise² + blur²)`).
     pub points: Vec<[f64; 2]>,
     /// Those of [`Convergence::points`] whose estimate is uncertain
-    /// ([`ErrorEstimate::uncertain`]: the error is in a few pixels).
+    /// ([`ErrorEstimate::why_uncertain`]: the error is in a few pixels, or the frames compared
+    /// straddle a restart).
     pub uncertain_points: Vec<[f64; 2]>,
     /// The newest estimate.
     latest: Option<ErrorEstimate>,
@@ -31,10 +32,16 @@ impl Convergence {
         *self = Self::default();
     }
 
-    /// Takes a frame of the current epoch made from `photons` photons with photon mapping's
-    /// `alpha` (1 for a path tracer's plain means).
-    pub fn add(&mut self, photons: u64, elapsed_secs: f64, radiance: &Arc<[[f32; 3]]>, alpha: f64) {
-        if let Some(estimate) = self.tracker.add(photons, radiance, alpha) {
+    /// Takes a frame of the current epoch made from `photons` photons, with the epoch's
+    /// `restarts` so far and photon mapping's `alpha` (1 for a path tracer's plain means).
+    pub fn add(
+        &mut self,
+        (photons, restarts): (u64, &Restarts),
+        elapsed_secs: f64,
+        radiance: &Arc<[[f32; 3]]>,
+        alpha: f64,
+    ) {
+        if let Some(estimate) = self.tracker.add((photons, restarts), radiance, alpha) {
             self.points.push([elapsed_secs, estimate.total()]);
             if estimate.uncertain() {
                 self.uncertain_points.push([elapsed_secs, estimate.total()]);

@@ -426,8 +426,12 @@ impl Viewer {
                 crate::settings::RendererKind::Ppm => self.document.scene().params.alpha,
                 _ => 1.0,
             };
-            self.convergence
-                .add(frame.photons, frame.elapsed_secs, &frame.radiance, alpha);
+            self.convergence.add(
+                (frame.photons, &frame.restarts),
+                frame.elapsed_secs,
+                &frame.radiance,
+                alpha,
+            );
         }
         if let Some(errors) = self
             .reference

@@ -105,7 +105,7 @@ pub fn check_estimates(scene: Scene, passes: &[u32], reference: &[[f32; 3]]) -> 
     let mut previous: Option<(u64, std::sync::Arc<[[f32; 3]]>)> = None;
     let mut out = Vec::new();
     render_session(scene, options, |f| {
-        let estimate = tracker.add(f.photons, &f.radiance, alpha);
+        let estimate = tracker.add((f.photons, &f.restarts), &f.radiance, alpha);
         let consecutive = previous
             .as_ref()
             .and_then(|(n, a)| relative_error_estimate(*n, a, f.photons, &f.radiance));

@@ -5,6 +5,7 @@
 
 use std::sync::Arc;
 
+use crate::render::error_tracker::Restarts;
 use crate::settings::RendererKind;
 
 /// A per-pixel quantity a renderer describes besides radiance (photon mapping: its search
@@ -93,6 +94,10 @@ pub struct Frame {
     /// Photons emitted in this epoch, or paths traced by a renderer without photons: the
     /// sample count that error estimates between two frames scale by (0 for a single frame).
     pub photons: u64,
+    /// Where and when estimates started again in this epoch, no longer counting earlier
+    /// passes: a frame from before is not part of this one there, and an error estimate
+    /// that compares the two must know ([`crate::render::error_tracker`]).
+    pub restarts: Restarts,
     /// Seconds since this epoch started.
     pub elapsed_secs: f64,
     /// What the renderer measured (and so which renderer made it).
@@ -122,6 +127,7 @@ impl Frame {
             epoch,
             pass,
             photons: 0,
+            restarts: Restarts::default(),
             elapsed_secs,
             stats,
             width,

@@ -102,6 +102,7 @@ impl Frame {
             epoch,
             pass: stats.passes,
             photons: stats.photons,
+            restarts: ppm.restarts(),
             elapsed_secs,
             stats: FrameStats::from(stats),
             width,

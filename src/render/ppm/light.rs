@@ -59,6 +59,9 @@ pub struct LightSeen {
     prior: Vec<PriorLight>,
     /// Which pixels' light seen is supersampled, learned from completed stochastic passes.
     seen: SeenLight,
+    /// Each pixel whose light seen started again (at its first supersampled pass), with the
+    /// photons emitted before that pass, in the order they started.
+    restarts: Vec<(u32, u64)>,
 }
 
 impl LightSeen {
@@ -82,6 +85,7 @@ impl LightSeen {
             } else {
                 SeenLight::default()
             },
+            restarts: Vec::new(),
         }
     }
 
@@ -136,12 +140,14 @@ impl LightSeen {
         }
     }
 
-    /// A completed stochastic pass, the `eye_passes`th: its light seen joins the sums (after
-    /// the sums of the pixels it supersampled for the first time are emptied, [`super::seen`])
-    /// and the next pixels to supersample are chosen. Returns the share of the pixels
-    /// supersampled.
-    pub fn complete_stochastic_pass(&mut self, eye_passes: u32) -> f64 {
-        self.forget_before_supersampling();
+    /// A completed stochastic pass, the `eye_passes`th, before which `photons` photons were
+    /// emitted: its light seen joins the sums (after the sums of the pixels it supersampled for
+    /// the first time are emptied, [`super::seen`]; they are [`LightSeen::restarts`]) and the
+    /// next pixels to supersample are chosen. Returns the share of the pixels supersampled.
+    pub fn complete_stochastic_pass(&mut self, eye_passes: u32, photons: u64) -> f64 {
+        for i in self.forget_before_supersampling() {
+            self.restarts.push((i, photons));
+        }
         self.seen.tally(&self.pass_direct);
         for (d, p) in self.direct.iter_mut().zip(self.pass_direct.drain(..)) {
             *d += p.as_dvec3();
@@ -151,16 +157,25 @@ impl LightSeen {
         self.seen.count() as f64 / self.direct.len().max(1) as f64
     }
 
+    /// Each pixel whose light seen started again, at its first supersampled pass, with the
+    /// photons emitted before that pass: its light seen counts only that pass and those since.
+    pub fn restarts(&self) -> &[(u32, u64)] {
+        &self.restarts
+    }
+
     /// Empties the light seen so far of the pixels chosen to be supersampled before this pass,
-    /// their first supersampled one, and of what a warm restart kept for them ([`super::seen`]).
-    fn forget_before_supersampling(&mut self) {
-        for i in self.seen.take_pending() {
+    /// their first supersampled one, and of what a warm restart kept for them ([`super::seen`]);
+    /// returns those pixels.
+    fn forget_before_supersampling(&mut self) -> Vec<u32> {
+        let pending = self.seen.take_pending();
+        for &i in &pending {
             self.direct[i as usize] = DVec3::ZERO;
             if let Some(prior) = self.prior.get_mut(i as usize) {
                 prior.direct = DVec3::ZERO;
                 prior.direct_passes = 0.0;
             }
         }
+        pending
     }
 
     /// Adds one light sample of every area light at each of `points` (their slots among

@@ -26,6 +26,7 @@ use super::warm::{
     records, records_in_place, Epoch, PointRecord, Reopen, StreamOffset, WarmStart, PRIOR_PASSES,
 };
 use crate::render::control::{Control, Interrupt};
+use crate::render::error_tracker::Restarts;
 use crate::render::shard::{PassSet, PassSums};
 use crate::scene::Scene;
 use crate::settings::RadiusSchedule;
@@ -425,7 +426,13 @@ impl Ppm {
         }
         if self.config.stochastic {
             self.stats.eye_passes += 1;
-            self.stats.supersampled_share = self.light.complete_stochastic_pass(self.stats.eye_passes);
+            self.stats.supersampled_share = self
+                .light
+                .complete_stochastic_pass(self.stats.eye_passes, self.stats.photons);
+        }
+        // The adaptive radius restarts its estimates at the second pass.
+        if self.radius.adaptive_radius && self.stats.passes == 1 {
+            self.stats.restarted_photons = self.stats.photons;
         }
         self.stats.passes += 1;
         self.epoch.inherited = None;
@@ -505,6 +512,15 @@ impl Ppm {
     /// The statistics slots (for the viewer's probe).
     pub fn slots(&self) -> &[Slot] {
         &self.estimates.slots
+    }
+
+    /// What restarted in this epoch: every pixel's estimates at the adaptive radius's restart,
+    /// and each lamp outline's light seen at its first supersampled pass (the `seen` module).
+    pub fn restarts(&self) -> Restarts {
+        Restarts {
+            all: self.stats.restarted_photons,
+            pixels: self.light.restarts().into(),
+        }
     }
 
     /// Whether this epoch continues an earlier one's estimates (it inherited a warm start).

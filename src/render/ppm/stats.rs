@@ -43,6 +43,10 @@ pub struct PpmStats {
     /// Share of the pixels whose eye path a warm restart's first pass copied from the
     /// previous epoch's last instead of tracing it again (the `reuse` module).
     pub copied_share: f64,
+    /// Photons emitted before the pass at which every pixel's estimates started again, no
+    /// longer counting the passes before it (the adaptive radius's restart at the second pass;
+    /// 0: none did). A frame of no more photons is no part of later frames.
+    pub restarted_photons: u64,
     /// Seconds spent in completed passes.
     pub elapsed_secs: f64,
     /// Seconds spent tracing photons.
@@ -76,6 +80,7 @@ impl PpmStats {
         self.bounces = 0;
         self.deposits = 0;
         self.useful_paths = 0;
+        self.restarted_photons = 0;
         if stochastic {
             self.eye_passes = 0;
         }
