@@ -384,6 +384,20 @@ fn vcm_shards_merge_into_the_plain_render() {
         !mixed.status.success() && t.contains("renderer \"vcm\" and \"ppm\""),
         "{t}"
     );
+    // A folder of VCM parts, as `view --watch` sees it: VCM's frame, light subpaths counted.
+    let read = |p: &str| caustic::render::shard::Part::read(Path::new(&path(p))).expect("reads");
+    assert_eq!(read("merged.exr").renderer(), RendererKind::Vcm);
+    assert_eq!(read("q1.exr").renderer(), RendererKind::Ppm);
+    let folder = tempfile::tempdir().expect("temp dir");
+    for p in ["p0.exr", "p1.exr"] {
+        std::fs::copy(path(p), folder.path().join(p)).expect("copies");
+    }
+    let mut merge = caustic::render::shard::FolderMerge::new();
+    let update = caustic::app::watch::scan(&mut merge, folder.path(), std::time::Instant::now());
+    assert_eq!(update.summary.renderer, RendererKind::Vcm);
+    assert_eq!(update.summary.renderer.emitted(), "light subpaths");
+    let frame = update.frame.expect("a merged frame");
+    assert_eq!(frame.stats.renderer(), RendererKind::Vcm);
     let mut path_tracer = VCM_CORNELL;
     path_tracer[3] = "path";
     let refused = common::caustic(&[&path_tracer[..], &["--shard", "0/2", "--out", &path("r.exr")]].concat());

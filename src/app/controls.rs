@@ -669,7 +669,12 @@ fn watching_ui(w: &super::watch::WatchSummary, ui: &mut egui::Ui, out: &mut Vec<
         let done = w.passes as f32 / w.total as f32;
         ui.add(egui::ProgressBar::new(done).text(format!("{} of {} passes", w.passes, w.total)))
             .on_hover_text("Passes merged out of the render's total");
-        ui.label(format!("{} parts, {} photons", w.parts, w.photons));
+        ui.label(format!(
+            "{} parts, {} {}",
+            w.parts,
+            w.photons,
+            w.renderer.emitted()
+        ));
         let error = w
             .relative_error
             .map_or("error estimate after two passes".to_owned(), |e| {

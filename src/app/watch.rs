@@ -15,6 +15,7 @@ use crossbeam_channel::{unbounded, Receiver, Sender};
 use crate::render::frame::{FrameStats, StatRow};
 use crate::render::session::Frame;
 use crate::render::shard::{FolderMerge, RenderInFolder, RenderKey};
+use crate::settings::RendererKind;
 
 /// How often the folder is scanned.
 pub const SCAN_INTERVAL: Duration = Duration::from_millis(250);
@@ -30,8 +31,10 @@ pub struct WatchSummary {
     pub total: u32,
     /// Part files merged.
     pub parts: usize,
-    /// Photons the merged passes emitted.
+    /// Photons the merged passes emitted (VCM: light subpaths).
     pub photons: u64,
+    /// The renderer of the merged passes (photon mapping before the first part).
+    pub renderer: RendererKind,
     /// The estimated relative error of the image (at least two passes).
     pub relative_error: Option<f64>,
     /// The first file merged of the render shown.
@@ -142,6 +145,7 @@ pub fn scan(merge: &mut FolderMerge, dir: &Path, started: Instant) -> WatchUpdat
         total: merge.merged().map_or(0, |p| p.total_passes),
         parts: merge.parts_merged(),
         photons: merge.merged().map_or(0, |p| p.sums.photons()),
+        renderer: merge.merged().map_or(RendererKind::Ppm, |p| p.renderer()),
         relative_error: merge.merged().and_then(|p| p.sums.relative_error()),
         first_part: merge.first_part().map(Path::to_owned),
         renders: merge.renders(),
@@ -167,7 +171,7 @@ fn merged_frame(
     started: Instant,
 ) -> Frame {
     let stats = FrameStats {
-        kind: crate::settings::RendererKind::Ppm,
+        kind: summary.renderer,
         seconds: 0.0,
         summary: Vec::new(),
         skipped: Vec::new(),

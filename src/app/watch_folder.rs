@@ -64,6 +64,7 @@ impl Viewer {
             total: 0,
             parts: 0,
             photons: 0,
+            renderer: crate::settings::RendererKind::Ppm,
             relative_error: None,
             first_part: None,
             renders: Vec::new(),

@@ -37,12 +37,7 @@ pub fn render_shard(scene: &mut Scene, passes: PassSet, total: u32, out: &Path, 
     let (part, photons) = shard_part(scene, &passes, total, || bar.inc(1))?;
     bar.finish_and_clear();
     part.write(out, force)?;
-    // What a pass emits: VCM's light subpaths are its photons.
-    let emitted = if scene.params.renderer == caustic::scene::RendererKind::Vcm {
-        "light subpaths"
-    } else {
-        "photons"
-    };
+    let emitted = scene.params.renderer.emitted();
     println!(
         "{passes}: {count} of {total} passes, {photons} {emitted} in {:.2} s ({:.2} passes/s) → {}",
         start.elapsed().as_secs_f64(),

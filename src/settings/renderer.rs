@@ -86,6 +86,15 @@ impl RendererKind {
     pub fn from_name(name: &str) -> Option<RendererKind> {
         Self::ALL.iter().copied().find(|k| k.name() == name)
     }
+
+    /// What a pass's sample count counts, in words: VCM's light subpaths play photon
+    /// mapping's photons (a frame's and a part's `photons`).
+    pub fn emitted(self) -> &'static str {
+        match self {
+            RendererKind::Vcm => "light subpaths",
+            _ => "photons",
+        }
+    }
 }
 
 impl Serialize for RendererKind {

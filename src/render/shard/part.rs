@@ -17,6 +17,7 @@ use std::path::{Path, PathBuf};
 use super::sums::{parse_passes, passes_text, PassSums, SumsClash};
 use crate::render::film::{exr_text_attributes, Metadata};
 use crate::render::provenance;
+use crate::settings::{RenderParams, RendererKind};
 
 /// Marks a part file (its format version).
 pub const PART: &str = "caustic:part";
@@ -116,6 +117,14 @@ impl Part {
             .iter()
             .find(|(k, _)| k == key)
             .map(|(_, v)| v.as_str())
+    }
+
+    /// The renderer its passes were rendered with, as its settings record it (VCM or photon
+    /// mapping; photon mapping when they do not say).
+    pub fn renderer(&self) -> RendererKind {
+        self.get(SETTINGS)
+            .and_then(|text| toml::from_str::<RenderParams>(text).ok())
+            .map_or(RendererKind::Ppm, |p| p.renderer)
     }
 
     /// Whether every pass of the render is in it.
