@@ -4,7 +4,10 @@ materials: rough (GGX `roughdielectric` and `roughconductor` with `material = "n
 (`dielectric` and `conductor` with `material = "none"`).
 
     pip install mitsuba          # and Debian's libllvm19 for the llvm variant
-    python3 assets/compare/mitsuba_cornell.py rough|smooth SPP OUT.exr
+    python3 assets/compare/mitsuba_cornell.py rough|smooth SPP OUT.exr [SEED]
+
+A reference's own noise adds to every RMSE measured against it: render two with different
+seeds and their RMSE is sqrt(2) times one's noise (see README, "Against Mitsuba 3").
 """
 import sys, time
 import mitsuba as mi
@@ -17,10 +20,11 @@ def rect(center, rot_axis, rot_deg, bsdf, emitter=None):
     return d
 diffuse = lambda c: {"type": "diffuse", "reflectance": {"type": "rgb", "value": c}}
 grey, red, green = diffuse([0.75]*3), diffuse([0.75, 0.25, 0.25]), diffuse([0.25, 0.75, 0.25])
-if len(sys.argv) != 4 or sys.argv[1] not in ("rough", "smooth"):
-    sys.exit("usage: mitsuba_cornell.py rough|smooth SPP OUT.exr")
+if len(sys.argv) not in (4, 5) or sys.argv[1] not in ("rough", "smooth"):
+    sys.exit("usage: mitsuba_cornell.py rough|smooth SPP OUT.exr [SEED]")
 smooth = sys.argv[1] == "smooth"
 spp = int(sys.argv[2])
+seed = int(sys.argv[4]) if len(sys.argv) == 5 else 0
 glass = ({"type": "dielectric", "int_ior": 1.5, "ext_ior": 1.0} if smooth else
          {"type": "roughdielectric", "distribution": "ggx", "alpha": 0.1, "int_ior": 1.5, "ext_ior": 1.0})
 mirror = ({"type": "conductor", "material": "none"} if smooth else
@@ -46,6 +50,6 @@ scene = mi.load_dict({
     "mirror": {"type": "sphere", "center": [-0.45, -0.65, -0.35], "radius": 0.35, "bsdf": mirror},
 })
 t = time.time()
-img = mi.render(scene, spp=spp)
+img = mi.render(scene, spp=spp, seed=seed)
 mi.Bitmap(img).write(sys.argv[3])
 print(f"{spp} spp in {time.time() - t:.1f} s")
