@@ -882,8 +882,8 @@ fn watching_a_folder_merges_each_new_part_and_skips_what_does_not_belong() {
         "the merged image is not black"
     );
     h.get_by_label("Render folder");
-    // What does nothing while watching is not shown: the renderer, pause, restart and the
-    // render settings; saving and exposure are.
+    // What does nothing while watching is not shown: the renderer, pause, restart, the
+    // render settings and a render's epoch, time and restarts; saving and exposure are.
     for gone in [
         "Renderer",
         "Pause",
@@ -892,6 +892,9 @@ fn watching_a_folder_merges_each_new_part_and_skips_what_does_not_belong() {
         "Photon mapping",
         "Camera",
         "Alpha",
+        "Epoch",
+        "Elapsed",
+        "Last restart",
     ] {
         assert!(h.query_by_label(gone).is_none(), "{gone} is shown while watching");
     }

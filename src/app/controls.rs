@@ -292,23 +292,31 @@ fn statistics_ui(viewer: &ViewerState, ui: &mut egui::Ui) {
                 ui.monospace(value).on_hover_text(tip);
                 ui.end_row();
             };
-            row(
-                "Epoch",
-                frame.epoch.to_string(),
-                "Restarts so far: each change that discards the accumulation starts a new epoch",
-            );
-            let pass = if frame.preview {
-                "preview (1/4 resolution)".to_owned()
-            } else {
-                frame.pass.to_string()
-            };
-            row(
-                "Pass",
-                pass,
-                "Completed passes in this epoch; a new epoch first shows a quick low-resolution preview",
-            );
+            // A watched folder's frame is its parts' merge: its own rows say how far it is,
+            // and it has no epochs, restarts or render time of its own.
+            let rendering = viewer.watching.is_none();
+            if rendering {
+                row(
+                    "Epoch",
+                    frame.epoch.to_string(),
+                    "Restarts so far: each change that discards the accumulation starts a new epoch",
+                );
+                let pass = if frame.preview {
+                    "preview (1/4 resolution)".to_owned()
+                } else {
+                    frame.pass.to_string()
+                };
+                row(
+                    "Pass",
+                    pass,
+                    "Completed passes in this epoch; a new epoch first shows a quick low-resolution preview",
+                );
+            }
             for r in &frame.stats.rows {
                 row(&r.label, r.value.clone(), &r.tip);
+            }
+            if !rendering {
+                return;
             }
             row(
                 "Elapsed",
