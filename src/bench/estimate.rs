@@ -9,6 +9,7 @@
 //! photons a pass as at the scene's own size.
 
 use std::path::PathBuf;
+use std::time::{Duration, Instant};
 
 use anyhow::{bail, Result};
 use clap::Parser;
@@ -92,8 +93,13 @@ pub fn scaled(mut scene: Scene, width: u32) -> Scene {
 }
 
 /// Renders `scene` as the viewer does for the largest of `passes`, comparing the estimates
-/// with the truth against `reference` after each of them.
-pub fn check_estimates(scene: Scene, passes: &[u32], reference: &[[f32; 3]]) -> Result<Vec<EstimateCheck>> {
+/// with the truth against `reference` after each of them; also the mean seconds the estimate
+/// took a frame.
+pub fn check_estimates(
+    scene: Scene,
+    passes: &[u32],
+    reference: &[[f32; 3]],
+) -> Result<(Vec<EstimateCheck>, f64)> {
     let most = passes.iter().copied().max().unwrap_or(0);
     let options = SessionOptions {
         max_passes: Some(most),
@@ -104,8 +110,12 @@ pub fn check_estimates(scene: Scene, passes: &[u32], reference: &[[f32; 3]]) -> 
     let mut tracker = ErrorTracker::default();
     let mut previous: Option<(u64, std::sync::Arc<[[f32; 3]]>)> = None;
     let mut out = Vec::new();
+    let (mut tracking, mut frames) = (Duration::ZERO, 0u32);
     render_session(scene, options, |f| {
+        let start = Instant::now();
         let estimate = tracker.add((f.photons, &f.restarts), &f.radiance, alpha);
+        tracking += start.elapsed();
+        frames += 1;
         let consecutive = previous
             .as_ref()
             .and_then(|(n, a)| relative_error_estimate(*n, a, f.photons, &f.radiance));
@@ -121,7 +131,7 @@ pub fn check_estimates(scene: Scene, passes: &[u32], reference: &[[f32; 3]]) -> 
             });
         }
     })?;
-    Ok(out)
+    Ok((out, tracking.as_secs_f64() / frames.max(1) as f64))
 }
 
 /// Runs the measurement.
@@ -149,7 +159,17 @@ pub fn bench_estimate(args: EstimateArgs, out: &mut BenchOutput) -> Result<()> {
             None,
             out,
         )?;
-        let checks = check_estimates(scene, &args.passes, &reference)?;
+        let (w, h) = (scene.camera.width, scene.camera.height);
+        let (checks, per_frame) = check_estimates(scene, &args.passes, &reference)?;
+        out.say(format!(
+            "{}: the estimate took {:.2} ms a frame at {w}x{h} (the viewer's thread, after each pass)",
+            path.display(),
+            1e3 * per_frame
+        ));
+        out.push(
+            "estimate_time",
+            serde_json::json!({ "scene": path.display().to_string(), "width": w, "height": h, "secs_a_frame": per_frame }),
+        );
         for c in checks {
             let show = |e: Option<f64>| {
                 e.map_or("-".into(), |e| {

@@ -336,7 +336,9 @@ fn half_comparison(
     (all, restart_of): (u64, Option<&[u64]>),
 ) -> HalfComparison {
     let alpha = alpha.clamp(0.05, 1.0);
-    let g = noise_factor(n_a as f64 / n_b as f64, alpha);
+    // Every pixel's factor when it restarted with all of them (or never): computed once, as
+    // a pixel of its own restart is rare (a lamp's outline).
+    let g_all = noise_factor((n_a - all.min(n_a)) as f64 / (n_b - all.min(n_a)) as f64, alpha);
     let (mut diff2, mut norm2, mut left_out, mut left_out_diff2) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
     let (mut raw, mut raw4) = (0.0f64, 0.0f64);
     for (i, (pa, pb)) in a.iter().zip(b).enumerate() {
@@ -348,10 +350,10 @@ fn half_comparison(
             left_out_diff2 += d2;
             continue;
         }
-        let g = if r > 0 {
-            noise_factor((n_a - r) as f64 / (n_b - r) as f64, alpha)
+        let g = if r == all {
+            g_all
         } else {
-            g
+            noise_factor((n_a - r) as f64 / (n_b - r) as f64, alpha)
         };
         diff2 += d2 / g;
         norm2 += own;
