@@ -325,6 +325,7 @@ fn a_watched_folder_merges_new_parts_ignores_hidden_and_redundant_ones_and_rebui
     assert!(folder.scan(dir.path()).expect("scans").changed);
     let all = folder.merged().expect("merged").clone();
     assert!(all.is_complete());
+    assert_eq!(folder.rebuilds(), 0, "new parts add to the merge");
     assert_eq!(all.sums, shard_sums(&scene, Shard::default(), total));
     // The farm's own merge beside its parts adds nothing and is not an error.
     all.write(&dir.path().join("image.exr"), false).expect("writes");
@@ -337,6 +338,7 @@ fn a_watched_folder_merges_new_parts_ignores_hidden_and_redundant_ones_and_rebui
     let generation = folder.generation();
     assert!(folder.scan(dir.path()).expect("scans").changed);
     assert!(folder.generation() > generation);
+    assert_eq!(folder.rebuilds(), 1, "a rewritten part starts the merge again");
     assert_eq!(folder.merged().map(|p| &p.sums), Some(&all.sums));
 }
 

@@ -876,6 +876,11 @@ fn watching_a_folder_merges_each_new_part_and_skips_what_does_not_belong() {
     step_until(&mut h, "the second part", |v| {
         v.frame().is_some_and(|f| f.pass == 4)
     });
+    // The plot shows the merge's own estimate, one point a merge, as the panel says it.
+    let error = viewer(&h).watching().and_then(|w| w.relative_error);
+    let plotted = viewer(&h).convergence();
+    assert_eq!(plotted.points.len(), 2, "{:?}", plotted.points);
+    assert_eq!(plotted.latest().map(|e| e.total()), error);
     let frame = viewer(&h).frame().expect("frame");
     assert!(
         frame.radiance.iter().any(|p| p[0] > 0.0),

@@ -425,8 +425,13 @@ fn convergence_plot_ui(viewer: &ViewerState, ui: &mut egui::Ui) {
 /// The newest estimate in words: its noise and blur, and a note where it is uncertain.
 fn latest_estimate_ui(viewer: &ViewerState, ui: &mut egui::Ui) {
     let Some(e) = viewer.convergence.latest() else {
-        ui.label(RichText::new("no estimate yet: it compares two frames").small())
-            .on_hover_text("The first estimate comes once a frame holds about twice the photons of an earlier one of the same render; with photon mapping, of one made after its estimates restarted with the adaptive radius (after the first pass)");
+        if viewer.watching.is_some() {
+            ui.label(RichText::new("no estimate yet: it needs two passes").small())
+                .on_hover_text("A watched render's estimate comes from the spread of its independent passes");
+        } else {
+            ui.label(RichText::new("no estimate yet: it compares two frames").small())
+                .on_hover_text("The first estimate comes once a frame holds about twice the photons of an earlier one of the same render; with photon mapping, of one made after its estimates restarted with the adaptive radius (after the first pass)");
+        }
         return;
     };
     let now = percent(e.total());
@@ -437,7 +442,7 @@ fn latest_estimate_ui(viewer: &ViewerState, ui: &mut egui::Ui) {
         });
         if let Some(why) = e.why_uncertain() {
             let help = if e.settling {
-                "Some pixels started their estimates anew a few passes ago (a lamp's outline that now takes extra rays, the adaptive radius after the first pass), so the frames compared differ there by both frames' noise: the estimate is high until those pixels have a few passes of their own"
+                "Some pixels started their estimates anew a few passes ago (a lamp's outline that now takes extra rays, the adaptive radius after the first pass), so the frames compared differ there by both frames' noise: those pixels are left out, and the estimate cannot see their error (it may be low) until they have a few passes of their own"
             } else {
                 "The error is in a few pixels (bright specks that come and go: a light seen in a pixel's corner, rare caustic paths, a focus a few pixels wide), so this frame's true error may be far from the estimate either way"
             };

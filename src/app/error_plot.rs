@@ -42,12 +42,18 @@ impl Convergence {
         alpha: f64,
     ) {
         if let Some(estimate) = self.tracker.add((photons, restarts), radiance, alpha) {
-            self.points.push([elapsed_secs, estimate.total()]);
-            if estimate.uncertain() {
-                self.uncertain_points.push([elapsed_secs, estimate.total()]);
-            }
-            self.latest = Some(estimate);
+            self.add_estimate(elapsed_secs, estimate);
         }
+    }
+
+    /// Takes an estimate made elsewhere after `elapsed_secs` (a watched render's, from the
+    /// spread of its independent passes).
+    pub fn add_estimate(&mut self, elapsed_secs: f64, estimate: ErrorEstimate) {
+        self.points.push([elapsed_secs, estimate.total()]);
+        if estimate.uncertain() {
+            self.uncertain_points.push([elapsed_secs, estimate.total()]);
+        }
+        self.latest = Some(estimate);
     }
 
     /// Takes a frame's true error against the reference.

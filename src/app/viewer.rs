@@ -419,7 +419,8 @@ impl Viewer {
                 self.pending_restart = None;
             }
         }
-        if frame.stats.renderer().progressive() && !frame.preview {
+        // A watched render's estimate comes with it (`poll_watch`).
+        if frame.stats.renderer().progressive() && !frame.preview && self.watching.is_none() {
             // Photon mapping's α shapes how its noise and bias fall; a path tracer's passes
             // are plain means (α = 1: no bias to fall).
             let alpha = match frame.stats.renderer() {

@@ -49,7 +49,7 @@ pub struct WatchSummary {
 pub struct WatchUpdate {
     /// Where the render stands.
     pub summary: WatchSummary,
-    /// The merged image (with the merge's generation as its epoch), when it changed.
+    /// The merged image (with the merge's rebuilds as its epoch), when it changed.
     pub frame: Option<Frame>,
     /// Files skipped in the scan, each with its reason.
     pub skipped: Vec<String>,
@@ -152,7 +152,9 @@ pub fn scan(merge: &mut FolderMerge, dir: &Path, started: Instant) -> WatchUpdat
         shown: merge.shown().map(|(k, chosen)| (k.clone(), chosen)),
     };
     let frame = match merge.merged() {
-        Some(part) if report.changed => Some(merged_frame(part, &summary, merge.generation(), started)),
+        // One epoch a rebuild: frames within it grow pass by pass, so the error plot keeps
+        // their estimates.
+        Some(part) if report.changed => Some(merged_frame(part, &summary, merge.rebuilds(), started)),
         _ => None,
     };
     WatchUpdate {
@@ -163,11 +165,11 @@ pub fn scan(merge: &mut FolderMerge, dir: &Path, started: Instant) -> WatchUpdat
     }
 }
 
-/// The merged image as a frame of epoch `generation`.
+/// The merged image as a frame of epoch `rebuilds`.
 fn merged_frame(
     part: &crate::render::shard::Part,
     summary: &WatchSummary,
-    generation: u64,
+    rebuilds: u64,
     started: Instant,
 ) -> Frame {
     let stats = FrameStats {
@@ -204,7 +206,7 @@ fn merged_frame(
         part.sums.size(),
         part.sums.mean(),
         summary.passes as u32,
-        (generation, started.elapsed().as_secs_f64()),
+        (rebuilds, started.elapsed().as_secs_f64()),
         stats,
     );
     frame.photons = summary.photons;

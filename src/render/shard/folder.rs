@@ -83,6 +83,8 @@ pub struct FolderMerge {
     merged: Option<(RenderKey, PathBuf, Part)>,
     /// Bumped whenever the merge changes.
     generation: u64,
+    /// Bumped whenever the merge starts again from nothing.
+    rebuilds: u64,
 }
 
 /// A scan's result: what changed, and the messages of files skipped in this scan.
@@ -128,6 +130,12 @@ impl FolderMerge {
     /// Increases whenever the merge changes.
     pub fn generation(&self) -> u64 {
         self.generation
+    }
+
+    /// Increases whenever the merge starts again from nothing (another render shown, a merged
+    /// part rewritten or gone); between two, each change adds passes.
+    pub fn rebuilds(&self) -> u64 {
+        self.rebuilds
     }
 
     /// Files merged so far.
@@ -208,6 +216,7 @@ impl FolderMerge {
             // Another render to show, or a merged part rewritten or gone: merge again.
             if self.merged.take().is_some() {
                 report.changed = true;
+                self.rebuilds += 1;
             }
             for entry in self.files.values_mut() {
                 if entry.fate == Fate::Merged || entry.fate == Fate::Redundant {
