@@ -6,6 +6,7 @@
 //! out and sends the document's changes to the render session.
 
 use std::collections::BTreeSet;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
 use egui::{Pos2, Vec2};
@@ -203,9 +204,17 @@ pub struct Editor {
     /// Undo / redo.
     pub history: History,
     overlay: Arc<WireframeGeometry>,
-    /// Changes whenever the overlay's geometry does.
+    /// Changes whenever the overlay's geometry does, to a value no editor of this process
+    /// had before ([`next_generation`]): the GPU keeps the geometry of the generation it last
+    /// uploaded, and a scene opened in place of another must not pass for it.
     pub generation: u64,
     overlay_stale: bool,
+}
+
+/// A generation of overlay geometry no editor of this process had before.
+fn next_generation() -> u64 {
+    static NEXT: AtomicU64 = AtomicU64::new(0);
+    NEXT.fetch_add(1, Ordering::Relaxed)
 }
 
 impl Editor {
@@ -228,7 +237,7 @@ impl Editor {
             world_up: navigate::world_up(cam.up),
             history: History::default(),
             overlay: Arc::default(),
-            generation: 0,
+            generation: next_generation(),
             overlay_stale: true,
         }
     }
@@ -360,7 +369,7 @@ impl Editor {
                 self.hovered,
                 &self.selection,
             ));
-            self.generation += 1;
+            self.generation = next_generation();
             self.overlay_stale = false;
         }
         self.overlay.clone()
@@ -536,6 +545,20 @@ impl Editor {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn another_scene_s_overlay_is_never_taken_for_the_last_one() {
+        let scene = Scene::builtin();
+        let (mut first, doc) = (Editor::new(&scene), Document::new(scene.clone()));
+        first.overlay(&doc);
+        let mut second = Editor::new(&scene);
+        assert_ne!(second.generation, first.generation);
+        second.overlay(&doc);
+        assert_ne!(
+            second.generation, first.generation,
+            "the GPU would keep the first scene's nets"
+        );
+    }
 
     #[test]
     fn history_undoes_redoes_and_knows_what_is_unsaved() {
