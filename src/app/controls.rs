@@ -649,8 +649,13 @@ fn render_choice_ui(w: &super::watch::WatchSummary, ui: &mut egui::Ui, out: &mut
     let current = shown
         .and_then(|(k, _)| w.renders.iter().find(|r| &r.key == k))
         .map_or("(none yet)".to_owned(), label);
-    egui::ComboBox::from_label("Render shown")
+    // The label above and the choice truncated to the panel: a render's description is
+    // longer than the panel is wide.
+    let name = ui.label("Render shown");
+    egui::ComboBox::from_id_salt("caustic-render-shown")
         .selected_text(current)
+        .width(ui.available_width())
+        .truncate()
         .show_ui(ui, |ui| {
             if ui
                 .selectable_label(shown.is_some_and(|(_, chosen)| !chosen), "The render most parts belong to")
@@ -666,6 +671,7 @@ fn render_choice_ui(w: &super::watch::WatchSummary, ui: &mut egui::Ui, out: &mut
             }
         })
         .response
+        .labelled_by(name.id)
         .on_hover_text("The folder holds parts of more than one render: the one most parts belong to is shown unless you choose another");
 }
 
