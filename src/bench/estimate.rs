@@ -171,50 +171,55 @@ pub fn bench_estimate(args: EstimateArgs, out: &mut BenchOutput) -> Result<()> {
             serde_json::json!({ "scene": path.display().to_string(), "width": w, "height": h, "secs_a_frame": per_frame }),
         );
         for c in checks {
-            let show = |e: Option<f64>| {
-                e.map_or("-".into(), |e| {
-                    format!("{:.2} % ({:.2}x)", 100.0 * e, e / c.truth)
-                })
-            };
-            let total = c.estimate.map_or("-".into(), |e| {
-                format!(
-                    "{:.2} % ({:.2}x, {:.0})",
-                    100.0 * e.total(),
-                    e.total() / c.truth,
-                    e.pixels
-                )
-            });
-            out.say(format!(
-                "{}  {}  {:.2} % ({:.0})  {}  {}  {}  {}  {}",
-                path.display(),
-                c.pass,
-                100.0 * c.truth,
-                c.truth_pixels,
-                show(c.estimate.map(|e| e.noise)),
-                show(c.estimate.and_then(|e| e.blur)),
-                total,
-                c.verdict(),
-                show(c.consecutive)
-            ));
-            let name = path
-                .file_stem()
-                .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
-            out.push(
-                "checks",
-                serde_json::json!({
-                    "scene": name,
-                    "pass": c.pass,
-                    "truth": c.truth,
-                    "truth_pixels": c.truth_pixels,
-                    "estimate": c.estimate.map(|e| e.noise),
-                    "blur": c.estimate.and_then(|e| e.blur),
-                    "total": c.estimate.map(|e| e.total()),
-                    "pixels": c.estimate.map(|e| e.pixels),
-                    "verdict": c.verdict(),
-                    "consecutive": c.consecutive,
-                }),
-            );
+            report_check(path, &c, out);
         }
     }
     Ok(())
+}
+
+/// Prints and records one check of the estimate of `path`'s render.
+fn report_check(path: &std::path::Path, c: &EstimateCheck, out: &mut BenchOutput) {
+    let show = |e: Option<f64>| {
+        e.map_or("-".into(), |e| {
+            format!("{:.2} % ({:.2}x)", 100.0 * e, e / c.truth)
+        })
+    };
+    let total = c.estimate.map_or("-".into(), |e| {
+        format!(
+            "{:.2} % ({:.2}x, {:.0})",
+            100.0 * e.total(),
+            e.total() / c.truth,
+            e.pixels
+        )
+    });
+    out.say(format!(
+        "{}  {}  {:.2} % ({:.0})  {}  {}  {}  {}  {}",
+        path.display(),
+        c.pass,
+        100.0 * c.truth,
+        c.truth_pixels,
+        show(c.estimate.map(|e| e.noise)),
+        show(c.estimate.and_then(|e| e.blur)),
+        total,
+        c.verdict(),
+        show(c.consecutive)
+    ));
+    let name = path
+        .file_stem()
+        .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
+    out.push(
+        "checks",
+        serde_json::json!({
+            "scene": name,
+            "pass": c.pass,
+            "truth": c.truth,
+            "truth_pixels": c.truth_pixels,
+            "estimate": c.estimate.map(|e| e.noise),
+            "blur": c.estimate.and_then(|e| e.blur),
+            "total": c.estimate.map(|e| e.total()),
+            "pixels": c.estimate.map(|e| e.pixels),
+            "verdict": c.verdict(),
+            "consecutive": c.consecutive,
+        }),
+    );
 }
