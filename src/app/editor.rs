@@ -205,7 +205,7 @@ pub struct Editor {
     pub history: History,
     overlay: Arc<WireframeGeometry>,
     /// Changes whenever the overlay's geometry does, to a value no editor of this process
-    /// had before ([`next_generation`]): the GPU keeps the geometry of the generation it last
+    /// had before (a process-wide counter): the GPU keeps the geometry of the generation it last
     /// uploaded, and a scene opened in place of another must not pass for it.
     pub generation: u64,
     overlay_stale: bool,
