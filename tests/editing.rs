@@ -51,6 +51,7 @@ fn flat_frame() -> Frame {
         radiance: vec![[0.2f32; 3]; n].into(),
         layers: Vec::new(),
         preview: false,
+        error: Default::default(),
     }
 }
 

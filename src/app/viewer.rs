@@ -19,6 +19,8 @@ use super::settings::{ViewerSettings, Zoom};
 pub use super::state::Status;
 use super::state::ViewerState;
 use super::tev_send::TevSend;
+use crate::render::error_tracker::ErrorEstimate;
+use crate::render::frame::ErrorSource;
 use crate::render::image_metadata;
 use crate::render::session::{Command, Frame, RenderSession, SessionOptions};
 use crate::scene::{RendererKind, Scene};
@@ -419,8 +421,19 @@ impl Viewer {
                 self.pending_restart = None;
             }
         }
-        // A watched render's estimate comes with it (`poll_watch`).
-        if frame.stats.renderer().progressive() && !frame.preview && self.watching.is_none() {
+        if let ErrorSource::PassSpread(spread) = frame.error {
+            if let Some(noise) = spread {
+                // Over every pixel: each one's passes spread.
+                let pixels = frame.width as f64 * frame.height as f64;
+                let estimate = ErrorEstimate {
+                    noise,
+                    blur: None,
+                    pixels,
+                    settling: false,
+                };
+                self.convergence.add_estimate(frame.elapsed_secs, estimate);
+            }
+        } else if frame.stats.renderer().progressive() && !frame.preview {
             // Photon mapping's α shapes how its noise and bias fall; a path tracer's passes
             // are plain means (α = 1: no bias to fall).
             let alpha = match frame.stats.renderer() {

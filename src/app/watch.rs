@@ -12,7 +12,7 @@ use std::time::{Duration, Instant};
 
 use crossbeam_channel::{unbounded, Receiver, Sender};
 
-use crate::render::frame::{FrameStats, StatRow};
+use crate::render::frame::{ErrorSource, FrameStats, StatRow};
 use crate::render::session::Frame;
 use crate::render::shard::{FolderMerge, RenderInFolder, RenderKey};
 use crate::settings::RendererKind;
@@ -210,5 +210,6 @@ fn merged_frame(
         stats,
     );
     frame.photons = summary.photons;
+    frame.error = ErrorSource::PassSpread(summary.relative_error);
     frame
 }

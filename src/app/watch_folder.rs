@@ -116,21 +116,7 @@ impl Viewer {
             if let Some(mut frame) = update.frame {
                 // Watched images follow whatever the paused session showed.
                 frame.epoch += self.watch_epoch_base;
-                let (secs, pixels) = (frame.elapsed_secs, frame.width as f64 * frame.height as f64);
                 self.show_frame(frame);
-                // The merge's own estimate, from the spread of its independent passes, over
-                // every pixel.
-                if let Some(noise) = update.summary.relative_error {
-                    self.convergence.add_estimate(
-                        secs,
-                        crate::render::error_tracker::ErrorEstimate {
-                            noise,
-                            blur: None,
-                            pixels,
-                            settling: false,
-                        },
-                    );
-                }
             }
             self.watching = Some(update.summary);
         }

@@ -112,6 +112,20 @@ pub struct Frame {
     pub layers: Vec<PixelLayer>,
     /// A quick low-resolution preview of a new epoch (pass 0), enlarged to full size.
     pub preview: bool,
+    /// Where its error estimate comes from.
+    pub error: ErrorSource,
+}
+
+/// Where a frame's error estimate comes from.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum ErrorSource {
+    /// The viewer compares it with the epoch's earlier frames
+    /// ([`crate::render::error_tracker`]).
+    #[default]
+    Frames,
+    /// The spread of the independent passes it merges (a watched folder's parts); `None`
+    /// before two.
+    PassSpread(Option<f64>),
 }
 
 impl Frame {
@@ -135,6 +149,7 @@ impl Frame {
             radiance: radiance.into(),
             layers: Vec::new(),
             preview: false,
+            error: ErrorSource::Frames,
         }
     }
 

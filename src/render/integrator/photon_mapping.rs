@@ -125,6 +125,7 @@ impl Frame {
                 },
             ],
             preview: false,
+            error: crate::render::frame::ErrorSource::Frames,
         }
     }
 }
